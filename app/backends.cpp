@@ -32,13 +32,13 @@ ReferenceOptions parseReferenceSpec(std::string_view spec) {
       int bits = -1;
       auto [ptr, ec] = std::from_chars(num.data(), num.data() + num.size(), bits);
       if (ec != std::errc() || ptr != num.data() + num.size() || bits < 0 || bits > 12) {
-        throw InputError(fmt::format("backend '{}': subpixel bits must be an integer in [0, 12]",
-                                     spec));
+        throw InputError(
+            fmt::format("backend '{}': subpixel bits must be an integer in [0, 12]", spec));
       }
       opts.subpixel_bits = bits;
     } else {
-      throw InputError(fmt::format("backend '{}': unknown reference option '{}' (valid: {})",
-                                   spec, part, kValidSpecs));
+      throw InputError(fmt::format("backend '{}': unknown reference option '{}' (valid: {})", spec,
+                                   part, kValidSpecs));
     }
   }
   if (!rest.empty())

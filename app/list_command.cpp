@@ -29,8 +29,8 @@ int listCommand(const ListArgs& args) {
   if (args.json) {
     nlohmann::json out = nlohmann::json::array();
     for (const Row& r : rows)
-      out.push_back({{"name", r.name}, {"tags", r.tags}, {"description", r.description},
-                     {"file", r.file}});
+      out.push_back(
+          {{"name", r.name}, {"tags", r.tags}, {"description", r.description}, {"file", r.file}});
     std::cout << out.dump(2) << '\n';
   } else if (args.markdown) {
     std::cout << "| fixture | tags | description |\n|---|---|---|\n";
