@@ -1,0 +1,54 @@
+// Per-fragment operations after shading: depth quantization and test, blending and the
+// colour format conversion.
+//   depth: z clamped to [0, 1]; d16/d24 store q = round-half-even(z * (2^b - 1)), i.e.
+//          the value q / (2^b - 1); d32f stores (float)z. llvmpipe does the same (see
+//          docs/reference.md). NaN depth stores 0, as llvmpipe's conversion yields.
+//   test:  LESS on the stored values (ALWAYS when the draw pass says so).
+//   blend: src * a + dst * (1 - a) on all four channels (GL_SRC_ALPHA,
+//          GL_ONE_MINUS_SRC_ALPHA), for rgba8 with the source clamped to [0, 1] first.
+//   colour: rgba32f stores (float)c; rgba8 stores round-half-even(clamp(c, 0, 1) * 255)
+//          / 255 (NaN stores 0).
+// Depth buffer entries are 32-bit keys whose unsigned order is the stored values' order
+// (q itself, or the bits of a non-negative float), so the test is one integer compare.
+#pragma once
+
+#include <bit>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "fixtures/scene.h"
+#include "reference/rounding.h"
+
+namespace rc::ref {
+
+// z clamped to [0, 1]; -0 and NaN become +0.
+inline double clampDepth(double z) {
+  if (!(z > 0.0)) return 0.0;
+  return z < 1.0 ? z : 1.0;
+}
+
+// (2^b - 1) for d16/d24; for d32f the 2^24 steps per unit the depth_gap channel counts.
+double depthStepsPerUnit(DepthFormat format);
+
+// The key of a clamped depth.
+inline std::uint32_t depthKey(double z01, DepthFormat format) {
+  switch (format) {
+    case DepthFormat::D16: return static_cast<std::uint32_t>(roundHalfEven(z01 * 65535.0));
+    case DepthFormat::D24: return static_cast<std::uint32_t>(roundHalfEven(z01 * 16777215.0));
+    case DepthFormat::D32F: break;
+  }
+  return std::bit_cast<std::uint32_t>(static_cast<float>(z01));
+}
+
+// The stored depth a key stands for, in [0, 1].
+double storedDepth(std::uint32_t key, DepthFormat format);
+
+// The value a colour channel is stored as, and the exact value read back for blending.
+float storeColor(double c, ColorFormat format);
+double loadColor(float stored, ColorFormat format);
+
+// src * a + dst * (1 - a) per channel, a = src alpha (source clamped first for rgba8).
+glm::dvec4 blendSourceOver(glm::dvec4 src, const glm::dvec4& dst, ColorFormat format);
+
+}  // namespace rc::ref

@@ -1,0 +1,426 @@
+// The reference renderer: drives the stages in the draw order of fixtures/scene_logic.h
+// drawPasses(). See reference_renderer.h and docs/reference.md.
+#include "reference/reference_renderer.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "fixtures/errors.h"
+#include "fixtures/scene_logic.h"
+#include "reference/clipper.h"
+#include "reference/fragment_ops.h"
+#include "reference/interpolation.h"
+#include "reference/rasterizer.h"
+#include "reference/shading.h"
+#include "reference/texture_sampling.h"
+#include "reference/uncertainty.h"
+#include "reference/vertex_stage.h"
+#include "reference/viewport.h"
+
+namespace rc {
+namespace {
+
+using namespace rc::ref;
+
+constexpr int kMaxImageSide = 16384;
+constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 26;
+
+// ---- input validation -------------------------------------------------------------------
+
+std::string sceneLabel(const Scene& scene) {
+  if (!scene.source.empty()) return scene.source.string();
+  return scene.name.empty() ? std::string("scene") : scene.name;
+}
+
+void validate(const Scene& scene, const ReferenceOptions& options) {
+  const std::string label = sceneLabel(scene);
+  auto fail = [&](const std::string& what) { throw InputError(label + ": " + what); };
+  if (options.subpixel_bits < 0 || options.subpixel_bits > kMaxSubpixelBits)
+    fail("reference subpixel bits " + std::to_string(options.subpixel_bits) +
+         " out of range [0, " + std::to_string(kMaxSubpixelBits) + "]");
+  if (scene.width < 1 || scene.height < 1 || scene.width > kMaxImageSide ||
+      scene.height > kMaxImageSide ||
+      std::int64_t{scene.width} * scene.height > kMaxImagePixels)
+    fail("image " + std::to_string(scene.width) + "x" + std::to_string(scene.height) +
+         " outside what the reference renders (1..16384 a side, at most 2^26 pixels)");
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    const Texture* t = scene.materials[m].texture.get();
+    if (t && (t->width < 1 || t->height < 1 ||
+              t->rgba.size() != 4 * static_cast<std::size_t>(t->width) * t->height))
+      fail("materials[" + std::to_string(m) + "]: texture size does not match its data");
+  }
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const Object& obj = scene.objects[o];
+    const Mesh& mesh = obj.mesh;
+    const std::string where = "objects[" + std::to_string(o) + "] (" + obj.name + "): ";
+    if (obj.material >= scene.materials.size())
+      fail(where + "material index " + std::to_string(obj.material) + " out of range");
+    if (mesh.normals.size() != mesh.positions.size())
+      fail(where + std::to_string(mesh.normals.size()) + " normals for " +
+           std::to_string(mesh.positions.size()) + " positions");
+    if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
+      fail(where + std::to_string(mesh.uvs.size()) + " uvs for " +
+           std::to_string(mesh.positions.size()) + " positions");
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+      for (std::uint32_t vi : mesh.triangles[t])
+        if (vi >= mesh.positions.size())
+          fail(where + "triangle " + std::to_string(t) + " uses vertex " + std::to_string(vi) +
+               " of " + std::to_string(mesh.positions.size()));
+  }
+}
+
+bool isFinite(const glm::dvec4& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
+}
+
+// ---- the renderer -----------------------------------------------------------------------
+
+// What the fragment loop needs about the original triangle being drawn.
+struct TriangleContext {
+  const PrimitiveRef* prim = nullptr;
+  const DrawPass* pass = nullptr;
+  const Material* material = nullptr;
+  const Texture* texture = nullptr;
+  const TransformedVertex* v[3] = {nullptr, nullptr, nullptr};
+  const LitColor* gouraud[3] = {nullptr, nullptr, nullptr};  // per original vertex
+  glm::dvec3 centroid{0.0};     // flat: world-space centroid of the original triangle
+  glm::dvec3 face_normal{0.0};  // flat: normalize(cross(p1 - p0, p2 - p0))
+  LitColor flat;
+  bool constant = false;        // flat, untextured, not blended: one stored colour
+  float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+};
+
+class Renderer {
+ public:
+  // Renders into a framebuffer covering `clip` (GL window coordinates): the whole image,
+  // or one pixel when trace is non-null.
+  Renderer(const Scene& scene, const ReferenceOptions& options, const PixelRect& clip,
+           std::vector<FragmentTrace>* trace)
+      : scene_(scene),
+        options_(options),
+        clip_(clip),
+        fb_width_(clip.x1 - clip.x0),
+        fb_height_(clip.y1 - clip.y0),
+        trace_(trace),
+        uncertainty_(options.uncertainty && trace == nullptr),
+        depth_format_(scene.state.depth_format),
+        color_format_(scene.state.color_format),
+        camera_(cameraTransform(scene)),
+        lighting_(sceneLighting(scene)),
+        volume_(clipVolume(scene.width, scene.height, guardLimitPx(options.subpixel_bits))) {}
+
+  Frame run();
+
+ private:
+  void transformVertices();
+  void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
+  void prepareTriangle(TriangleContext& t) const;
+  template <Shading kShading, bool kTrace>
+  void shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py,
+                 int x_begin, int x_end);
+  template <Shading kShading>
+  glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b,
+                           ShadingTerms* terms) const;
+  void traceTerms(const TriangleContext& t, const glm::dvec3& b, ShadingTerms& terms) const;
+  void writeColor(std::size_t index, const glm::dvec4& src, bool blend);
+  glm::dvec4 storedColor(std::size_t index) const;
+
+  const Scene& scene_;
+  const ReferenceOptions& options_;
+  const PixelRect clip_;
+  const int fb_width_;
+  const int fb_height_;
+  std::vector<FragmentTrace>* trace_;
+  const bool uncertainty_;
+  const DepthFormat depth_format_;
+  const ColorFormat color_format_;
+  const CameraTransform camera_;
+  const Lighting lighting_;
+  const ClipVolume volume_;
+
+  std::vector<std::vector<TransformedVertex>> vertices_;  // per object
+  std::vector<std::vector<LitColor>> gouraud_;            // per object, Gouraud only
+  Frame frame_;                     // colour, id, edge_dist over the clip rectangle
+  std::vector<std::uint32_t> depth_;  // depth keys (fragment_ops.h)
+  DepthGapTracker gaps_;
+};
+
+void Renderer::transformVertices() {
+  vertices_.resize(scene_.objects.size());
+  if (scene_.state.shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
+  for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
+    const Object& obj = scene_.objects[o];
+    if (obj.mesh.triangles.empty()) continue;
+    transformObject(obj, camera_, vertices_[o]);
+    if (scene_.state.shading != Shading::Gouraud) continue;
+    // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
+    const Material& material = scene_.materials[obj.material];
+    gouraud_[o].resize(vertices_[o].size());
+    for (std::size_t i = 0; i < vertices_[o].size(); ++i)
+      gouraud_[o][i] = shadePoint(lighting_, material, vertices_[o][i].world, vertices_[o][i].normal);
+  }
+}
+
+Frame Renderer::run() {
+  const auto start = std::chrono::steady_clock::now();
+  float clear_rgba[4];
+  for (int c = 0; c < 4; ++c) clear_rgba[c] = storeColor(scene_.clear_color[c], color_format_);
+  const std::uint32_t clear_key = depthKey(clampDepth(scene_.clear_depth), depth_format_);
+  frame_.allocate(fb_width_, fb_height_, clear_rgba,
+                  static_cast<float>(storedDepth(clear_key, depth_format_)), uncertainty_);
+  depth_.assign(frame_.pixelCount(), clear_key);
+  if (uncertainty_) gaps_.reset(frame_.pixelCount());
+
+  transformVertices();
+  for (const DrawPass& pass : drawPasses(scene_, options_.force_painter))
+    for (const PrimitiveRef& prim : pass.primitives) drawTriangle(prim, pass);
+
+  for (std::size_t i = 0; i < frame_.pixelCount(); ++i) {
+    frame_.depth[i] = static_cast<float>(storedDepth(depth_[i], depth_format_));
+    if (uncertainty_) frame_.depth_gap[i] = gaps_.gapSteps(i, depth_format_);
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  frame_.meta = {{"renderer", "rastercheck reference"},
+                 {"subpixel_bits", options_.subpixel_bits},
+                 {"painter_forced", options_.force_painter},
+                 {"timing_ms", {{"render", ms}}}};
+  return std::move(frame_);
+}
+
+void Renderer::prepareTriangle(TriangleContext& t) const {
+  const Object& obj = scene_.objects[t.prim->object];
+  const auto& tri = obj.mesh.triangles[t.prim->triangle];
+  t.material = &scene_.materials[obj.material];
+  t.texture = t.material->texture.get();
+  for (int k = 0; k < 3; ++k) {
+    t.v[k] = &vertices_[t.prim->object][tri[k]];
+    if (!gouraud_.empty()) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];
+  }
+  if (scene_.state.shading != Shading::Flat) return;
+  // Flat: lit once, at the original triangle's centroid, with its face normal.
+  const glm::dvec3& p0 = t.v[0]->world;
+  const glm::dvec3& p1 = t.v[1]->world;
+  const glm::dvec3& p2 = t.v[2]->world;
+  t.centroid = (p0 + p1 + p2) / 3.0;
+  t.face_normal = safeNormalize(glm::cross(p1 - p0, p2 - p0));
+  t.flat = shadePoint(lighting_, *t.material, t.centroid, t.face_normal);
+  t.constant = t.texture == nullptr && !t.pass->blend;
+  if (t.constant) {
+    const glm::dvec4 c = finalColor(t.flat, glm::dvec3(1.0), t.material->opacity);
+    for (int k = 0; k < 4; ++k) t.constant_stored[k] = storeColor(c[k], color_format_);
+  }
+}
+
+void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
+  const Object& obj = scene_.objects[prim.object];
+  const auto& tri = obj.mesh.triangles[prim.triangle];
+  const std::vector<TransformedVertex>& verts = vertices_[prim.object];
+  const glm::dvec4& c0 = verts[tri[0]].clip;
+  const glm::dvec4& c1 = verts[tri[1]].clip;
+  const glm::dvec4& c2 = verts[tri[2]].clip;
+  if (!isFinite(c0) || !isFinite(c1) || !isFinite(c2)) return;  // NaN/Inf geometry: dropped
+
+  ClipPolygon poly;
+  if (!clipTriangle(c0, c1, c2, volume_, poly)) return;
+  WindowVertex wv[kMaxClipVertices];
+  FixedVertex fv[kMaxClipVertices];
+  for (int i = 0; i < poly.count; ++i) {
+    if (!(poly.v[i].clip.w > 0.0)) return;  // only a degenerate camera gets here
+    wv[i] = toWindow(poly.v[i], scene_.width, scene_.height);
+    if (!std::isfinite(wv[i].x) || !std::isfinite(wv[i].y) || !std::isfinite(wv[i].z)) return;
+    fv[i] = snapVertex(wv[i].x, wv[i].y, options_.subpixel_bits);
+  }
+
+  const bool ccw_is_front = scene_.state.front_face == FrontFace::CCW;
+  const Cull cull = scene_.state.cull;
+  auto culled = [&](bool ccw) {
+    const bool front = ccw == ccw_is_front;
+    return (cull == Cull::Back && !front) || (cull == Cull::Front && front);
+  };
+
+  if (uncertainty_) {
+    const double area2 = polygonArea2(wv, poly.count);
+    const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
+    if (rasterized || cullCouldFlip(wv, poly.count))
+      addEdgeDistances(wv, poly.count, clip_, fb_width_, fb_height_, frame_.edge_dist.data());
+  }
+
+  TriangleContext t;
+  t.prim = &prim;
+  t.pass = &pass;
+  bool prepared = false;
+  // The clipped polygon is drawn as a fan; each piece is culled by its own snapped area
+  // (as GL implementations set up each post-clip triangle).
+  for (int i = 1; i + 1 < poly.count; ++i) {
+    const std::int64_t area2 = snappedArea2(fv[0], fv[i], fv[i + 1]);
+    if (area2 == 0 || culled(area2 > 0)) continue;
+    TriangleCoverage coverage;
+    if (!coverage.setup(fv[0], fv[i], fv[i + 1], options_.subpixel_bits, clip_)) continue;
+    FragmentInterpolator interp;
+    interp.setup(wv[0], wv[i], wv[i + 1]);
+    if (!prepared) {
+      prepareTriangle(t);
+      prepared = true;
+    }
+    auto run = [&](auto span) {
+      coverage.forEachSpan([&](int py, int x0, int x1) { (this->*span)(t, interp, py, x0, x1); });
+    };
+    const bool tracing = trace_ != nullptr;
+    switch (scene_.state.shading) {
+      case Shading::Flat:
+        tracing ? run(&Renderer::shadeSpan<Shading::Flat, true>)
+                : run(&Renderer::shadeSpan<Shading::Flat, false>);
+        break;
+      case Shading::Gouraud:
+        tracing ? run(&Renderer::shadeSpan<Shading::Gouraud, true>)
+                : run(&Renderer::shadeSpan<Shading::Gouraud, false>);
+        break;
+      case Shading::Phong:
+        tracing ? run(&Renderer::shadeSpan<Shading::Phong, true>)
+                : run(&Renderer::shadeSpan<Shading::Phong, false>);
+        break;
+    }
+  }
+}
+
+template <Shading kShading>
+glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::dvec3& b,
+                                   ShadingTerms* terms) const {
+  glm::dvec3 tex(1.0);
+  if (t.texture) {
+    const glm::dvec2 uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
+    tex = glm::dvec3(sampleTexture(*t.texture, uv, scene_.state.texture_filter,
+                                   scene_.state.texture_wrap));
+  }
+  LitColor lit;
+  if constexpr (kShading == Shading::Flat) {
+    lit = t.flat;
+  } else if constexpr (kShading == Shading::Gouraud) {
+    lit.ambient_diffuse = b.x * t.gouraud[0]->ambient_diffuse +
+                          b.y * t.gouraud[1]->ambient_diffuse + b.z * t.gouraud[2]->ambient_diffuse;
+    lit.specular = b.x * t.gouraud[0]->specular + b.y * t.gouraud[1]->specular +
+                   b.z * t.gouraud[2]->specular;
+  } else {
+    const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
+    const glm::dvec3 n =
+        safeNormalize(b.x * t.v[0]->normal + b.y * t.v[1]->normal + b.z * t.v[2]->normal);
+    lit = shadePoint(lighting_, *t.material, p, n, terms);
+  }
+  const glm::dvec4 color = finalColor(lit, tex, t.material->opacity);
+  if (terms) {
+    if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
+    terms->texture = tex;
+    terms->color = color;
+  }
+  return color;
+}
+
+// The ambient and per-light terms of flat and Gouraud fragments (Phong records them
+// while lighting). Gouraud interpolates each vertex's terms like AD and S.
+void Renderer::traceTerms(const TriangleContext& t, const glm::dvec3& b,
+                          ShadingTerms& terms) const {
+  if (scene_.state.shading == Shading::Flat) {
+    shadePoint(lighting_, *t.material, t.centroid, t.face_normal, &terms);
+    return;
+  }
+  ShadingTerms vt[3];
+  for (int k = 0; k < 3; ++k) shadePoint(lighting_, *t.material, t.v[k]->world, t.v[k]->normal, &vt[k]);
+  terms.ambient = b.x * vt[0].ambient + b.y * vt[1].ambient + b.z * vt[2].ambient;
+  terms.lights.assign(vt[0].lights.size(), LightTerms{});
+  for (std::size_t i = 0; i < terms.lights.size(); ++i) {
+    terms.lights[i].diffuse =
+        b.x * vt[0].lights[i].diffuse + b.y * vt[1].lights[i].diffuse + b.z * vt[2].lights[i].diffuse;
+    terms.lights[i].specular = b.x * vt[0].lights[i].specular + b.y * vt[1].lights[i].specular +
+                               b.z * vt[2].lights[i].specular;
+  }
+}
+
+glm::dvec4 Renderer::storedColor(std::size_t index) const {
+  const float* c = &frame_.color[4 * index];
+  return glm::dvec4(loadColor(c[0], color_format_), loadColor(c[1], color_format_),
+                    loadColor(c[2], color_format_), loadColor(c[3], color_format_));
+}
+
+void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool blend) {
+  const glm::dvec4 out = blend ? blendSourceOver(src, storedColor(index), color_format_) : src;
+  float* c = &frame_.color[4 * index];
+  for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
+}
+
+template <Shading kShading, bool kTrace>
+void Renderer::shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py,
+                         int x_begin, int x_end) {
+  const double cy = py + 0.5;  // pixel centres
+  const std::size_t row =
+      static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+  const bool always = t.pass->depth_func == DepthFunc::Always;
+  const bool depth_write = t.pass->depth_write;
+  const bool blend = t.pass->blend;
+  for (int px = x_begin; px < x_end; ++px) {
+    const double cx = px + 0.5;
+    const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
+    const double z = clampDepth(interp.depth(cx, cy));
+    if (uncertainty_) gaps_.add(index, z);
+    const std::uint32_t key = depthKey(z, depth_format_);
+    const std::uint32_t against = depth_[index];
+    const bool pass = always || key < against;
+
+    if constexpr (kTrace) {
+      FragmentTrace f;
+      f.primitive = t.prim->id;
+      f.object = t.prim->object;
+      f.barycentric = interp.barycentric(cx, cy);
+      f.window_z = z;
+      f.stored_z = storedDepth(key, depth_format_);
+      f.depth_pass = pass;
+      f.depth_against = storedDepth(against, depth_format_);
+      const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading);
+      if (pass) {
+        if (depth_write) depth_[index] = key;
+        frame_.id[index] = t.prim->id;
+        writeColor(index, color, blend);
+      }
+      f.color_written = storedColor(index);
+      trace_->push_back(std::move(f));
+      continue;
+    }
+
+    if (!pass) continue;
+    if (depth_write) depth_[index] = key;
+    frame_.id[index] = t.prim->id;
+    if constexpr (kShading == Shading::Flat) {
+      if (t.constant) {
+        float* c = &frame_.color[4 * index];
+        for (int k = 0; k < 4; ++k) c[k] = t.constant_stored[k];
+        continue;
+      }
+    }
+    writeColor(index, fragmentColor<kShading>(t, interp.barycentric(cx, cy), nullptr), blend);
+  }
+}
+
+}  // namespace
+
+Frame renderReference(const Scene& scene, const ReferenceOptions& options) {
+  validate(scene, options);
+  Renderer renderer(scene, options, PixelRect{0, 0, scene.width, scene.height}, nullptr);
+  return renderer.run();
+}
+
+std::vector<FragmentTrace> tracePixel(const Scene& scene, const ReferenceOptions& options, int x,
+                                      int y_image) {
+  validate(scene, options);
+  if (x < 0 || x >= scene.width || y_image < 0 || y_image >= scene.height)
+    throw InputError(sceneLabel(scene) + ": pixel " + std::to_string(x) + "," +
+                     std::to_string(y_image) + " is outside the " + std::to_string(scene.width) +
+                     "x" + std::to_string(scene.height) + " image");
+  const int y = scene.height - 1 - y_image;  // GL window row
+  std::vector<FragmentTrace> trace;
+  Renderer renderer(scene, options, PixelRect{x, y, x + 1, y + 1}, &trace);
+  renderer.run();
+  return trace;
+}
+
+}  // namespace rc

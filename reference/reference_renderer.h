@@ -1,0 +1,60 @@
+// The reference renderer: the scalar CPU ground truth the harness compares GL against.
+// It follows DESIGN.md "Rendering semantics" stage by stage (one file per stage, see
+// docs/reference.md): vertex stage (double) -> clipper (near/far + guard band) ->
+// viewport -> snap + cull -> rasterizer (integer edge functions, llvmpipe's tie-break) ->
+// interpolation (perspective-correct, from unsnapped coordinates) -> shading ->
+// texture sampling -> fragment ops (depth quantize/test, blend, colour format), with
+// the uncertainty channels (edge_dist, depth_gap) alongside. Single-threaded and
+// bit-identical on every run and build type.
+//
+// It does not: multisample, mipmap, clamp depth, do two-sided lighting, run shaders,
+// or clip against the viewport (the bounding box does that; the guard band only bounds
+// the fixed-point range).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "fixtures/frame.h"
+#include "fixtures/scene.h"
+#include "reference/shading.h"
+
+namespace rc {
+
+struct ReferenceOptions {
+  int subpixel_bits = 8;       // vertex snapping grid: 1 / 2^bits px, in [0, 12]
+  bool force_painter = false;  // `ref:painter`: draw far-to-near with no depth test
+  bool uncertainty = true;     // compute edge_dist and depth_gap
+};
+
+// Renders the scene. Throws InputError for options out of range (subpixel_bits outside
+// [0, 12]), images larger than 16384 px a side or 2^26 px in all, and inconsistent
+// scenes (material index, normal/uv counts, vertex indices, texture sizes). NaN or
+// infinite geometry is not an error: those triangles are dropped.
+// frame.meta: {"renderer", "subpixel_bits", "painter_forced", "timing_ms": {"render"}}.
+Frame renderReference(const Scene& scene, const ReferenceOptions& options = {});
+
+// One fragment that reached a pixel, in draw order (`rastercheck explain`).
+struct FragmentTrace {
+  std::uint32_t primitive = 0;    // primitive id (1-based)
+  std::uint32_t object = 0;       // index into Scene::objects
+  glm::dvec3 barycentric{0.0};    // w.r.t. the ORIGINAL triangle, perspective-correct
+  double window_z = 0.0;          // interpolated window z, clamped to [0, 1]
+  double stored_z = 0.0;          // window_z quantized to the depth format
+  bool depth_pass = false;
+  double depth_against = 0.0;     // the stored depth it was tested against
+  ShadingTerms shading;           // every term of its colour (computed even if it failed)
+  glm::dvec4 color_written{0.0};  // the colour buffer after this fragment (blended and
+                                  // converted; unchanged when the depth test failed)
+};
+
+// Every fragment that covers image pixel (x, y_image) (top-left origin, y down), in draw
+// order, rendered exactly as renderReference() renders it (the same passes and depth
+// buffer history, restricted to that one pixel). Throws InputError when the pixel is
+// outside the image (and for everything renderReference() rejects).
+std::vector<FragmentTrace> tracePixel(const Scene& scene, const ReferenceOptions& options, int x,
+                                      int y_image);
+
+}  // namespace rc

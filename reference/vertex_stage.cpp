@@ -1,0 +1,33 @@
+// Vertex stage: see vertex_stage.h.
+#include "reference/vertex_stage.h"
+
+#include "fixtures/scene_logic.h"
+#include "reference/shading.h"
+
+namespace rc::ref {
+
+CameraTransform cameraTransform(const Scene& scene) {
+  CameraTransform t;
+  const double aspect = static_cast<double>(scene.width) / static_cast<double>(scene.height);
+  t.view_projection = projectionMatrix(scene.camera, aspect) * viewMatrix(scene.camera);
+  t.eye = scene.camera.eye;
+  return t;
+}
+
+void transformObject(const Object& object, const CameraTransform& camera,
+                     std::vector<TransformedVertex>& out) {
+  const Mesh& mesh = object.mesh;
+  const glm::dmat3 normal_matrix = normalMatrix(object.model);
+  out.resize(mesh.positions.size());
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    TransformedVertex& v = out[i];
+    v.world = glm::dvec3(object.model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0));
+    v.clip = camera.view_projection * glm::dvec4(v.world, 1.0);
+    v.normal = i < mesh.normals.size()
+                   ? safeNormalize(normal_matrix * glm::dvec3(mesh.normals[i]))
+                   : glm::dvec3(0.0);
+    v.uv = i < mesh.uvs.size() ? glm::dvec2(mesh.uvs[i]) : glm::dvec2(0.0);
+  }
+}
+
+}  // namespace rc::ref

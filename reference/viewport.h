@@ -1,0 +1,31 @@
+// Perspective divide and viewport transform (GL conventions): window x, y in pixels with
+// the origin at the bottom-left corner (y up), pixel centres at +0.5, window z = depth
+// range [0, 1]. In double; the viewport is the whole image.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "reference/clipper.h"
+
+namespace rc::ref {
+
+struct WindowVertex {
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;      // window depth, z_ndc * 0.5 + 0.5
+  double inv_w = 0.0;  // 1 / w_clip, for perspective-correct interpolation
+  glm::dvec3 bary{0.0};  // w.r.t. the original triangle (from the clipper)
+};
+
+inline WindowVertex toWindow(const ClipVertex& c, int width, int height) {
+  const double inv_w = 1.0 / c.clip.w;
+  WindowVertex v;
+  v.x = (c.clip.x * inv_w * 0.5 + 0.5) * width;
+  v.y = (c.clip.y * inv_w * 0.5 + 0.5) * height;
+  v.z = c.clip.z * inv_w * 0.5 + 0.5;
+  v.inv_w = inv_w;
+  v.bary = c.bary;
+  return v;
+}
+
+}  // namespace rc::ref

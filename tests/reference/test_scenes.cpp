@@ -1,0 +1,213 @@
+// Scenes built in code: see test_scenes.h.
+#include "tests/reference/test_scenes.h"
+
+#include <cmath>
+#include <memory>
+
+namespace rc::test {
+
+Scene windowScene(int width, int height) {
+  Scene s;
+  s.name = "test";
+  s.width = width;
+  s.height = height;
+  s.camera.projection = Projection::Orthographic;
+  s.camera.eye = {0.0, 0.0, 1.0};
+  s.camera.target = {0.0, 0.0, 0.0};
+  s.camera.up = {0.0, 1.0, 0.0};
+  s.camera.bounds = {0.0, static_cast<double>(width), 0.0, static_cast<double>(height)};
+  s.camera.near = 0.0;
+  s.camera.far = 1.0;
+  s.ambient_light = glm::dvec3(1.0);
+  Material white;
+  white.name = "white";
+  white.ambient = glm::dvec3(1.0);
+  white.diffuse = glm::dvec3(0.0);
+  white.specular = glm::dvec3(0.0);
+  s.materials.push_back(white);
+  return s;
+}
+
+std::size_t addMesh(Scene& scene, const std::vector<glm::vec3>& positions,
+                    const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                    std::size_t material, const glm::vec3& normal,
+                    const std::vector<glm::vec2>& uvs) {
+  Object o;
+  o.name = "object" + std::to_string(scene.objects.size());
+  o.material = material;
+  o.mesh.positions = positions;
+  o.mesh.normals.assign(positions.size(), normal);
+  o.mesh.uvs = uvs;
+  o.mesh.triangles = triangles;
+  scene.objects.push_back(std::move(o));
+  return scene.objects.size() - 1;
+}
+
+std::size_t addTriangle(Scene& scene, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                        std::size_t material) {
+  return addMesh(scene, {a, b, c}, {{0, 1, 2}}, material);
+}
+
+std::size_t addRect(Scene& scene, float x0, float y0, float x1, float y1, float z,
+                    std::size_t material) {
+  return addMesh(scene, {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}},
+                 {{0, 1, 2}, {0, 2, 3}}, material, {0.0f, 0.0f, 1.0f},
+                 {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}});
+}
+
+std::size_t addMaterial(Scene& scene, const Material& material) {
+  scene.materials.push_back(material);
+  return scene.materials.size() - 1;
+}
+
+Mesh sphereMesh(int segments, int rings) {
+  Mesh m;
+  const double pi = std::acos(-1.0);
+  for (int r = 0; r <= rings; ++r) {
+    const double theta = pi * r / rings;  // from +y down to -y
+    for (int s = 0; s <= segments; ++s) {
+      const double phi = 2.0 * pi * s / segments;
+      const glm::vec3 p(static_cast<float>(std::sin(theta) * std::sin(phi)),
+                        static_cast<float>(std::cos(theta)),
+                        static_cast<float>(std::sin(theta) * std::cos(phi)));
+      m.positions.push_back(p);
+      m.normals.push_back(p);
+      m.uvs.emplace_back(static_cast<float>(s) / segments, 1.0f - static_cast<float>(r) / rings);
+    }
+  }
+  const auto row = static_cast<std::uint32_t>(segments + 1);
+  for (int r = 0; r < rings; ++r) {
+    for (int s = 0; s < segments; ++s) {
+      const std::uint32_t a = r * row + s;
+      const std::uint32_t b = a + row;
+      m.triangles.push_back({a, b, b + 1});  // counter-clockwise seen from outside
+      m.triangles.push_back({a, b + 1, a + 1});
+    }
+  }
+  return m;
+}
+
+namespace {
+
+std::shared_ptr<const Texture> checkerTexture() {
+  auto t = std::make_shared<Texture>();
+  t->width = 4;
+  t->height = 4;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const bool odd = ((i + j) & 1) != 0;
+      t->rgba.insert(t->rgba.end(), {static_cast<std::uint8_t>(odd ? 230 : 20),
+                                     static_cast<std::uint8_t>(60 * i),
+                                     static_cast<std::uint8_t>(60 * j), 255});
+    }
+  return t;
+}
+
+// A lit perspective scene: a textured sphere, a ground plane crossing the near plane,
+// a tilted transparent quad.
+Scene litScene(Shading shading) {
+  Scene s;
+  s.name = "lit";
+  s.width = 96;
+  s.height = 64;
+  s.camera.eye = {0.3, 1.2, 4.0};
+  s.camera.target = {0.0, 0.0, 0.0};
+  s.camera.fovy_deg = 50.0;
+  s.camera.near = 0.5;
+  s.camera.far = 30.0;
+  s.ambient_light = {0.1, 0.1, 0.12};
+  s.lights.push_back(Light{LightType::Point, {2.0, 3.0, 4.0}, {0.0, -1.0, 0.0}, {1.0, 0.9, 0.8}, 1.5});
+  s.lights.push_back(
+      Light{LightType::Directional, {0.0, 0.0, 0.0}, {-0.3, -1.0, -0.2}, {0.4, 0.5, 0.6}, 0.7});
+  s.state.shading = shading;
+  s.state.attenuation = Attenuation::Inverse;
+  Material ball;
+  ball.ambient = {0.3, 0.2, 0.2};
+  ball.diffuse = {0.8, 0.5, 0.4};
+  ball.specular = {1.0, 1.0, 1.0};
+  ball.shininess = 24.0;
+  ball.texture = checkerTexture();
+  Material ground;
+  ground.ambient = {0.2, 0.3, 0.2};
+  ground.diffuse = {0.4, 0.7, 0.4};
+  ground.specular = {0.2, 0.2, 0.2};
+  ground.shininess = 7.5;
+  Material glass;
+  glass.ambient = {0.1, 0.1, 0.3};
+  glass.diffuse = {0.2, 0.3, 0.9};
+  glass.specular = {0.5, 0.5, 0.5};
+  glass.opacity = 0.4;
+  s.materials = {ball, ground, glass};
+  Object sphere;
+  sphere.name = "sphere";
+  sphere.material = 0;
+  sphere.mesh = sphereMesh(24, 12);
+  sphere.model = glm::dmat4(glm::dvec4(1.0, 0.0, 0.0, 0.0), glm::dvec4(0.0, 1.5, 0.0, 0.0),
+                            glm::dvec4(0.0, 0.0, 1.0, 0.0), glm::dvec4(0.0, 0.5, 0.0, 1.0));
+  s.objects.push_back(sphere);
+  Object plane;
+  plane.name = "ground";
+  plane.material = 1;
+  plane.mesh.positions = {{-50, -1, -50}, {50, -1, -50}, {50, -1, 50}, {-50, -1, 50}};
+  plane.mesh.normals.assign(4, {0, 1, 0});
+  plane.mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
+  s.objects.push_back(plane);
+  Object quad;
+  quad.name = "glass";
+  quad.material = 2;
+  quad.mesh.positions = {{-1.5, -1, 1.2}, {1.5, -1, 0.8}, {1.5, 2, 0.2}, {-1.5, 2, 0.6}};
+  quad.mesh.normals.assign(4, {0, 0.3f, 1});
+  quad.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  s.objects.push_back(quad);
+  return s;
+}
+
+}  // namespace
+
+std::vector<NamedScene> featureScenes() {
+  std::vector<NamedScene> out;
+  for (Shading sh : {Shading::Flat, Shading::Gouraud, Shading::Phong}) {
+    Scene s = litScene(sh);
+    s.state.blend = Blend::Alpha;
+    out.push_back({std::string("lit_") + toString(sh), s});
+  }
+  {
+    Scene s = litScene(Shading::Phong);
+    s.state.specular_model = SpecularModel::Phong;
+    s.state.attenuation = Attenuation::InverseSquare;
+    s.state.texture_filter = TextureFilter::Linear;
+    s.state.texture_wrap = TextureWrap::Clamp;
+    s.state.color_format = ColorFormat::RGBA8;
+    s.state.depth_format = DepthFormat::D16;
+    s.state.cull = Cull::Back;
+    out.push_back({"lit_phong_rgba8_d16_cull", s});
+  }
+  {
+    Scene s = litScene(Shading::Gouraud);
+    s.state.visibility = Visibility::Painter;
+    s.state.depth_format = DepthFormat::D32F;
+    s.state.front_face = FrontFace::CW;
+    s.state.cull = Cull::Front;
+    out.push_back({"lit_painter_d32f_cw", s});
+  }
+  {
+    // Many small and sliver triangles in window space.
+    Scene s = windowScene(64, 64);
+    s.state.shading = Shading::Flat;
+    std::uint32_t seed = 12345u;
+    auto rnd = [&]() {
+      seed = seed * 1664525u + 1013904223u;
+      return static_cast<float>((seed >> 8) & 0xffff) / 1024.0f;  // [0, 64), 1/1024 grid
+    };
+    for (int i = 0; i < 300; ++i) {
+      const glm::vec3 a(rnd(), rnd(), 0.5f);
+      const glm::vec3 b(a.x + (rnd() - 32.0f) / 8.0f, a.y + (rnd() - 32.0f) / 8.0f, 0.25f);
+      const glm::vec3 c(rnd(), rnd(), 0.75f);
+      addTriangle(s, a, b, c);
+    }
+    out.push_back({"window_random", s});
+  }
+  return out;
+}
+
+}  // namespace rc::test

@@ -1,0 +1,50 @@
+// Scenes built in code for the reference renderer's tests, benchmarks and the
+// cross-optimisation-level dump tool (no dependency on the fixture loader).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "fixtures/scene.h"
+
+namespace rc::test {
+
+// A width x height scene whose orthographic camera maps world (x, y) to GL window
+// (x, y) exactly for power-of-two sizes, and world z to window depth 1 - z (camera at
+// z = 1 looking down -z, near 0, far 1). Default state, no lights, ambient light 1,
+// one white material with ambient 1 (so untextured colour = (1, 1, 1, opacity)).
+Scene windowScene(int width, int height);
+
+// Appends an object with inline triangles; every normal is `normal`; uvs optional.
+// Returns the object's index.
+std::size_t addMesh(Scene& scene, const std::vector<glm::vec3>& positions,
+                    const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                    std::size_t material = 0, const glm::vec3& normal = {0.0f, 0.0f, 1.0f},
+                    const std::vector<glm::vec2>& uvs = {});
+
+// One triangle (three fresh vertices).
+std::size_t addTriangle(Scene& scene, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                        std::size_t material = 0);
+
+// An axis-aligned rectangle at depth z as two counter-clockwise triangles, uvs (0,0)..(1,1).
+std::size_t addRect(Scene& scene, float x0, float y0, float x1, float y1, float z,
+                    std::size_t material = 0);
+
+std::size_t addMaterial(Scene& scene, const Material& material);
+
+// A UV sphere of radius 1 (normals = positions), `segments` around, `rings` pole to pole.
+Mesh sphereMesh(int segments, int rings);
+
+// Named scenes that exercise every feature (shading modes, textures, clipping, culling,
+// blending, painter's, every depth and colour format): the determinism corpus.
+struct NamedScene {
+  std::string name;
+  Scene scene;
+};
+std::vector<NamedScene> featureScenes();
+
+}  // namespace rc::test
