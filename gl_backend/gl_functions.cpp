@@ -1,0 +1,33 @@
+// Loading the GL function table: see gl_functions.h.
+#include "gl_backend/gl_functions.h"
+
+#include <cstring>
+#include <string>
+
+#include "fixtures/errors.h"
+
+namespace rc::gl {
+
+void Functions::load(ProcLoader loader) {
+#define RC_GL_LOAD(type, name)                                                       \
+  name = reinterpret_cast<type>(loader("gl" #name));                                 \
+  if (name == nullptr) {                                                             \
+    throw BackendError("the GL provider does not export gl" #name " (GL 3.3 core)"); \
+  }
+  RC_GL_CORE_FUNCTIONS(RC_GL_LOAD)
+#undef RC_GL_LOAD
+
+  // KHR_debug is core in 4.3 and an extension below (softpipe exposes 3.3 core).
+  GLint count = 0;
+  GetIntegerv(GL_NUM_EXTENSIONS, &count);
+  bool khr_debug = false;
+  for (GLint i = 0; i < count && !khr_debug; ++i) {
+    const auto* ext = reinterpret_cast<const char*>(GetStringi(GL_EXTENSIONS, i));
+    khr_debug = ext != nullptr && std::strcmp(ext, "GL_KHR_debug") == 0;
+  }
+  DebugMessageCallback =
+      khr_debug ? reinterpret_cast<PFNGLDEBUGMESSAGECALLBACKPROC>(loader("glDebugMessageCallback"))
+                : nullptr;
+}
+
+}  // namespace rc::gl

@@ -1,0 +1,99 @@
+// The GL entry points the backend calls, loaded through the context provider's
+// getProcAddress into one table. Nothing links libGL/libOpenGL, so the symbols of
+// libOSMesa and of the EGL vendor library can never clash.
+#pragma once
+
+#include <GL/glcorearb.h>
+
+#include "gl_backend/context.h"
+
+namespace rc::gl {
+
+// X(type, name): the member `name` holds "gl" #name. Only GL 3.3 core functions, plus
+// KHR_debug's callback which is loaded when the extension is present.
+#define RC_GL_CORE_FUNCTIONS(X)                                                        \
+  X(PFNGLGETSTRINGPROC, GetString)                                                     \
+  X(PFNGLGETSTRINGIPROC, GetStringi)                                                   \
+  X(PFNGLGETINTEGERVPROC, GetIntegerv)                                                 \
+  X(PFNGLGETERRORPROC, GetError)                                                       \
+  X(PFNGLENABLEPROC, Enable)                                                           \
+  X(PFNGLDISABLEPROC, Disable)                                                         \
+  X(PFNGLENABLEIPROC, Enablei)                                                         \
+  X(PFNGLDISABLEIPROC, Disablei)                                                       \
+  X(PFNGLVIEWPORTPROC, Viewport)                                                       \
+  X(PFNGLDEPTHRANGEPROC, DepthRange)                                                   \
+  X(PFNGLDEPTHFUNCPROC, DepthFunc)                                                     \
+  X(PFNGLDEPTHMASKPROC, DepthMask)                                                     \
+  X(PFNGLCOLORMASKPROC, ColorMask)                                                     \
+  X(PFNGLBLENDFUNCPROC, BlendFunc)                                                     \
+  X(PFNGLBLENDEQUATIONPROC, BlendEquation)                                             \
+  X(PFNGLFRONTFACEPROC, FrontFace)                                                     \
+  X(PFNGLCULLFACEPROC, CullFace)                                                       \
+  X(PFNGLPOLYGONMODEPROC, PolygonMode)                                                 \
+  X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)                                             \
+  X(PFNGLCLEARBUFFERUIVPROC, ClearBufferuiv)                                           \
+  X(PFNGLDRAWBUFFERSPROC, DrawBuffers)                                                 \
+  X(PFNGLREADBUFFERPROC, ReadBuffer)                                                   \
+  X(PFNGLREADPIXELSPROC, ReadPixels)                                                   \
+  X(PFNGLPIXELSTOREIPROC, PixelStorei)                                                 \
+  X(PFNGLFINISHPROC, Finish)                                                           \
+  X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                                         \
+  X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                                         \
+  X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                                   \
+  X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer)                         \
+  X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus)                           \
+  X(PFNGLGETFRAMEBUFFERATTACHMENTPARAMETERIVPROC, GetFramebufferAttachmentParameteriv) \
+  X(PFNGLGENRENDERBUFFERSPROC, GenRenderbuffers)                                       \
+  X(PFNGLBINDRENDERBUFFERPROC, BindRenderbuffer)                                       \
+  X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers)                                 \
+  X(PFNGLRENDERBUFFERSTORAGEPROC, RenderbufferStorage)                                 \
+  X(PFNGLGENBUFFERSPROC, GenBuffers)                                                   \
+  X(PFNGLBINDBUFFERPROC, BindBuffer)                                                   \
+  X(PFNGLBUFFERDATAPROC, BufferData)                                                   \
+  X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                                             \
+  X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                                         \
+  X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                                         \
+  X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                                   \
+  X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                                 \
+  X(PFNGLVERTEXATTRIBIPOINTERPROC, VertexAttribIPointer)                               \
+  X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)                         \
+  X(PFNGLCREATESHADERPROC, CreateShader)                                               \
+  X(PFNGLSHADERSOURCEPROC, ShaderSource)                                               \
+  X(PFNGLCOMPILESHADERPROC, CompileShader)                                             \
+  X(PFNGLGETSHADERIVPROC, GetShaderiv)                                                 \
+  X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                                       \
+  X(PFNGLDELETESHADERPROC, DeleteShader)                                               \
+  X(PFNGLCREATEPROGRAMPROC, CreateProgram)                                             \
+  X(PFNGLATTACHSHADERPROC, AttachShader)                                               \
+  X(PFNGLLINKPROGRAMPROC, LinkProgram)                                                 \
+  X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                                               \
+  X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)                                     \
+  X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                                             \
+  X(PFNGLUSEPROGRAMPROC, UseProgram)                                                   \
+  X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                                   \
+  X(PFNGLUNIFORM1IPROC, Uniform1i)                                                     \
+  X(PFNGLUNIFORM1FPROC, Uniform1f)                                                     \
+  X(PFNGLUNIFORM1IVPROC, Uniform1iv)                                                   \
+  X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                                   \
+  X(PFNGLUNIFORM3FVPROC, Uniform3fv)                                                   \
+  X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                                       \
+  X(PFNGLGENTEXTURESPROC, GenTextures)                                                 \
+  X(PFNGLBINDTEXTUREPROC, BindTexture)                                                 \
+  X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                                             \
+  X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                                   \
+  X(PFNGLTEXPARAMETERIPROC, TexParameteri)                                             \
+  X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                           \
+  X(PFNGLDRAWARRAYSPROC, DrawArrays)
+
+struct Functions {
+#define RC_GL_DECLARE(type, name) type name = nullptr;
+  RC_GL_CORE_FUNCTIONS(RC_GL_DECLARE)
+#undef RC_GL_DECLARE
+  PFNGLDEBUGMESSAGECALLBACKPROC DebugMessageCallback = nullptr;  // null without KHR_debug
+
+  // Loads every entry point; throws BackendError naming the first one that is missing.
+  // Must be called with the context current (some providers only resolve then).
+  void load(ProcLoader loader);
+};
+
+}  // namespace rc::gl

@@ -1,0 +1,766 @@
+// renderGl: the process-wide GL session, the FBO, the draw sequence of drawPasses() and
+// the readback into a Frame (top row first). See gl_backend.h and docs/gl_backend.md.
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "fixtures/errors.h"
+#include "fixtures/scene_logic.h"
+#include "gl_backend/context.h"
+#include "gl_backend/gl_backend.h"
+#include "gl_backend/gl_functions.h"
+#include "gl_backend/gl_testing.h"
+#include "gl_backend/shaders.h"
+#include "gl_backend/vertex_data.h"
+
+namespace rc {
+
+namespace gl::testing {
+Hooks& hooks() {
+  static Hooks instance;
+  return instance;
+}
+}  // namespace gl::testing
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+const char* glErrorName(GLenum error) {
+  switch (error) {
+    case GL_INVALID_ENUM:
+      return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE:
+      return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION:
+      return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION:
+      return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY:
+      return "GL_OUT_OF_MEMORY";
+    default:
+      return "unknown GL error";
+  }
+}
+
+const char* framebufferStatusName(GLenum status) {
+  switch (status) {
+    case GL_FRAMEBUFFER_UNDEFINED:
+      return "GL_FRAMEBUFFER_UNDEFINED";
+    case GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT:
+      return "GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT";
+    case GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT:
+      return "GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT";
+    case GL_FRAMEBUFFER_INCOMPLETE_DRAW_BUFFER:
+      return "GL_FRAMEBUFFER_INCOMPLETE_DRAW_BUFFER";
+    case GL_FRAMEBUFFER_INCOMPLETE_READ_BUFFER:
+      return "GL_FRAMEBUFFER_INCOMPLETE_READ_BUFFER";
+    case GL_FRAMEBUFFER_UNSUPPORTED:
+      return "GL_FRAMEBUFFER_UNSUPPORTED";
+    case GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE:
+      return "GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE";
+    default:
+      return "unknown framebuffer status";
+  }
+}
+
+std::string glString(const gl::Functions& gl, GLenum name) {
+  const auto* s = reinterpret_cast<const char*>(gl.GetString(name));
+  return s != nullptr ? s : "";
+}
+
+int glInteger(const gl::Functions& gl, GLenum name) {
+  GLint value = 0;
+  gl.GetIntegerv(name, &value);
+  return value;
+}
+
+// "llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe"; a GPU keeps its full renderer string.
+std::string driverFromRenderer(const std::string& renderer) {
+  if (renderer.find("llvmpipe") != std::string::npos) return "llvmpipe";
+  if (renderer.find("softpipe") != std::string::npos) return "softpipe";
+  return renderer;
+}
+
+// Uniform locations of the one program, looked up once per program.
+struct Program {
+  GLuint id = 0;
+  int max_lights = 0;
+  GLint view_projection = -1, shading = -1, eye = -1, ambient_light = -1, light_count = -1;
+  GLint light_directional = -1, light_position = -1, light_direction = -1, light_color = -1;
+  GLint light_intensity = -1, specular_model = -1, attenuation = -1;
+  GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
+  GLint opacity = -1, has_texture = -1, texture = -1;
+};
+
+// One GL context per process (GALLIUM_DRIVER is read once per process), reused by every
+// call for a compatible spec.
+struct Session {
+  GlSpec spec;
+  std::unique_ptr<gl::Context> context;
+  gl::Functions gl;
+  std::string vendor, renderer, version, glsl_version, driver;
+  int subpixel_bits = 0;
+  std::map<std::string, Program> programs;  // by source text
+  std::vector<std::string> debug_errors;    // KHR_debug error messages since the last check
+};
+
+std::mutex g_mutex;
+// Deliberately never destroyed: tearing EGL/OSMesa down from a static destructor races
+// with the drivers' own exit handlers. The OS reclaims the context.
+Session* g_session = nullptr;
+
+void APIENTRY onDebugMessage(GLenum /*source*/, GLenum type, GLuint /*id*/, GLenum /*severity*/,
+                             GLsizei length, const GLchar* message, const void* user) {
+  if (type != GL_DEBUG_TYPE_ERROR) return;
+  auto* session = static_cast<Session*>(const_cast<void*>(user));
+  session->debug_errors.emplace_back(
+      message, length >= 0 ? static_cast<std::size_t>(length) : std::strlen(message));
+}
+
+// Throws BackendError when GL reported an error since the last check.
+void checkGl(Session& s, const char* stage) {
+  const GLenum first = s.gl.GetError();
+  for (int i = 0; i < 16 && s.gl.GetError() != GL_NO_ERROR; ++i) {
+  }
+  if (first == GL_NO_ERROR && s.debug_errors.empty()) return;
+  const std::string detail = s.debug_errors.empty() ? "" : ": " + s.debug_errors.front();
+  s.debug_errors.clear();
+  throw BackendError(fmt::format("GL error {} after {}{}",
+                                 first == GL_NO_ERROR ? "(debug output)" : glErrorName(first),
+                                 stage, detail));
+}
+
+std::unique_ptr<Session> createSession(const GlSpec& spec) {
+  const std::string& forced = gl::testing::hooks().gallium_driver;
+  const std::string gallium = forced.empty() ? spec.driver : forced;
+  if (!gallium.empty()) {
+    // Read by Mesa when the first screen is created; later changes have no effect.
+    setenv("GALLIUM_DRIVER", gallium.c_str(), 1);
+    // Surfaceless EGL would prefer a GPU render node; a software driver was asked for.
+    if (spec.platform == GlSpec::Platform::EglSurfaceless) setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+  }
+  auto s = std::make_unique<Session>();
+  s->spec = spec;
+  switch (spec.platform) {
+    case GlSpec::Platform::EglSurfaceless:
+      s->context = gl::createEglSurfacelessContext();
+      break;
+    case GlSpec::Platform::EglDevice:
+      s->context = gl::createEglDeviceContext(spec.device);
+      break;
+    case GlSpec::Platform::OSMesa:
+      s->context = gl::createOsMesaContext();
+      break;
+  }
+  s->context->makeCurrent();
+  gl::Functions& gl = s->gl;
+  gl.load(s->context->loader());
+  s->vendor = glString(gl, GL_VENDOR);
+  s->renderer = glString(gl, GL_RENDERER);
+  s->version = glString(gl, GL_VERSION);
+  s->glsl_version = glString(gl, GL_SHADING_LANGUAGE_VERSION);
+  s->subpixel_bits = glInteger(gl, GL_SUBPIXEL_BITS);
+  s->driver = driverFromRenderer(s->renderer);
+  const int major = glInteger(gl, GL_MAJOR_VERSION);
+  const int minor = glInteger(gl, GL_MINOR_VERSION);
+  if (major * 10 + minor < 33)
+    throw BackendError(fmt::format("need OpenGL 3.3 core, {} gives {}", s->renderer, s->version));
+  if (!spec.driver.empty() && s->driver != spec.driver) {
+    throw BackendError(fmt::format("asked for {}, GL_RENDERER is {} (no silent substitution)",
+                                   spec.driver, s->renderer));
+  }
+  if (gl.DebugMessageCallback != nullptr) {
+    gl.Enable(GL_DEBUG_OUTPUT);
+    gl.Enable(GL_DEBUG_OUTPUT_SYNCHRONOUS);  // errors arrive inside the failing call
+    gl.DebugMessageCallback(&onDebugMessage, s.get());
+  }
+  checkGl(*s, "context creation");
+  return s;
+}
+
+// Returns the session for spec, made current on this thread.
+Session& acquireSession(const GlSpec& spec) {
+  // A missing GPU is the answer for an egl-device spec, whatever else this process runs.
+  if (spec.platform == GlSpec::Platform::EglDevice) gl::findEglDevice(spec.device);
+  if (g_session == nullptr) {
+    g_session = createSession(spec).release();
+    return *g_session;
+  }
+  const Session& have = *g_session;
+  if (have.spec.platform != spec.platform ||
+      (spec.platform == GlSpec::Platform::EglDevice && have.spec.device != spec.device)) {
+    throw BackendError(fmt::format(
+        "this process already renders with {} ({}); one GL provider per process: run {} in its "
+        "own process",
+        toString(have.spec), have.driver, toString(spec)));
+  }
+  if (!spec.driver.empty() && spec.driver != have.driver) {
+    throw BackendError(fmt::format(
+        "asked for {}, but this process already loaded {} (GALLIUM_DRIVER is read once per "
+        "process): run {} in its own process",
+        spec.driver, have.driver, toString(spec)));
+  }
+  g_session->context->makeCurrent();
+  return *g_session;
+}
+
+GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& source) {
+  const GLuint shader = gl.CreateShader(stage);
+  const char* text = source.c_str();
+  gl.ShaderSource(shader, 1, &text, nullptr);
+  gl.CompileShader(shader);
+  GLint ok = GL_FALSE;
+  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (ok == GL_TRUE) return shader;
+  GLint length = 0;
+  gl.GetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+  std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+  gl.GetShaderInfoLog(shader, length, nullptr, log.data());
+  gl.DeleteShader(shader);
+  log.resize(std::strlen(log.c_str()));
+  // One line: the report shows the first error; the compiler's newlines become "; ".
+  while (!log.empty() && (log.back() == '\n' || log.back() == ' ')) log.pop_back();
+  for (char& c : log) c = c == '\n' ? ';' : c;
+  throw BackendError(fmt::format("{} shader does not compile: {}",
+                                 stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log));
+}
+
+const Program& programFor(Session& s, int max_lights) {
+  gl::ProgramSource source = gl::programSource(max_lights);
+  const gl::testing::Hooks& hooks = gl::testing::hooks();
+  if (!hooks.vertex_shader.empty()) source.vertex = hooks.vertex_shader;
+  if (!hooks.fragment_shader.empty()) source.fragment = hooks.fragment_shader;
+  const std::string key = source.vertex + '\0' + source.fragment;
+  if (auto it = s.programs.find(key); it != s.programs.end()) return it->second;
+
+  const gl::Functions& gl = s.gl;
+  const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, source.vertex);
+  GLuint fs = 0;
+  try {
+    fs = compileShader(gl, GL_FRAGMENT_SHADER, source.fragment);
+  } catch (...) {
+    gl.DeleteShader(vs);
+    throw;
+  }
+  const GLuint id = gl.CreateProgram();
+  gl.AttachShader(id, vs);
+  gl.AttachShader(id, fs);
+  gl.LinkProgram(id);
+  gl.DeleteShader(vs);
+  gl.DeleteShader(fs);
+  GLint ok = GL_FALSE;
+  gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    GLint length = 0;
+    gl.GetProgramiv(id, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+    gl.GetProgramInfoLog(id, length, nullptr, log.data());
+    gl.DeleteProgram(id);
+    log.resize(std::strlen(log.c_str()));
+    for (char& c : log) c = c == '\n' ? ';' : c;
+    throw BackendError(fmt::format("shader program does not link: {}", log));
+  }
+  Program p;
+  p.id = id;
+  p.max_lights = max_lights;
+  auto loc = [&](const char* name) { return gl.GetUniformLocation(id, name); };
+  p.view_projection = loc("u_view_projection");
+  p.shading = loc("u_shading");
+  p.eye = loc("u_eye");
+  p.ambient_light = loc("u_ambient_light");
+  p.light_count = loc("u_light_count");
+  p.light_directional = loc("u_light_directional");
+  p.light_position = loc("u_light_position");
+  p.light_direction = loc("u_light_direction");
+  p.light_color = loc("u_light_color");
+  p.light_intensity = loc("u_light_intensity");
+  p.specular_model = loc("u_specular_model");
+  p.attenuation = loc("u_attenuation");
+  p.material_ambient = loc("u_material_ambient");
+  p.material_diffuse = loc("u_material_diffuse");
+  p.material_specular = loc("u_material_specular");
+  p.shininess = loc("u_shininess");
+  p.opacity = loc("u_opacity");
+  p.has_texture = loc("u_has_texture");
+  p.texture = loc("u_texture");
+  return s.programs.emplace(key, p).first->second;
+}
+
+// GL objects of one render, deleted on every exit path (the context is still current).
+struct RenderObjects {
+  const gl::Functions& gl;
+  GLuint framebuffer = 0;
+  GLuint renderbuffers[3] = {0, 0, 0};  // colour, ids, depth
+  GLuint vertex_buffer = 0;
+  GLuint vertex_array = 0;
+  std::vector<GLuint> textures;
+
+  explicit RenderObjects(const gl::Functions& functions) : gl(functions) {}
+  RenderObjects(const RenderObjects&) = delete;
+  RenderObjects& operator=(const RenderObjects&) = delete;
+  ~RenderObjects() {
+    if (!textures.empty())
+      gl.DeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+    if (vertex_array != 0) gl.DeleteVertexArrays(1, &vertex_array);
+    if (vertex_buffer != 0) gl.DeleteBuffers(1, &vertex_buffer);
+    if (framebuffer != 0) gl.DeleteFramebuffers(1, &framebuffer);
+    gl.DeleteRenderbuffers(3, renderbuffers);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.GetError();  // cleanup after a failure must not leak an error into the next call
+  }
+};
+
+struct AttachmentFormat {
+  GLenum internal;
+  const char* name;
+};
+
+AttachmentFormat colorFormat(ColorFormat f) {
+  return f == ColorFormat::RGBA8 ? AttachmentFormat{GL_RGBA8, "rgba8"}
+                                 : AttachmentFormat{GL_RGBA32F, "rgba32f"};
+}
+
+AttachmentFormat depthFormat(DepthFormat f) {
+  switch (f) {
+    case DepthFormat::D16:
+      return {GL_DEPTH_COMPONENT16, "d16"};
+    case DepthFormat::D24:
+      return {GL_DEPTH_COMPONENT24, "d24"};
+    case DepthFormat::D32F:
+      return {GL_DEPTH_COMPONENT32F, "d32f"};
+  }
+  return {GL_DEPTH_COMPONENT24, "d24"};
+}
+
+// Allocates colour (RGBA32F/RGBA8), ids (R32UI) and depth attachments and checks that the
+// driver gave exactly the asked formats (no silent substitution).
+void createFramebuffer(RenderObjects& o, const Scene& scene) {
+  const gl::Functions& gl = o.gl;
+  const AttachmentFormat color = colorFormat(scene.state.color_format);
+  const AttachmentFormat depth = depthFormat(scene.state.depth_format);
+  gl.GenFramebuffers(1, &o.framebuffer);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, o.framebuffer);
+  gl.GenRenderbuffers(3, o.renderbuffers);
+  const GLenum internal[3] = {color.internal, GL_R32UI, depth.internal};
+  const GLenum attachment[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_DEPTH_ATTACHMENT};
+  for (int i = 0; i < 3; ++i) {
+    gl.BindRenderbuffer(GL_RENDERBUFFER, o.renderbuffers[i]);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, internal[i], scene.width, scene.height);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, attachment[i], GL_RENDERBUFFER, o.renderbuffers[i]);
+  }
+  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw BackendError(fmt::format(
+        "framebuffer incomplete: {} (colour {}, ids r32ui, depth {}, {}x{})",
+        framebufferStatusName(status), color.name, depth.name, scene.width, scene.height));
+  }
+  auto query = [&](GLenum att, GLenum pname) {
+    GLint v = 0;
+    gl.GetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, att, pname, &v);
+    return v;
+  };
+  const int depth_bits = query(GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE);
+  const int depth_type = query(GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE);
+  const int want_bits =
+      scene.state.depth_format == DepthFormat::D32F ? 32 : depthBits(scene.state.depth_format);
+  const int want_type =
+      scene.state.depth_format == DepthFormat::D32F ? GL_FLOAT : GL_UNSIGNED_NORMALIZED;
+  if (depth_bits != want_bits || depth_type != want_type) {
+    throw BackendError(
+        fmt::format("asked for a {} depth buffer, the driver gave {} bits of type 0x{:x}",
+                    depth.name, depth_bits, depth_type));
+  }
+  const int red_bits = query(GL_COLOR_ATTACHMENT0, GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE);
+  const int want_red = scene.state.color_format == ColorFormat::RGBA8 ? 8 : 32;
+  if (red_bits != want_red) {
+    throw BackendError(fmt::format("asked for an {} colour buffer, the driver gave {} red bits",
+                                   color.name, red_bits));
+  }
+  const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl.DrawBuffers(2, draw_buffers);
+}
+
+void uploadVertices(RenderObjects& o, const gl::VertexData& data) {
+  const gl::Functions& gl = o.gl;
+  gl.GenVertexArrays(1, &o.vertex_array);
+  gl.BindVertexArray(o.vertex_array);
+  gl.GenBuffers(1, &o.vertex_buffer);
+  gl.BindBuffer(GL_ARRAY_BUFFER, o.vertex_buffer);
+  gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.vertices.size() * sizeof(gl::Vertex)),
+                data.vertices.empty() ? nullptr : data.vertices.data(), GL_STATIC_DRAW);
+  constexpr auto kStride = static_cast<GLsizei>(sizeof(gl::Vertex));
+  auto offset = [](std::size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+  auto floats = [&](GLuint location, GLint size, std::size_t bytes) {
+    gl.EnableVertexAttribArray(location);
+    gl.VertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, kStride, offset(bytes));
+  };
+  floats(gl::kAttribWorldPosition, 3, offsetof(gl::Vertex, world_position));
+  floats(gl::kAttribWorldNormal, 3, offsetof(gl::Vertex, world_normal));
+  floats(gl::kAttribUv, 2, offsetof(gl::Vertex, uv));
+  gl.EnableVertexAttribArray(gl::kAttribPrimitiveId);
+  gl.VertexAttribIPointer(gl::kAttribPrimitiveId, 1, GL_UNSIGNED_INT, kStride,
+                          offset(offsetof(gl::Vertex, primitive_id)));
+  floats(gl::kAttribFaceCentroid, 3, offsetof(gl::Vertex, face_centroid));
+  floats(gl::kAttribFaceNormal, 3, offsetof(gl::Vertex, face_normal));
+}
+
+// One GL texture per distinct rc::Texture; returns the name for each material (0: none).
+std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max_texture_size) {
+  const gl::Functions& gl = o.gl;
+  std::map<const Texture*, GLuint> by_texture;
+  std::vector<GLuint> per_material(scene.materials.size(), 0);
+  const GLint filter = scene.state.texture_filter == TextureFilter::Linear ? GL_LINEAR : GL_NEAREST;
+  const GLint wrap = scene.state.texture_wrap == TextureWrap::Clamp ? GL_CLAMP_TO_EDGE : GL_REPEAT;
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.ActiveTexture(GL_TEXTURE0);
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    const Texture* t = scene.materials[m].texture.get();
+    if (t == nullptr) continue;
+    if (auto it = by_texture.find(t); it != by_texture.end()) {
+      per_material[m] = it->second;
+      continue;
+    }
+    if (t->width <= 0 || t->height <= 0 ||
+        t->rgba.size() != static_cast<std::size_t>(t->width) * t->height * 4) {
+      throw InputError(fmt::format("{}: materials[{}] ({}): texture {} is {}x{} with {} bytes",
+                                   scene.name, m, scene.materials[m].name, t->path.string(),
+                                   t->width, t->height, t->rgba.size()));
+    }
+    if (t->width > max_texture_size || t->height > max_texture_size) {
+      throw BackendError(fmt::format("texture {} is {}x{}, GL_MAX_TEXTURE_SIZE is {}",
+                                     t->path.string(), t->width, t->height, max_texture_size));
+    }
+    GLuint name = 0;
+    gl.GenTextures(1, &name);
+    o.textures.push_back(name);
+    gl.BindTexture(GL_TEXTURE_2D, name);
+    // Row 0 of rc::Texture is v = 0, which is also GL's first row: no flip.
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, t->width, t->height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                  t->rgba.data());
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    by_texture.emplace(t, name);
+    per_material[m] = name;
+  }
+  return per_material;
+}
+
+glm::vec3 toFloat(const glm::dvec3& v) { return glm::vec3(v); }
+
+void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& scene) {
+  const double aspect = static_cast<double>(scene.width) / scene.height;
+  const glm::mat4 view_projection(projectionMatrix(scene.camera, aspect) *
+                                  viewMatrix(scene.camera));
+  gl.UseProgram(p.id);
+  gl.UniformMatrix4fv(p.view_projection, 1, GL_FALSE, glm::value_ptr(view_projection));
+  const RenderState& st = scene.state;
+  gl.Uniform1i(p.shading, st.shading == Shading::Flat      ? gl::kShadingFlat
+                          : st.shading == Shading::Gouraud ? gl::kShadingGouraud
+                                                           : gl::kShadingPhong);
+  gl.Uniform1i(p.specular_model, st.specular_model == SpecularModel::BlinnPhong
+                                     ? gl::kSpecularBlinnPhong
+                                     : gl::kSpecularPhong);
+  gl.Uniform1i(p.attenuation, st.attenuation == Attenuation::Inverse         ? gl::kAttInverse
+                              : st.attenuation == Attenuation::InverseSquare ? gl::kAttInverseSquare
+                                                                             : gl::kAttNone);
+  gl.Uniform3fv(p.eye, 1, glm::value_ptr(toFloat(scene.camera.eye)));
+  gl.Uniform3fv(p.ambient_light, 1, glm::value_ptr(toFloat(scene.ambient_light)));
+  const auto count = static_cast<GLsizei>(scene.lights.size());
+  gl.Uniform1i(p.light_count, count);
+  gl.Uniform1i(p.texture, 0);
+  if (count == 0) return;
+  std::vector<GLint> directional;
+  std::vector<glm::vec3> position, direction, color;
+  std::vector<GLfloat> intensity;
+  for (const Light& l : scene.lights) {
+    directional.push_back(l.type == LightType::Directional ? 1 : 0);
+    position.push_back(toFloat(l.position));
+    direction.push_back(toFloat(l.direction));
+    color.push_back(toFloat(l.color));
+    intensity.push_back(static_cast<GLfloat>(l.intensity));
+  }
+  gl.Uniform1iv(p.light_directional, count, directional.data());
+  gl.Uniform3fv(p.light_position, count, glm::value_ptr(position[0]));
+  gl.Uniform3fv(p.light_direction, count, glm::value_ptr(direction[0]));
+  gl.Uniform3fv(p.light_color, count, glm::value_ptr(color[0]));
+  gl.Uniform1fv(p.light_intensity, count, intensity.data());
+}
+
+void setMaterialUniforms(const gl::Functions& gl, const Program& p, const Material& m,
+                         GLuint texture) {
+  gl.Uniform3fv(p.material_ambient, 1, glm::value_ptr(toFloat(m.ambient)));
+  gl.Uniform3fv(p.material_diffuse, 1, glm::value_ptr(toFloat(m.diffuse)));
+  gl.Uniform3fv(p.material_specular, 1, glm::value_ptr(toFloat(m.specular)));
+  gl.Uniform1f(p.shininess, static_cast<GLfloat>(m.shininess));
+  gl.Uniform1f(p.opacity, static_cast<GLfloat>(m.opacity));
+  gl.Uniform1i(p.has_texture, texture != 0 ? 1 : 0);
+  gl.BindTexture(GL_TEXTURE_2D, texture);
+}
+
+// Fixed-function state that never changes between passes: GL conventions of DESIGN.md.
+void setFixedState(const gl::Functions& gl, const Scene& scene) {
+  gl.Viewport(0, 0, scene.width, scene.height);
+  gl.DepthRange(0.0, 1.0);
+  for (GLenum cap : {GL_DITHER, GL_MULTISAMPLE, GL_FRAMEBUFFER_SRGB, GL_DEPTH_CLAMP,
+                     GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_POLYGON_OFFSET_FILL,
+                     GL_SAMPLE_ALPHA_TO_COVERAGE, GL_RASTERIZER_DISCARD, GL_PRIMITIVE_RESTART}) {
+    gl.Disable(cap);
+  }
+  gl.PolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  gl.Enable(GL_DEPTH_TEST);  // also for "no depth test": ALWAYS keeps depth writes on
+  if (scene.state.cull == Cull::None) {
+    gl.Disable(GL_CULL_FACE);
+  } else {
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(scene.state.cull == Cull::Back ? GL_BACK : GL_FRONT);
+  }
+  gl.FrontFace(scene.state.front_face == FrontFace::CW ? GL_CW : GL_CCW);
+  gl.BlendEquation(GL_FUNC_ADD);
+  gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  gl.Disablei(GL_BLEND, 1);  // R32UI ids never blend (GL ignores blending on integer buffers)
+}
+
+void clearFramebuffer(const gl::Functions& gl, const Scene& scene) {
+  gl.DepthMask(GL_TRUE);
+  const glm::vec4 clear_color(scene.clear_color);
+  gl.ClearBufferfv(GL_COLOR, 0, glm::value_ptr(clear_color));
+  const GLuint zero_ids[4] = {0, 0, 0, 0};
+  gl.ClearBufferuiv(GL_COLOR, 1, zero_ids);
+  const auto clear_depth = static_cast<GLfloat>(scene.clear_depth);
+  gl.ClearBufferfv(GL_DEPTH, 0, &clear_depth);
+}
+
+void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
+                  const gl::VertexData& data, const std::vector<GLuint>& textures) {
+  std::uint32_t bound_material = UINT32_MAX;
+  for (const gl::PassRuns& pass : data.passes) {
+    gl.DepthFunc(pass.depth_func == DepthFunc::Less ? GL_LESS : GL_ALWAYS);
+    gl.DepthMask(pass.depth_write ? GL_TRUE : GL_FALSE);
+    if (pass.blend) {
+      gl.Enablei(GL_BLEND, 0);
+    } else {
+      gl.Disablei(GL_BLEND, 0);
+    }
+    for (const gl::DrawRun& run : pass.runs) {
+      if (run.material != bound_material) {
+        setMaterialUniforms(gl, p, scene.materials[run.material], textures[run.material]);
+        bound_material = run.material;
+      }
+      gl.DrawArrays(GL_TRIANGLES, static_cast<GLint>(run.first_vertex),
+                    static_cast<GLsizei>(run.vertex_count));
+    }
+  }
+}
+
+// Reverses the row order in place: GL's row 0 is the bottom, the Frame's the top.
+template <typename T>
+void flipRows(std::vector<T>& data, std::size_t row_elements, int height) {
+  std::vector<T> tmp(row_elements);
+  for (int y = 0; y < height / 2; ++y) {
+    T* a = data.data() + static_cast<std::size_t>(y) * row_elements;
+    T* b = data.data() + static_cast<std::size_t>(height - 1 - y) * row_elements;
+    std::memcpy(tmp.data(), a, row_elements * sizeof(T));
+    std::memcpy(a, b, row_elements * sizeof(T));
+    std::memcpy(b, tmp.data(), row_elements * sizeof(T));
+  }
+}
+
+// Reads a GL-row-ordered scratch image and writes frame rows top first through convert.
+template <typename Src, typename Dst, typename Convert>
+void convertFlipped(const std::vector<Src>& src, std::vector<Dst>& dst, std::size_t row_elements,
+                    int height, Convert convert) {
+  for (int y = 0; y < height; ++y) {
+    const Src* s = src.data() + static_cast<std::size_t>(height - 1 - y) * row_elements;
+    Dst* d = dst.data() + static_cast<std::size_t>(y) * row_elements;
+    for (std::size_t i = 0; i < row_elements; ++i) d[i] = convert(s[i]);
+  }
+}
+
+void readBack(const gl::Functions& gl, const Scene& scene, Frame& frame) {
+  const int w = scene.width;
+  const int h = scene.height;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  frame.width = w;
+  frame.height = h;
+  frame.color.resize(n * 4);
+  frame.depth.resize(n);
+  frame.id.resize(n);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  if (scene.state.color_format == ColorFormat::RGBA8) {
+    std::vector<std::uint8_t> bytes(n * 4);
+    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
+    static const auto kUnorm8 = [] {
+      std::array<float, 256> t{};
+      for (int q = 0; q < 256; ++q) t[q] = static_cast<float>(q / 255.0);
+      return t;
+    }();
+    convertFlipped(bytes, frame.color, static_cast<std::size_t>(w) * 4, h,
+                   [](std::uint8_t q) { return kUnorm8[q]; });
+  } else {
+    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, frame.color.data());
+    flipRows(frame.color, static_cast<std::size_t>(w) * 4, h);
+  }
+
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  gl.ReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, frame.id.data());
+  flipRows(frame.id, static_cast<std::size_t>(w), h);
+
+  // Depth comes back as the stored integer q (exactly), then q / (2^b - 1) like the
+  // reference; GL_UNSIGNED_INT scales a 24-bit value to 32 bits, so q = v >> 8 whether
+  // the driver replicates bits or rounds (see docs/gl_backend.md).
+  switch (scene.state.depth_format) {
+    case DepthFormat::D16: {
+      std::vector<std::uint16_t> q(n);
+      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, q.data());
+      convertFlipped(q, frame.depth, static_cast<std::size_t>(w), h,
+                     [](std::uint16_t v) { return static_cast<float>(v / 65535.0); });
+      break;
+    }
+    case DepthFormat::D24: {
+      std::vector<std::uint32_t> q(n);
+      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, q.data());
+      convertFlipped(q, frame.depth, static_cast<std::size_t>(w), h,
+                     [](std::uint32_t v) { return static_cast<float>((v >> 8) / 16777215.0); });
+      break;
+    }
+    case DepthFormat::D32F:
+      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, frame.depth.data());
+      flipRows(frame.depth, static_cast<std::size_t>(w), h);
+      break;
+  }
+}
+
+// Lights cost 5 vec4 slots each in the worst packing; the rest of the uniforms fit in 16.
+constexpr int kSlotsPerLight = 5;
+constexpr int kOtherSlots = 16;
+
+int lightArraySize(const gl::Functions& gl, std::size_t lights) {
+  const int components = std::min(glInteger(gl, GL_MAX_VERTEX_UNIFORM_COMPONENTS),
+                                  glInteger(gl, GL_MAX_FRAGMENT_UNIFORM_COMPONENTS));
+  const int max_lights = (components / 4 - kOtherSlots) / kSlotsPerLight;
+  if (lights > static_cast<std::size_t>(max_lights)) {
+    throw BackendError(fmt::format(
+        "the scene has {} lights; this driver's uniform limits ({} components) allow at most {}",
+        lights, components, max_lights));
+  }
+  // Power-of-two array sizes (at least 8) keep the number of distinct programs small.
+  int size = 8;
+  while (static_cast<std::size_t>(size) < lights) size *= 2;
+  return std::min(size, max_lights);
+}
+
+Frame renderLocked(const Scene& scene, const GlSpec& spec) {
+  if (scene.width <= 0 || scene.height <= 0) {
+    throw InputError(
+        fmt::format("{}: image size {}x{} is not positive", scene.name, scene.width, scene.height));
+  }
+  auto start = Clock::now();
+  Session& s = acquireSession(spec);
+  struct Release {
+    Session& s;
+    ~Release() { s.context->release(); }
+  } release{s};
+  const gl::Functions& gl = s.gl;
+  s.debug_errors.clear();
+  while (gl.GetError() != GL_NO_ERROR) {
+  }
+  const double context_ms = msSince(start);
+
+  start = Clock::now();
+  const int max_rb = glInteger(gl, GL_MAX_RENDERBUFFER_SIZE);
+  GLint max_viewport[2] = {0, 0};
+  gl.GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
+  if (scene.width > std::min(max_rb, max_viewport[0]) ||
+      scene.height > std::min(max_rb, max_viewport[1])) {
+    throw BackendError(
+        fmt::format("image {}x{} exceeds the driver's limits (GL_MAX_RENDERBUFFER_SIZE {}, "
+                    "GL_MAX_VIEWPORT_DIMS {}x{})",
+                    scene.width, scene.height, max_rb, max_viewport[0], max_viewport[1]));
+  }
+  const Program& program = programFor(s, lightArraySize(gl, scene.lights.size()));
+  checkGl(s, "shader compilation");
+  const gl::VertexData data = gl::buildVertexData(scene, drawPasses(scene));
+  if (data.vertices.size() > static_cast<std::size_t>(INT32_MAX)) {
+    throw BackendError(
+        fmt::format("{} vertices exceed what one glDrawArrays can address", data.vertices.size()));
+  }
+  RenderObjects objects(gl);
+  createFramebuffer(objects, scene);
+  checkGl(s, "framebuffer setup");
+  uploadVertices(objects, data);
+  const std::vector<GLuint> textures =
+      uploadTextures(objects, scene, glInteger(gl, GL_MAX_TEXTURE_SIZE));
+  setSceneUniforms(gl, program, scene);
+  if (gl::testing::hooks().gl_error_after_upload) gl.Enable(0xFFFFu);  // not a capability
+  checkGl(s, "upload");
+  const double upload_ms = msSince(start);
+
+  start = Clock::now();
+  setFixedState(gl, scene);
+  clearFramebuffer(gl, scene);
+  drawPassesGl(gl, program, scene, data, textures);
+  gl.Finish();
+  checkGl(s, "draw");
+  const double draw_ms = msSince(start);
+
+  start = Clock::now();
+  Frame frame;
+  readBack(gl, scene, frame);
+  checkGl(s, "readback");
+  const double readback_ms = msSince(start);
+
+  nlohmann::json& m = frame.meta;
+  m["renderer"] = s.renderer;
+  m["gl_vendor"] = s.vendor;
+  m["gl_renderer"] = s.renderer;
+  m["gl_version"] = s.version;
+  m["glsl_version"] = s.glsl_version;
+  m["subpixel_bits"] = s.subpixel_bits;
+  m["platform"] = s.context->platform();
+  m["driver"] = s.driver;
+  m["skipped_triangles"] = data.skipped_triangles;
+  m["timing_ms"] = {
+      {"context", context_ms}, {"upload", upload_ms}, {"draw", draw_ms}, {"readback", readback_ms}};
+  return frame;
+}
+
+}  // namespace
+
+Frame renderGl(const Scene& scene, const GlSpec& spec) {
+  const std::string name = scene.name.empty() ? "(unnamed scene)" : scene.name;
+  try {
+    const std::lock_guard lock(g_mutex);
+    return renderLocked(scene, spec);
+  } catch (const BackendError& e) {
+    throw BackendError(fmt::format("{}: {}: {}", name, toString(spec), e.what()));
+  } catch (const std::bad_alloc&) {
+    throw BackendError(fmt::format("{}: {}: out of memory for a {}x{} frame", name, toString(spec),
+                                   scene.width, scene.height));
+  }
+}
+
+}  // namespace rc

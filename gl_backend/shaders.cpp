@@ -1,0 +1,156 @@
+// GLSL sources: see shaders.h. Written next to DESIGN.md "Shading"; every formula below
+// has a same-named counterpart in reference/shading.cpp.
+#include "gl_backend/shaders.h"
+
+#include <fmt/format.h>
+
+namespace rc::gl {
+namespace {
+
+constexpr const char* kHeader = R"(#version 330 core
+#define RC_MAX_LIGHTS {}
+)";
+
+// Uniforms and the lighting model, shared by both stages (Gouraud lights per vertex,
+// flat and Phong per fragment).
+constexpr const char* kLighting = R"(
+uniform vec3 u_eye;               // camera.eye: v points towards it
+uniform vec3 u_ambient_light;
+uniform int u_light_count;
+uniform int u_light_directional[RC_MAX_LIGHTS];  // 1: directional, 0: point
+uniform vec3 u_light_position[RC_MAX_LIGHTS];    // point lights, world space
+uniform vec3 u_light_direction[RC_MAX_LIGHTS];   // directional: the direction light travels
+uniform vec3 u_light_color[RC_MAX_LIGHTS];
+uniform float u_light_intensity[RC_MAX_LIGHTS];
+uniform int u_specular_model;     // 0 phong, 1 blinn-phong
+uniform int u_attenuation;        // 0 none, 1 inverse (1/r), 2 inverse_square (1/r^2)
+uniform vec3 u_material_ambient;
+uniform vec3 u_material_diffuse;
+uniform vec3 u_material_specular;
+uniform float u_shininess;
+
+// normalize() with zero staying zero (a zero normal lights nothing).
+vec3 safeNormalize(vec3 v) {
+  float len = length(v);
+  return len > 0.0 ? v / len : vec3(0.0);
+}
+
+// max(0, x)^s with pow(0, 0) := 1 (GLSL leaves pow(0, y <= 0) undefined).
+float specularPower(float base, float shininess) {
+  if (shininess == 0.0) return 1.0;
+  return base > 0.0 ? pow(base, shininess) : 0.0;
+}
+
+// The lit colour at world point p with unit normal n, split into the part a texture
+// multiplies (ambient + sum of diffuse) and the part it does not (sum of specular).
+void shadePoint(vec3 p, vec3 n, out vec3 ambient_diffuse, out vec3 specular) {
+  ambient_diffuse = u_material_ambient * u_ambient_light;
+  specular = vec3(0.0);
+  if (n == vec3(0.0)) return;  // zero normal: no diffuse, no specular
+  vec3 v = safeNormalize(u_eye - p);
+  for (int i = 0; i < u_light_count; ++i) {
+    vec3 l;
+    float att = 1.0;
+    if (u_light_directional[i] != 0) {
+      l = -safeNormalize(u_light_direction[i]);
+    } else {
+      vec3 to_light = u_light_position[i] - p;
+      float r = length(to_light);
+      l = safeNormalize(to_light);
+      if (u_attenuation == 1) att = 1.0 / r;
+      else if (u_attenuation == 2) att = 1.0 / (r * r);
+    }
+    vec3 L = u_light_color[i] * u_light_intensity[i] * att;
+    float n_dot_l = dot(n, l);
+    ambient_diffuse += u_material_diffuse * L * max(0.0, n_dot_l);
+    float base;
+    if (u_specular_model == 1) {
+      vec3 h = safeNormalize(l + v);
+      base = max(0.0, dot(n, h));
+    } else {
+      vec3 r = 2.0 * n_dot_l * n - l;
+      base = max(0.0, dot(r, v));
+    }
+    specular += u_material_specular * L * specularPower(base, u_shininess);
+  }
+}
+)";
+
+constexpr const char* kVertexMain = R"(
+layout(location = 0) in vec3 a_world_position;
+layout(location = 1) in vec3 a_world_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in uint a_primitive_id;
+layout(location = 4) in vec3 a_face_centroid;
+layout(location = 5) in vec3 a_face_normal;
+
+uniform mat4 u_view_projection;  // projection * view, composed in double on the CPU
+uniform int u_shading;           // 0 flat, 1 gouraud, 2 phong
+
+out vec3 v_world_position;
+out vec3 v_world_normal;
+out vec2 v_uv;
+out vec3 v_gouraud_ambient_diffuse;
+out vec3 v_gouraud_specular;
+flat out uint v_primitive_id;
+flat out vec3 v_face_centroid;
+flat out vec3 v_face_normal;
+
+void main() {
+  gl_Position = u_view_projection * vec4(a_world_position, 1.0);
+  v_world_position = a_world_position;
+  v_world_normal = a_world_normal;
+  v_uv = a_uv;
+  v_primitive_id = a_primitive_id;
+  v_face_centroid = a_face_centroid;
+  v_face_normal = a_face_normal;
+  v_gouraud_ambient_diffuse = vec3(0.0);
+  v_gouraud_specular = vec3(0.0);
+  if (u_shading == 1) shadePoint(a_world_position, a_world_normal, v_gouraud_ambient_diffuse,
+                                 v_gouraud_specular);
+}
+)";
+
+constexpr const char* kFragmentMain = R"(
+in vec3 v_world_position;
+in vec3 v_world_normal;
+in vec2 v_uv;
+in vec3 v_gouraud_ambient_diffuse;
+in vec3 v_gouraud_specular;
+flat in uint v_primitive_id;
+flat in vec3 v_face_centroid;
+flat in vec3 v_face_normal;
+
+uniform int u_shading;
+uniform int u_has_texture;
+uniform sampler2D u_texture;
+uniform float u_opacity;
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out uint o_primitive_id;
+
+void main() {
+  vec3 tex = u_has_texture != 0 ? texture(u_texture, v_uv).rgb : vec3(1.0);
+  vec3 ambient_diffuse;
+  vec3 specular;
+  if (u_shading == 0) {
+    shadePoint(v_face_centroid, v_face_normal, ambient_diffuse, specular);
+  } else if (u_shading == 1) {
+    ambient_diffuse = v_gouraud_ambient_diffuse;
+    specular = v_gouraud_specular;
+  } else {
+    shadePoint(v_world_position, safeNormalize(v_world_normal), ambient_diffuse, specular);
+  }
+  o_color = vec4(tex * ambient_diffuse + specular, u_opacity);
+  o_primitive_id = v_primitive_id;
+}
+)";
+
+}  // namespace
+
+ProgramSource programSource(int max_lights) {
+  const std::string header = fmt::format(kHeader, max_lights);
+  return {header + kLighting + kVertexMain, header + kLighting + kFragmentMain};
+}
+
+}  // namespace rc::gl

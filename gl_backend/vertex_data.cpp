@@ -1,0 +1,140 @@
+// Building the vertex buffer: see vertex_data.h.
+#include "gl_backend/vertex_data.h"
+
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "fixtures/errors.h"
+
+namespace rc::gl {
+namespace {
+
+// World-space attributes of one object's vertices, computed once per object.
+struct WorldMesh {
+  std::vector<glm::dvec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<bool> finite;  // world and clip position finite, in double and in float
+};
+
+bool isFinite(const glm::dvec4& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
+}
+
+bool fitsFloat(const glm::dvec3& v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  return std::abs(v.x) <= kMax && std::abs(v.y) <= kMax && std::abs(v.z) <= kMax;
+}
+
+glm::dvec3 normalizeOrZero(const glm::dvec3& v) {
+  const double len = glm::length(v);
+  return len > 0.0 ? v / len : glm::dvec3(0.0);
+}
+
+void validateObject(const Scene& scene, std::size_t index) {
+  const Object& o = scene.objects[index];
+  const Mesh& m = o.mesh;
+  auto fail = [&](const std::string& what) {
+    throw InputError(fmt::format("{}: objects[{}] ({}): {}", scene.name, index, o.name, what));
+  };
+  if (o.material >= scene.materials.size())
+    fail(fmt::format("material index {} out of range ({} materials)", o.material,
+                     scene.materials.size()));
+  if (m.normals.size() != m.positions.size())
+    fail(fmt::format("{} normals for {} positions", m.normals.size(), m.positions.size()));
+  if (!m.uvs.empty() && m.uvs.size() != m.positions.size())
+    fail(fmt::format("{} uvs for {} positions", m.uvs.size(), m.positions.size()));
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    for (std::uint32_t vi : m.triangles[t]) {
+      if (vi >= m.positions.size())
+        fail(fmt::format("triangle {} uses vertex {} of {}", t, vi, m.positions.size()));
+    }
+  }
+}
+
+WorldMesh toWorld(const Object& o, const glm::dmat4& view_projection) {
+  WorldMesh w;
+  const std::size_t n = o.mesh.positions.size();
+  w.positions.resize(n);
+  w.normals.resize(n);
+  w.finite.resize(n);
+  const glm::dmat3 normal_matrix = normalMatrix(o.model);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec4 p = o.model * glm::dvec4(glm::dvec3(o.mesh.positions[i]), 1.0);
+    w.positions[i] = glm::dvec3(p);
+    w.finite[i] = isFinite(p) && isFinite(view_projection * glm::dvec4(w.positions[i], 1.0)) &&
+                  fitsFloat(w.positions[i]);
+    w.normals[i] = glm::vec3(normalizeOrZero(normal_matrix * glm::dvec3(o.mesh.normals[i])));
+  }
+  return w;
+}
+
+void store(float (&dst)[3], const glm::dvec3& v) {
+  dst[0] = static_cast<float>(v.x);
+  dst[1] = static_cast<float>(v.y);
+  dst[2] = static_cast<float>(v.z);
+}
+
+}  // namespace
+
+VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes) {
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) validateObject(scene, i);
+  const double aspect = static_cast<double>(scene.width) / scene.height;
+  const glm::dmat4 view_projection =
+      projectionMatrix(scene.camera, aspect) * viewMatrix(scene.camera);
+  std::vector<WorldMesh> world;
+  world.reserve(scene.objects.size());
+  for (const Object& o : scene.objects) world.push_back(toWorld(o, view_projection));
+
+  VertexData data;
+  std::size_t triangles = 0;
+  for (const DrawPass& p : passes) triangles += p.primitives.size();
+  data.vertices.reserve(triangles * 3);
+
+  for (const DrawPass& pass : passes) {
+    PassRuns& out = data.passes.emplace_back();
+    out.depth_func = pass.depth_func;
+    out.depth_write = pass.depth_write;
+    out.blend = pass.blend;
+    for (const PrimitiveRef& prim : pass.primitives) {
+      const Object& obj = scene.objects[prim.object];
+      const WorldMesh& wm = world[prim.object];
+      const auto& tri = obj.mesh.triangles[prim.triangle];
+      if (!wm.finite[tri[0]] || !wm.finite[tri[1]] || !wm.finite[tri[2]]) {
+        ++data.skipped_triangles;
+        continue;
+      }
+      const glm::dvec3 p0 = wm.positions[tri[0]];
+      const glm::dvec3 p1 = wm.positions[tri[1]];
+      const glm::dvec3 p2 = wm.positions[tri[2]];
+      const glm::dvec3 centroid = (p0 + p1 + p2) / 3.0;
+      const glm::dvec3 face_normal = normalizeOrZero(glm::cross(p1 - p0, p2 - p0));
+
+      const auto material = static_cast<std::uint32_t>(obj.material);
+      const auto first = static_cast<std::uint32_t>(data.vertices.size());
+      if (out.runs.empty() || out.runs.back().material != material)
+        out.runs.push_back(DrawRun{material, first, 0});
+      out.runs.back().vertex_count += 3;
+
+      for (std::uint32_t vi : tri) {
+        Vertex& v = data.vertices.emplace_back();
+        store(v.world_position, wm.positions[vi]);
+        const glm::vec3& n = wm.normals[vi];
+        v.world_normal[0] = n.x;
+        v.world_normal[1] = n.y;
+        v.world_normal[2] = n.z;
+        const glm::vec2 uv = obj.mesh.uvs.empty() ? glm::vec2(0.0f) : obj.mesh.uvs[vi];
+        v.uv[0] = uv.x;
+        v.uv[1] = uv.y;
+        v.primitive_id = prim.id;
+        store(v.face_centroid, centroid);
+        store(v.face_normal, face_normal);
+      }
+    }
+    if (out.runs.empty()) data.passes.pop_back();
+  }
+  return data;
+}
+
+}  // namespace rc::gl

@@ -1,0 +1,335 @@
+// The GL backend's contract around the pixels: spec parsing, driver identity and
+// frame.json metadata, every failure path as BackendError/InputError (with injected
+// faults: a broken shader, a GL error, a driver substitution, a second driver in one
+// process), and bad input that must not crash.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <set>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "gl_backend/gl_testing.h"
+#include "tests/gl/gl_test_util.h"
+
+namespace rc::gltest {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(GlSpecParse, AcceptsEveryDocumentedForm) {
+  struct Case {
+    const char* text;
+    GlSpec::Platform platform;
+    const char* driver;
+    int device;
+    const char* canonical;
+  };
+  const Case cases[] = {
+      {"gl", GlSpec::Platform::EglSurfaceless, "", -1, "gl"},
+      {"gl:egl", GlSpec::Platform::EglSurfaceless, "", -1, "gl"},
+      {"gl:egl:llvmpipe", GlSpec::Platform::EglSurfaceless, "llvmpipe", -1, "gl:egl:llvmpipe"},
+      {"gl:egl:softpipe", GlSpec::Platform::EglSurfaceless, "softpipe", -1, "gl:egl:softpipe"},
+      {"gl:osmesa", GlSpec::Platform::OSMesa, "", -1, "gl:osmesa"},
+      {"gl:osmesa:llvmpipe", GlSpec::Platform::OSMesa, "llvmpipe", -1, "gl:osmesa:llvmpipe"},
+      {"gl:osmesa:softpipe", GlSpec::Platform::OSMesa, "softpipe", -1, "gl:osmesa:softpipe"},
+      {"gl:egl-device", GlSpec::Platform::EglDevice, "", -1, "gl:egl-device"},
+      {"gl:egl-device:0", GlSpec::Platform::EglDevice, "", 0, "gl:egl-device:0"},
+      {"gl:egl-device:12", GlSpec::Platform::EglDevice, "", 12, "gl:egl-device:12"},
+  };
+  for (const Case& c : cases) {
+    const GlSpec s = parseGlSpec(c.text);
+    EXPECT_EQ(s.platform, c.platform) << c.text;
+    EXPECT_EQ(s.driver, c.driver) << c.text;
+    EXPECT_EQ(s.device, c.device) << c.text;
+    EXPECT_EQ(toString(s), c.canonical) << c.text;
+    const GlSpec again = parseGlSpec(toString(s));
+    EXPECT_EQ(again.platform, s.platform);
+    EXPECT_EQ(again.driver, s.driver);
+    EXPECT_EQ(again.device, s.device);
+  }
+}
+
+TEST(GlSpecParse, RejectsEverythingElseWithTheValidForms) {
+  for (const char* bad :
+       {"", "g", "GL", "gl:", "gl:egl:", "gl:egl:zink", "gl:egl:llvmpipe:x", "gl:osmesa:swrast",
+        "gl:egl-device:", "gl:egl-device:-1", "gl:egl-device:1x", "gl:egl-device:llvmpipe",
+        "gl:vulkan", "ref", "gl:eglx", " gl"}) {
+    try {
+      parseGlSpec(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const InputError& e) {
+      EXPECT_THAT(std::string(e.what()), HasSubstr(std::string("'") + bad + "'"));
+      EXPECT_THAT(std::string(e.what()), HasSubstr("gl:osmesa:softpipe"));
+      EXPECT_THAT(std::string(e.what()), HasSubstr("gl:egl-device:N"));
+    }
+  }
+}
+
+TEST(GlEglDevice, NoGpuIsABackendErrorSayingSo) {
+  // This machine has no GPU (Mesa may list only its software device). Where a GPU
+  // exists the render must succeed and report a non-software renderer instead.
+  Scene s = orthoScene(4, 4);
+  s.name = "gltest/device";
+  try {
+    const Frame f = renderGl(s, parseGlSpec("gl:egl-device"));
+    const std::string driver = f.meta.at("driver");
+    EXPECT_NE(driver, "llvmpipe");
+    EXPECT_NE(driver, "softpipe");
+    EXPECT_EQ(f.meta.at("platform"), "egl-device");
+  } catch (const BackendError& e) {
+    const std::string msg = e.what();
+    EXPECT_THAT(msg, HasSubstr("gltest/device: gl:egl-device: "));
+    EXPECT_THAT(msg, HasSubstr("no EGL device with a GPU"));
+  }
+  // An index past the device list is never a software fallback.
+  EXPECT_THROW(renderGl(s, parseGlSpec("gl:egl-device:99")), BackendError);
+}
+
+class GlBackend : public GlTest {};
+
+TEST_F(GlBackend, DriverAndMetadataMatchTheSpec) {
+  const GlSpec sp = spec();
+  const Frame f = render(orthoScene(4, 4));
+  const std::string renderer = f.meta.at("gl_renderer");
+  EXPECT_EQ(f.meta.at("renderer"), renderer);
+  if (!sp.driver.empty()) {
+    EXPECT_THAT(renderer, HasSubstr(sp.driver));
+    EXPECT_EQ(f.meta.at("driver"), sp.driver);
+  }
+  // Measured on Mesa 22.3: llvmpipe snaps to 1/256 px, softpipe to 1/16 px.
+  const std::string driver = f.meta.at("driver");
+  if (driver == "llvmpipe") {
+    EXPECT_EQ(f.meta.at("subpixel_bits"), 8);
+  }
+  if (driver == "softpipe") {
+    EXPECT_EQ(f.meta.at("subpixel_bits"), 4);
+  }
+  EXPECT_EQ(f.meta.at("platform"), sp.platform == GlSpec::Platform::OSMesa ? "osmesa" : "egl");
+  EXPECT_THAT(std::string(f.meta.at("gl_version")), HasSubstr("Mesa"));
+  EXPECT_FALSE(std::string(f.meta.at("glsl_version")).empty());
+  for (const char* key : {"context", "upload", "draw", "readback"})
+    EXPECT_GE(f.meta.at("timing_ms").at(key).get<double>(), 0.0) << key;
+  EXPECT_TRUE(f.edge_dist.empty());
+  EXPECT_TRUE(f.depth_gap.empty());
+}
+
+TEST_F(GlBackend, RowZeroIsTheTopRow) {
+  // A quad covering only the top half of the view: image rows 0..3 covered, 4..7 not.
+  Scene s = orthoScene(8, 8);
+  s.ambient_light = glm::dvec3(1.0);
+  Material m;
+  m.ambient = {1, 1, 1};
+  s.materials.push_back(m);
+  s.objects.push_back(quad(-2, 0.0, 2, 2, 0, 0));
+  const Frame f = render(s);
+  for (int y = 0; y < 8; ++y) EXPECT_EQ(f.id[f.index(3, y)] != 0, y < 4) << "row " << y;
+}
+
+TEST_F(GlBackend, RepeatedRendersAreIdentical) {
+  Scene s = orthoScene(24, 16);
+  s.ambient_light = {0.1, 0.2, 0.3};
+  Material m;
+  m.ambient = {1, 1, 1};
+  m.specular = {0.5, 0.5, 0.5};
+  s.materials.push_back(m);
+  Light l;
+  l.position = {0.3, 0.2, 1.0};
+  s.lights.push_back(l);
+  Object o = quad(-0.9, -0.8, 0.7, 0.9, 0.1, 0);
+  o.mesh.positions[2].z = -0.4f;
+  s.objects.push_back(o);
+  const Frame a = render(s);
+  const Frame b = render(s);
+  EXPECT_EQ(a.color, b.color);
+  EXPECT_EQ(a.depth, b.depth);
+  EXPECT_EQ(a.id, b.id);
+}
+
+// Restores the hooks whatever the test does.
+struct HookGuard {
+  HookGuard() = default;
+  HookGuard(const HookGuard&) = delete;
+  HookGuard& operator=(const HookGuard&) = delete;
+  ~HookGuard() { gl::testing::hooks() = gl::testing::Hooks{}; }
+};
+
+TEST_F(GlBackend, ShaderCompileErrorSurfacesTheLog) {
+  HookGuard guard;
+  gl::testing::hooks().fragment_shader =
+      "#version 330 core\nout vec4 c;\nvoid main() { c = vec4(undeclared_thing_42); }\n";
+  Scene s = orthoScene(4, 4);
+  s.name = "gltest/broken-shader";
+  try {
+    render(s);
+    FAIL() << "a broken shader rendered";
+  } catch (const BackendError& e) {
+    const std::string msg = e.what();
+    EXPECT_THAT(msg, HasSubstr("gltest/broken-shader: " + toString(spec()) + ": "));
+    EXPECT_THAT(msg, HasSubstr("fragment shader does not compile"));
+    EXPECT_THAT(msg, HasSubstr("undeclared_thing_42"));  // the compiler's own log
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line";
+  }
+  // The real program still works afterwards.
+  gl::testing::hooks() = gl::testing::Hooks{};
+  EXPECT_NO_THROW(render(s));
+}
+
+TEST_F(GlBackend, GlErrorIsReportedWithItsStage) {
+  HookGuard guard;
+  gl::testing::hooks().gl_error_after_upload = true;
+  Scene s = orthoScene(4, 4);
+  s.name = "gltest/gl-error";
+  try {
+    render(s);
+    FAIL() << "an invalid GL call went unnoticed";
+  } catch (const BackendError& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("GL error GL_INVALID_ENUM after upload"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("gltest/gl-error: "));
+  }
+  gl::testing::hooks() = gl::testing::Hooks{};
+  EXPECT_NO_THROW(render(s));  // the error does not leak into the next call
+}
+
+// Death tests run in a fresh process ("threadsafe" style re-executes the binary), which
+// is what these need: the driver is chosen by the first context of a process.
+class GlProcess : public GlTest {
+ protected:
+  void SetUp() override {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    // The child re-runs SetUp; probing there would load the process spec's driver
+    // before the statement under test picks one.
+    if (GTEST_FLAG_GET(internal_run_death_test).empty()) GlTest::SetUp();
+  }
+  static std::string platformPrefix() {
+    return spec().platform == GlSpec::Platform::OSMesa ? "gl:osmesa:" : "gl:egl:";
+  }
+};
+
+[[noreturn]] void renderAndExit(const GlSpec& sp) {
+  try {
+    renderGl(orthoScene(2, 2), sp);
+    std::_Exit(0);
+  } catch (const BackendError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    std::_Exit(3);
+  }
+}
+
+TEST_F(GlProcess, SubstitutedDriverIsABackendError) {
+  if (spec().platform == GlSpec::Platform::EglDevice) GTEST_SKIP() << "no Gallium driver choice";
+  EXPECT_EXIT(
+      {
+        gl::testing::hooks().gallium_driver = "llvmpipe";           // Mesa loads llvmpipe...
+        renderAndExit(parseGlSpec(platformPrefix() + "softpipe"));  // ...softpipe was asked
+      },
+      ::testing::ExitedWithCode(3), "asked for softpipe, GL_RENDERER is llvmpipe");
+}
+
+TEST_F(GlProcess, SecondDriverInOneProcessIsRefused) {
+  if (spec().platform == GlSpec::Platform::EglDevice) GTEST_SKIP() << "no Gallium driver choice";
+  EXPECT_EXIT(
+      {
+        renderGl(orthoScene(2, 2), parseGlSpec(platformPrefix() + "llvmpipe"));
+        renderAndExit(parseGlSpec(platformPrefix() + "softpipe"));
+      },
+      ::testing::ExitedWithCode(3), "already loaded llvmpipe");
+}
+
+TEST_F(GlProcess, DefaultDriverIsWhatGalliumDriverSays) {
+  if (spec().platform == GlSpec::Platform::EglDevice) GTEST_SKIP() << "no Gallium driver choice";
+  EXPECT_EXIT(
+      {
+        setenv("GALLIUM_DRIVER", "softpipe", 1);
+        const Frame f =
+            renderGl(orthoScene(2, 2),
+                     parseGlSpec(spec().platform == GlSpec::Platform::OSMesa ? "gl:osmesa" : "gl"));
+        std::fprintf(stderr, "driver=%s\n", f.meta.at("driver").get<std::string>().c_str());
+        std::_Exit(0);
+      },
+      ::testing::ExitedWithCode(0), "driver=softpipe");
+}
+
+TEST_F(GlBackend, BadInputNeverCrashes) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  Scene s = orthoScene(8, 8);
+  s.ambient_light = glm::dvec3(1.0);
+  Material m;
+  m.ambient = {1, 1, 1};
+  s.materials.push_back(m);
+  Object nan_quad = quad(-2, -2, 2, 2, 0, 0);
+  nan_quad.mesh.positions[3].x = nan;  // only triangle (0, 2, 3) uses vertex 3
+  s.objects.push_back(nan_quad);
+  Object empty;
+  s.objects.push_back(empty);
+  Object degenerate;
+  degenerate.mesh.positions.assign(3, glm::vec3(0.1f, 0.1f, 0.0f));
+  degenerate.mesh.normals.assign(3, glm::vec3(0, 0, 1));
+  degenerate.mesh.triangles = {{0, 1, 2}};
+  s.objects.push_back(degenerate);
+  // Finite but far outside the view, behind the rest: GL's clipper must cope.
+  s.objects.push_back(quad(-1e30, -1e30, 1e30, 1e30, -0.9, 0));  // ids 4, 5
+  Object inf;
+  inf.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, std::numeric_limits<float>::infinity(), 0}};
+  inf.mesh.normals.assign(3, glm::vec3(0, 0, 1));
+  inf.mesh.triangles = {{0, 1, 2}};  // id 6
+  s.objects.push_back(inf);
+  const Frame f = render(s);
+  EXPECT_EQ(f.meta.at("skipped_triangles"), 2);  // the NaN triangle and the infinite one
+  const std::set<std::uint32_t> ids(f.id.begin(), f.id.end());
+  EXPECT_EQ(ids.count(1), 1u);                 // the finite half of the NaN quad
+  EXPECT_EQ(ids.count(2), 0u);                 // its NaN half
+  EXPECT_EQ(ids.count(3), 0u);                 // the degenerate triangle covers nothing
+  EXPECT_EQ(ids.count(4) + ids.count(5), 1u);  // the huge quad shows where id 2 is missing
+  EXPECT_EQ(ids.count(6), 0u);
+  for (float c : f.color) ASSERT_TRUE(std::isfinite(c));
+}
+
+TEST_F(GlBackend, TinyAndAbsurdSizes) {
+  Scene one = orthoScene(1, 1);
+  one.materials.push_back(Material{});
+  one.objects.push_back(quad(-2, -2, 2, 2, 0, 0));
+  const Frame f = render(one);
+  EXPECT_EQ(f.pixelCount(), 1u);
+  EXPECT_NE(f.id[0], 0u);
+
+  Scene absurd = orthoScene(1000000, 1000000);
+  absurd.name = "gltest/absurd";
+  try {
+    render(absurd);
+    FAIL() << "a 10^12-pixel frame rendered";
+  } catch (const BackendError& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("gltest/absurd: "));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("exceeds"));
+  }
+  EXPECT_THROW(render(orthoScene(0, 4)), InputError);
+  EXPECT_THROW(render(orthoScene(4, -1)), InputError);
+}
+
+TEST_F(GlBackend, InconsistentScenesAreInputErrors) {
+  Scene s = orthoScene(4, 4);
+  s.materials.push_back(Material{});
+  Object o = quad(-1, -1, 1, 1, 0, 0);
+  o.material = 7;
+  s.objects.push_back(o);
+  EXPECT_THROW(render(s), InputError);
+  s.objects[0].material = 0;
+  s.objects[0].mesh.triangles.push_back({0, 1, 9});
+  EXPECT_THROW(render(s), InputError);
+  s.objects[0].mesh.triangles.pop_back();
+  s.objects[0].mesh.normals.pop_back();
+  EXPECT_THROW(render(s), InputError);
+  s.objects[0].mesh.normals.emplace_back(0, 0, 1);
+  auto bad = std::make_shared<Texture>();
+  bad->width = 4;
+  bad->height = 4;  // but no texels
+  s.materials[0].texture = bad;
+  EXPECT_THROW(render(s), InputError);
+  s.materials[0].texture = nullptr;
+  EXPECT_NO_THROW(render(s));
+}
+
+}  // namespace
+}  // namespace rc::gltest
