@@ -1,0 +1,558 @@
+// The per-pixel comparison: see compare.h; formulas and their derivation in
+// docs/tolerances.md. One pass over the rows; the common pixel (same id, small errors)
+// takes a short branch-light path, everything unusual goes to out-of-line helpers.
+#include "compare/compare.h"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "fixtures/errors.h"
+
+namespace rc {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Round to nearest (ties to even) for |v| < 2^51 without calling libm: adding 1.5 * 2^52
+// leaves no fraction bits. Not folded away because we never build with fast-math.
+inline double roundNearest(double v) {
+  constexpr double kMagic = 6755399441055744.0;
+  return (v + kMagic) - kMagic;
+}
+
+inline bool isNonFinite(float f) {
+  return (std::bit_cast<std::uint32_t>(f) & 0x7f800000u) == 0x7f800000u;
+}
+
+std::string metaString(const Frame& f, const char* key) {
+  const auto it = f.meta.find(key);
+  return it != f.meta.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+std::string frameLabel(const Frame& f, const char* role) {
+  const std::string backend = metaString(f, "backend");
+  return backend.empty() ? std::string(role) : fmt::format("{} ({})", role, backend);
+}
+
+int subpixelBits(const Frame& f, const char* role) {
+  const auto it = f.meta.find("subpixel_bits");
+  if (it == f.meta.end() || it->is_null()) return 8;
+  if (!it->is_number_integer() || it->get<long long>() < 0 || it->get<long long>() > 24)
+    throw InputError(
+        fmt::format("{}: frame.json: subpixel_bits must be an integer in [0, 24], "
+                    "got {}",
+                    frameLabel(f, role), it->dump()));
+  return it->get<int>();
+}
+
+void checkBuffers(const Frame& f, const char* role, bool need_color) {
+  if (f.width < 0 || f.height < 0 || static_cast<long long>(f.width) * f.height > (1LL << 31))
+    throw InputError(
+        fmt::format("{}: unusable frame size {}x{}", frameLabel(f, role), f.width, f.height));
+  const std::size_t n = f.pixelCount();
+  if ((need_color && f.color.size() != n * 4) || f.depth.size() != n || f.id.size() != n)
+    throw InputError(fmt::format("{}: frame buffers do not match its size {}x{}",
+                                 frameLabel(f, role), f.width, f.height));
+  if (!f.edge_dist.empty() && f.edge_dist.size() != n)
+    throw InputError(fmt::format("{}: edge_dist does not match its size", frameLabel(f, role)));
+  if (!f.depth_gap.empty() && f.depth_gap.size() != n)
+    throw InputError(fmt::format("{}: depth_gap does not match its size", frameLabel(f, role)));
+}
+
+// Counts NaN and Inf per channel in one row; a cheap vectorisable scan first, since
+// almost every row has none.
+bool countRowNonFinite(const float* color, const float* depth, int width, NonFiniteCounts& counts) {
+  unsigned bad = 0;
+  for (int k = 0; k < width * 4; ++k) bad += isNonFinite(color[k]) ? 1u : 0u;
+  for (int k = 0; k < width; ++k) bad += isNonFinite(depth[k]) ? 1u : 0u;
+  if (bad == 0) return false;
+  auto tally = [&](float v, int channel) {
+    if (std::isnan(v))
+      ++counts.nan[channel];
+    else if (std::isinf(v))
+      ++counts.inf[channel];
+  };
+  for (int x = 0; x < width; ++x) {
+    for (int c = 0; c < 4; ++c) tally(color[x * 4 + c], c);
+    tally(depth[x], 4);
+  }
+  return true;
+}
+
+class Comparator {
+ public:
+  Comparator(const Frame& e, const Frame& a, const Frame& u, const Tolerances& tol, PairResult& r)
+      : e_(e), a_(a), u_(u), tol_(tol), r_(r) {
+    step_scale_ = depthStepsPerUnit(tol.depth_format);
+    quantized_depth_ = tol.depth_format != DepthFormat::D32F;
+    quantized_color_ = tol.color_format == ColorFormat::RGBA8;
+    have_uncertainty_ = u.hasUncertainty();
+    band_ = r.visibility.band_px;
+    r_.depth.histogram = ErrorHistogram(quantized_depth_ ? 1.0 : 1.0 / 64.0, quantized_depth_);
+    r_.shading.histogram = ErrorHistogram(quantized_color_ ? 1.0 : 1.0 / 64.0, quantized_color_);
+  }
+
+  void run(ClassMaps* maps) {
+    if (maps) {
+      const std::size_t n = e_.pixelCount();
+      maps->width = e_.width;
+      maps->height = e_.height;
+      maps->pixel_class.assign(n, PixelClass::Background);
+      maps->depth_steps.assign(n, 0.0f);
+      maps->depth_tolerance.assign(n, 0.0f);
+      maps->shading_abs.assign(n, 0.0f);
+      maps->delta_rgba.assign(n * 4, 0.0f);
+    }
+    for (int y = 0; y < e_.height; ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * e_.width;
+      const bool bad_e =
+          countRowNonFinite(&e_.color[row * 4], &e_.depth[row], e_.width, r_.nonfinite_expected);
+      const bool bad_a =
+          countRowNonFinite(&a_.color[row * 4], &a_.depth[row], a_.width, r_.nonfinite_actual);
+      const bool finite = !bad_e && !bad_a;
+      if (maps) {
+        finite ? runRow<true, true>(y, maps) : runRow<true, false>(y, maps);
+      } else {
+        finite ? runRow<false, true>(y, maps) : runRow<false, false>(y, maps);
+      }
+    }
+    finish();
+  }
+
+ private:
+  double depthSteps(float z) const {
+    const double s = static_cast<double>(z) * step_scale_;
+    return quantized_depth_ ? roundNearest(s) : s;
+  }
+
+  template <bool kMaps, bool kRowFinite>
+  void runRow(int y, ClassMaps* maps) {
+    const int w = e_.width;
+    const std::size_t row = static_cast<std::size_t>(y) * w;
+    const std::uint32_t* ida = &e_.id[row];
+    const std::uint32_t* idb = &a_.id[row];
+    const float* za = &e_.depth[row];
+    const float* zb = &a_.depth[row];
+    const float* ca = &e_.color[row * 4];
+    const float* cb = &a_.color[row * 4];
+    const float depth_warn = static_cast<float>(tol_.depth.warn);
+    const float shade_warn = static_cast<float>(tol_.shading.warn);
+    const float shade_fail = static_cast<float>(tol_.shading.fail);
+    double shade_sum = 0.0;
+    double shade_sq = 0.0;
+    double depth_sum = 0.0;
+    for (int x = 0; x < w; ++x) {
+      const std::uint32_t a = ida[x];
+      const std::uint32_t b = idb[x];
+      const std::size_t i = row + x;
+      if (kMaps) {
+        for (int c = 0; c < 4; ++c)
+          maps->delta_rgba[i * 4 + c] = (cb[x * 4 + c] - ca[x * 4 + c]) * 255.0f;
+      }
+      if (a != b) {
+        const PixelClass cls = classifyMismatch(x, y, a, b);
+        if (kMaps) maps->pixel_class[i] = cls;
+        continue;
+      }
+      if (a == 0) continue;  // background on both sides
+      ++vis_match_;
+      if (kMaps) maps->pixel_class[i] = PixelClass::Match;
+
+      // Depth.
+      if (!kRowFinite && (isNonFinite(za[x]) || isNonFinite(zb[x]))) {
+        depthNonFinite(x, y);
+        if (kMaps) {
+          maps->depth_steps[i] = std::numeric_limits<float>::quiet_NaN();
+          maps->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allowance(x, y));
+        }
+      } else {
+        const double dz = std::fabs(depthSteps(za[x]) - depthSteps(zb[x]));
+        depth_sum += dz;
+        r_.depth.histogram.add(dz);
+        if (dz > depth_max_) {
+          depth_max_ = dz;
+          depth_max_at_ = i;
+        }
+        if (dz > depth_warn) depthOverBase(x, y, dz);
+        if (kMaps) {
+          maps->depth_steps[i] = static_cast<float>(dz);
+          maps->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allowance(x, y));
+        }
+      }
+
+      // Shading.
+      const float* pa = ca + x * 4;
+      const float* pb = cb + x * 4;
+      if (!kRowFinite &&
+          (isNonFinite(pa[0]) || isNonFinite(pa[1]) || isNonFinite(pa[2]) || isNonFinite(pa[3]) ||
+           isNonFinite(pb[0]) || isNonFinite(pb[1]) || isNonFinite(pb[2]) || isNonFinite(pb[3]))) {
+        shadingNonFinite(i);
+        if (kMaps) maps->shading_abs[i] = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      float d[4];
+      if (quantized_color_) {
+        for (int c = 0; c < 4; ++c)
+          d[c] = static_cast<float>(
+              std::fabs(roundNearest(pa[c] * 255.0) - roundNearest(pb[c] * 255.0)));
+      } else {
+        for (int c = 0; c < 4; ++c) d[c] = std::fabs(pa[c] - pb[c]) * 255.0f;
+      }
+      const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
+      shade_sum += (d[0] + d[1]) + (d[2] + d[3]);
+      shade_sq += (d[0] * d[0] + d[1] * d[1]) + (d[2] * d[2] + d[3] * d[3]);
+      for (int c = 0; c < 4; ++c) shade_max_rgba_[c] = std::max(shade_max_rgba_[c], d[c]);
+      r_.shading.histogram.add(e);
+      if (e > shade_max_) {
+        shade_max_ = e;
+        shade_max_at_ = i;
+      }
+      if (e > shade_warn) {
+        ++r_.shading.over_tolerance;
+        if (e > shade_fail) ++r_.shading.over_fail;
+      }
+      if (kMaps) maps->shading_abs[i] = e;
+    }
+    shade_sum_ += shade_sum;
+    shade_sq_ += shade_sq;
+    depth_sum_ += depth_sum;
+  }
+
+  // Local depth slope of the uncertainty frame at (x, y) in steps/px, from same-id
+  // neighbours: per axis the larger one-sided difference at distance 1, else at distance
+  // 2 (halved); an axis with neither borrows the other's. nullopt when neither axis has.
+  std::optional<double> slope(int x, int y) const {
+    const std::size_t i = u_.index(x, y);
+    const std::uint32_t id = u_.id[i];
+    if (id == 0 || isNonFinite(u_.depth[i])) return std::nullopt;
+    const double z0 = depthSteps(u_.depth[i]);
+    auto axis = [&](int dx, int dy) -> std::optional<double> {
+      for (int dist = 1; dist <= 2; ++dist) {
+        std::optional<double> g;
+        for (int sign : {-1, 1}) {
+          const int nx = x + sign * dist * dx;
+          const int ny = y + sign * dist * dy;
+          if (nx < 0 || ny < 0 || nx >= u_.width || ny >= u_.height) continue;
+          const std::size_t j = u_.index(nx, ny);
+          if (u_.id[j] != id || isNonFinite(u_.depth[j])) continue;
+          const double diff = std::fabs(depthSteps(u_.depth[j]) - z0) / dist;
+          g = std::max(g.value_or(0.0), diff);
+        }
+        if (g) return g;
+      }
+      return std::nullopt;
+    };
+    std::optional<double> gx = axis(1, 0);
+    std::optional<double> gy = axis(0, 1);
+    if (!gx && !gy) return std::nullopt;
+    if (!gx) gx = gy;
+    if (!gy) gy = gx;
+    return std::hypot(*gx, *gy);
+  }
+
+  // Steps a triangle's stored depth may move at (x, y) when its vertices move by the band.
+  double allowance(int x, int y) {
+    const std::optional<double> s = slope(x, y);
+    if (!s) return 0.0;
+    r_.depth.max_slope = std::max(r_.depth.max_slope, *s);
+    return tol_.depth_slope_factor * *s * band_;
+  }
+
+  __attribute__((noinline)) void depthOverBase(int x, int y, double dz) {
+    const std::optional<double> s = slope(x, y);
+    if (!s) ++r_.depth.slope_unknown;
+    const double allow = s ? tol_.depth_slope_factor * *s * band_ : 0.0;
+    if (s) r_.depth.max_slope = std::max(r_.depth.max_slope, *s);
+    const double excess = dz - (tol_.depth.warn + allow);
+    if (excess <= 0.0) return;
+    ++r_.depth.over_tolerance;
+    if (dz > tol_.depth.fail + allow) ++r_.depth.over_fail;
+    if (!depth_over_any_ || excess > depth_worst_excess_) {
+      depth_over_any_ = true;
+      depth_worst_excess_ = excess;
+      depth_worst_at_ = e_.index(x, y);
+      depth_worst_allow_ = allow;
+    }
+  }
+
+  __attribute__((noinline)) void depthNonFinite(int x, int y) {
+    ++r_.depth.nonfinite;
+    ++r_.depth.over_tolerance;
+    ++r_.depth.over_fail;
+    if (!depth_over_any_ || depth_worst_excess_ < kInf) {
+      depth_over_any_ = true;
+      depth_worst_excess_ = kInf;
+      depth_worst_at_ = e_.index(x, y);
+      depth_worst_allow_ = 0.0;
+    }
+  }
+
+  __attribute__((noinline)) void shadingNonFinite(std::size_t i) {
+    if (r_.shading.nonfinite++ == 0) shade_nonfinite_at_ = i;
+    ++r_.shading.over_tolerance;
+    ++r_.shading.over_fail;
+  }
+
+  __attribute__((noinline)) PixelClass classifyMismatch(int x, int y, std::uint32_t a,
+                                                        std::uint32_t b) {
+    const std::size_t i = e_.index(x, y);
+    const double edge = have_uncertainty_ ? static_cast<double>(u_.edge_dist[i]) : kInf;
+    bool ambiguous = edge <= band_;  // false for NaN
+    if (!ambiguous && a != 0 && b != 0 && have_uncertainty_) {
+      // Each surface's stored depth may be off by its tolerance; the two are assumed to
+      // share the local slope (they are nearly coplanar where they tie).
+      const double gap = u_.depth_gap[i];
+      if (gap <= 2.0 * (tol_.depth.fail + allowance(x, y))) {
+        ambiguous = true;
+        ++r_.visibility.ambiguous_by_depth_gap;
+      }
+    }
+    PixelClass cls;
+    if (b == 0)
+      cls = ambiguous ? PixelClass::MissingAmbiguous : PixelClass::MissingHard;
+    else if (a == 0)
+      cls = ambiguous ? PixelClass::ExtraAmbiguous : PixelClass::ExtraHard;
+    else
+      cls = ambiguous ? PixelClass::WrongAmbiguous : PixelClass::WrongHard;
+    ++class_counts_[static_cast<int>(cls)];
+    if (!ambiguous) {
+      const double rank = std::isnan(edge) ? -1.0 : edge;
+      if (!vis_worst_any_ || rank > vis_worst_edge_) {
+        vis_worst_any_ = true;
+        vis_worst_edge_ = rank;
+        r_.visibility.worst = {x, y};
+        r_.visibility.worst_edge_dist = edge;
+      }
+    }
+    return cls;
+  }
+
+  PixelRef pixelAt(std::size_t i) const {
+    return {static_cast<int>(i % e_.width), static_cast<int>(i / e_.width)};
+  }
+
+  void finish() {
+    VisibilityStats& v = r_.visibility;
+    auto count = [&](PixelClass c) { return class_counts_[static_cast<int>(c)]; };
+    v.missing = count(PixelClass::MissingAmbiguous) + count(PixelClass::MissingHard);
+    v.extra = count(PixelClass::ExtraAmbiguous) + count(PixelClass::ExtraHard);
+    v.wrong_primitive = count(PixelClass::WrongAmbiguous) + count(PixelClass::WrongHard);
+    v.missing_hard = count(PixelClass::MissingHard);
+    v.extra_hard = count(PixelClass::ExtraHard);
+    v.wrong_primitive_hard = count(PixelClass::WrongHard);
+    v.hard = v.missing_hard + v.extra_hard + v.wrong_primitive_hard;
+    v.mismatched = v.missing + v.extra + v.wrong_primitive;
+    v.ambiguous = v.mismatched - v.hard;
+    v.uncertainty_available = have_uncertainty_;
+    v.status = tol_.visibility.verdict(static_cast<double>(v.hard));
+
+    DepthStats& d = r_.depth;
+    d.compared = vis_match_;
+    const std::uint64_t depth_finite = d.compared - d.nonfinite;
+    d.max_steps = depth_max_;
+    d.mean_steps = depth_finite ? depth_sum_ / static_cast<double>(depth_finite) : 0.0;
+    d.p99_steps = d.histogram.percentile(0.99, depth_max_);
+    if (depth_over_any_) {
+      d.worst = pixelAt(depth_worst_at_);
+      d.worst_allowance = depth_worst_allow_;
+      d.worst_steps = std::isinf(depth_worst_excess_)
+                          ? std::numeric_limits<double>::quiet_NaN()
+                          : depth_worst_excess_ + tol_.depth.warn + depth_worst_allow_;
+    } else if (depth_max_ > 0.0) {  // all equal: no worst pixel
+      d.worst = pixelAt(depth_max_at_);
+      d.worst_steps = depth_max_;
+      const PixelRef p = d.worst;
+      const std::optional<double> s = slope(p.x, p.y);
+      d.worst_allowance = s ? tol_.depth_slope_factor * *s * band_ : 0.0;
+    }
+    d.status = d.over_fail ? Status::Fail : d.over_tolerance ? Status::Warn : Status::Pass;
+
+    ShadingStats& s = r_.shading;
+    s.compared = vis_match_;
+    const std::uint64_t shade_finite = s.compared - s.nonfinite;
+    s.max_abs = shade_max_;
+    for (int c = 0; c < 4; ++c) s.max_abs_rgba[c] = shade_max_rgba_[c];
+    if (shade_finite > 0) {
+      const double values = 4.0 * static_cast<double>(shade_finite);
+      s.mean_abs = shade_sum_ / values;
+      s.rmse = std::sqrt(shade_sq_ / values);
+      if (s.rmse > 0.0) s.psnr_db = 20.0 * std::log10(255.0 / s.rmse);
+    }
+    s.p99_abs = s.histogram.percentile(0.99, shade_max_);
+    if (s.nonfinite > 0)
+      s.worst = pixelAt(shade_nonfinite_at_);
+    else if (shade_max_ > 0.0f)
+      s.worst = pixelAt(shade_max_at_);
+    s.status = s.over_fail ? Status::Fail : s.over_tolerance ? Status::Warn : Status::Pass;
+
+    r_.status = worse(v.status, worse(d.status, s.status));
+  }
+
+  const Frame& e_;
+  const Frame& a_;
+  const Frame& u_;
+  const Tolerances& tol_;
+  PairResult& r_;
+  double step_scale_ = 1.0;
+  bool quantized_depth_ = true;
+  bool quantized_color_ = false;
+  bool have_uncertainty_ = false;
+  double band_ = 0.0;
+
+  std::uint64_t class_counts_[kPixelClassCount] = {};
+  std::uint64_t vis_match_ = 0;
+  bool vis_worst_any_ = false;
+  double vis_worst_edge_ = 0.0;
+
+  double depth_sum_ = 0.0;
+  double depth_max_ = 0.0;
+  std::size_t depth_max_at_ = 0;
+  bool depth_over_any_ = false;
+  double depth_worst_excess_ = 0.0;
+  std::size_t depth_worst_at_ = 0;
+  double depth_worst_allow_ = 0.0;
+
+  double shade_sum_ = 0.0;
+  double shade_sq_ = 0.0;
+  float shade_max_ = 0.0f;
+  std::size_t shade_max_at_ = 0;
+  std::size_t shade_nonfinite_at_ = 0;
+  float shade_max_rgba_[4] = {};
+};
+
+}  // namespace
+
+const char* toString(PixelClass c) {
+  switch (c) {
+    case PixelClass::Background:
+      return "background";
+    case PixelClass::Match:
+      return "match";
+    case PixelClass::MissingAmbiguous:
+      return "missing (ambiguous)";
+    case PixelClass::MissingHard:
+      return "missing";
+    case PixelClass::ExtraAmbiguous:
+      return "extra (ambiguous)";
+    case PixelClass::ExtraHard:
+      return "extra";
+    case PixelClass::WrongAmbiguous:
+      return "wrong_primitive (ambiguous)";
+    case PixelClass::WrongHard:
+      return "wrong_primitive";
+  }
+  return "?";
+}
+
+std::uint64_t NonFiniteCounts::total() const {
+  std::uint64_t t = 0;
+  for (std::size_t c = 0; c < nan.size(); ++c) t += nan[c] + inf[c];
+  return t;
+}
+
+PairResult errorResult(std::string fixture, std::string expected, std::string actual,
+                       std::string message) {
+  PairResult r;
+  r.fixture = std::move(fixture);
+  r.expected = std::move(expected);
+  r.actual = std::move(actual);
+  r.status = Status::Error;
+  r.error = std::move(message);
+  return r;
+}
+
+PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                         const Tolerances& tolerances, ClassMaps* maps) {
+  const auto start = std::chrono::steady_clock::now();
+  checkBuffers(expected, "expected", true);
+  checkBuffers(actual, "actual", true);
+  const bool separate_uncertainty = &uncertainty != &expected;
+  if (separate_uncertainty) checkBuffers(uncertainty, "uncertainty", false);
+  if (expected.width != actual.width || expected.height != actual.height)
+    throw InputError(fmt::format("frames differ in size: {} is {}x{}, {} is {}x{}",
+                                 frameLabel(expected, "expected"), expected.width, expected.height,
+                                 frameLabel(actual, "actual"), actual.width, actual.height));
+  if (uncertainty.width != expected.width || uncertainty.height != expected.height)
+    throw InputError(fmt::format("frames differ in size: {} is {}x{}, {} is {}x{}",
+                                 frameLabel(expected, "expected"), expected.width, expected.height,
+                                 frameLabel(uncertainty, "uncertainty"), uncertainty.width,
+                                 uncertainty.height));
+
+  PairResult r;
+  r.fixture = metaString(expected, "fixture");
+  if (r.fixture.empty()) r.fixture = metaString(actual, "fixture");
+  r.expected = metaString(expected, "backend");
+  r.actual = metaString(actual, "backend");
+  r.width = expected.width;
+  r.height = expected.height;
+  r.pixels = expected.pixelCount();
+  r.expected_subpixel_bits = subpixelBits(expected, "expected");
+  r.actual_subpixel_bits = subpixelBits(actual, "actual");
+  r.tolerances = tolerances;
+  BandInputs band;
+  band.expected_bits = r.expected_subpixel_bits;
+  band.actual_bits = r.actual_subpixel_bits;
+  band.uncertainty_bits =
+      separate_uncertainty ? subpixelBits(uncertainty, "uncertainty") : r.expected_subpixel_bits;
+  band.uncertainty_is_expected = !separate_uncertainty;
+  band.width = expected.width;
+  band.height = expected.height;
+  r.visibility.band_px = snapBandPx(tolerances, band);
+
+  Comparator(expected, actual, uncertainty, tolerances, r).run(maps);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual) {
+  auto format = [](const Frame& f, const char* key, const char* role) {
+    std::string v = metaString(f, key);
+    if (v.empty() && f.meta.contains(key))
+      throw InputError(
+          fmt::format("{}: frame.json: {} must be a string", frameLabel(f, role), key));
+    return v;
+  };
+  const std::string de = format(expected, "depth_format", "expected");
+  const std::string da = format(actual, "depth_format", "actual");
+  const std::string ce = format(expected, "color_format", "expected");
+  const std::string ca = format(actual, "color_format", "actual");
+  if (!de.empty() && !da.empty() && de != da)
+    throw InputError(fmt::format("{} has depth_format {}, {} has {}",
+                                 frameLabel(expected, "expected"), de, frameLabel(actual, "actual"),
+                                 da));
+  if (!ce.empty() && !ca.empty() && ce != ca)
+    throw InputError(fmt::format("{} has color_format {}, {} has {}",
+                                 frameLabel(expected, "expected"), ce, frameLabel(actual, "actual"),
+                                 ca));
+  const std::string depth = de.empty() ? da : de;
+  const std::string color = ce.empty() ? ca : ce;
+  DepthFormat df = DepthFormat::D24;
+  if (depth == "d16")
+    df = DepthFormat::D16;
+  else if (depth == "d32f")
+    df = DepthFormat::D32F;
+  else if (!depth.empty() && depth != "d24")
+    throw InputError(fmt::format("frame.json: unknown depth_format '{}'", depth));
+  ColorFormat cf = ColorFormat::RGBA32F;
+  if (color == "rgba8")
+    cf = ColorFormat::RGBA8;
+  else if (!color.empty() && color != "rgba32f")
+    throw InputError(fmt::format("frame.json: unknown color_format '{}'", color));
+  return defaultTolerances(df, cf);
+}
+
+void checkSameSize(const Frame& expected, const Frame& actual,
+                   const std::filesystem::path& expected_dir,
+                   const std::filesystem::path& actual_dir) {
+  if (expected.width != actual.width || expected.height != actual.height)
+    throw InputError(fmt::format("{} ({}x{}) and {} ({}x{}) differ in size", expected_dir.string(),
+                                 expected.width, expected.height, actual_dir.string(), actual.width,
+                                 actual.height));
+}
+
+}  // namespace rc

@@ -1,0 +1,164 @@
+// The comparator: for two frames of one fixture, says pixel by pixel what differs and
+// why (visibility, depth, shading), separates legal differences from errors using the
+// reference's uncertainty channels, and gives each class and the pair a verdict.
+// It does not read or write files (see frame_io.h, pair_images.h, report.h) and does not
+// render; the classes and numbers are those of ../shared/DESIGN.md "The comparison".
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compare/histogram.h"
+#include "compare/tolerances.h"
+#include "fixtures/frame.h"
+
+namespace rc {
+
+// Per-pixel visibility class (a = expected id, b = actual id). The codes are stored in
+// ClassMaps and in diff.exr's id_class channel.
+enum class PixelClass : std::uint8_t {
+  Background = 0,        // a = b = 0
+  Match = 1,             // a = b != 0: depth and shading are compared here
+  MissingAmbiguous = 2,  // a != 0, b = 0, within the band
+  MissingHard = 3,
+  ExtraAmbiguous = 4,  // a = 0, b != 0
+  ExtraHard = 5,
+  WrongAmbiguous = 6,  // a, b != 0, a != b: within the band or a depth tie
+  WrongHard = 7,
+};
+inline constexpr int kPixelClassCount = 8;
+const char* toString(PixelClass c);
+
+// A pixel in image coordinates (origin top-left, y down); x = -1 when there is none.
+// Reports add the GL window coordinate [x, height - 1 - y].
+struct PixelRef {
+  int x = -1;
+  int y = -1;
+  bool valid() const { return x >= 0; }
+};
+
+struct VisibilityStats {
+  Status status = Status::Pass;
+  std::uint64_t mismatched = 0;  // = missing + extra + wrong_primitive = ambiguous + hard
+  std::uint64_t ambiguous = 0;
+  std::uint64_t hard = 0;
+  std::uint64_t missing = 0;
+  std::uint64_t extra = 0;
+  std::uint64_t wrong_primitive = 0;
+  std::uint64_t missing_hard = 0;
+  std::uint64_t extra_hard = 0;
+  std::uint64_t wrong_primitive_hard = 0;
+  std::uint64_t ambiguous_by_depth_gap = 0;  // wrong_primitive excused only by depth_gap
+  double band_px = 0.0;                      // edge_dist at or below this is ambiguous
+  bool uncertainty_available = false;        // false: no edge_dist/depth_gap, all are hard
+  PixelRef worst;                // the hard mismatch farthest from any edge (first on ties)
+  double worst_edge_dist = 0.0;  // its edge_dist (1 = capped; +inf without uncertainty)
+};
+
+struct DepthStats {
+  Status status = Status::Pass;
+  std::uint64_t compared = 0;  // pixels with a = b != 0 (including non-finite ones)
+  double max_steps = 0.0;      // over finite pixels
+  double mean_steps = 0.0;
+  double p99_steps = 0.0;
+  std::uint64_t over_tolerance = 0;  // |dZ| > warn + allowance (non-finite pixels count)
+  std::uint64_t over_fail = 0;       // |dZ| > fail + allowance (non-finite pixels count)
+  std::uint64_t nonfinite = 0;       // Z NaN or Inf on either side
+  std::uint64_t slope_unknown = 0;   // pixels over the base threshold whose slope is unknown
+  // The pixel furthest over its tolerance when any is over, else the largest error; none
+  // when every compared depth is equal.
+  PixelRef worst;
+  double worst_steps = 0.0;
+  double worst_allowance = 0.0;  // the slope allowance there (steps)
+  double max_slope = 0.0;        // largest local slope met while checking pixels (steps/px)
+  ErrorHistogram histogram{1.0, true};
+};
+
+struct ShadingStats {
+  Status status = Status::Pass;
+  std::uint64_t compared = 0;  // pixels with a = b != 0 (including non-finite ones)
+  double max_abs = 0.0;        // 8-bit units, over finite pixels and the four channels
+  double mean_abs = 0.0;       // over finite pixels and the four channels
+  double rmse = 0.0;
+  std::optional<double> psnr_db;     // 20 log10(255 / rmse); none when rmse = 0 (identical)
+  double p99_abs = 0.0;              // of the per-pixel error (largest channel)
+  std::uint64_t over_tolerance = 0;  // per-pixel error > warn (non-finite pixels count)
+  std::uint64_t over_fail = 0;       // per-pixel error > fail (non-finite pixels count)
+  std::uint64_t nonfinite = 0;       // a colour channel NaN or Inf on either side
+  std::array<double, 4> max_abs_rgba{};
+  PixelRef worst;  // largest per-pixel error (first on ties); none when all are equal
+  ErrorHistogram histogram{1.0 / 64.0, false};
+};
+
+// NaN and Inf counts of one frame, per channel R G B A Z, over every pixel.
+struct NonFiniteCounts {
+  std::array<std::uint64_t, 5> nan{};
+  std::array<std::uint64_t, 5> inf{};
+  std::uint64_t total() const;
+};
+inline constexpr std::array<const char*, 5> kFrameChannels = {"R", "G", "B", "A", "Z"};
+
+struct PairResult {
+  std::string fixture;
+  std::string expected;  // backend specs, e.g. "ref", "gl:egl:llvmpipe"
+  std::string actual;
+  Status status = Status::Pass;
+  std::string error;  // status Error: why the pair could not be compared
+  int width = 0;
+  int height = 0;
+  std::uint64_t pixels = 0;
+  int expected_subpixel_bits = 8;
+  int actual_subpixel_bits = 8;
+  Tolerances tolerances;  // the ones in effect
+  VisibilityStats visibility;
+  DepthStats depth;
+  ShadingStats shading;
+  NonFiniteCounts nonfinite_expected;
+  NonFiniteCounts nonfinite_actual;
+  // Files written by writePairImages, by kind: expected, actual, visibility, depth_heat,
+  // shading_heat, diff_exr. Reports print them relative to the report folder.
+  std::map<std::string, std::filesystem::path> images;
+  double depth_heat_scale = 0.0;    // steps that map to the top of depth_heat's colour map
+  double shading_heat_scale = 0.0;  // 8-bit units that map to the top of shading_heat's
+  double seconds = 0.0;             // time the comparison took
+};
+
+// A report row for a pair that could not be compared (e.g. the backend did not start).
+PairResult errorResult(std::string fixture, std::string expected, std::string actual,
+                       std::string message);
+
+// Per-pixel results, for images and diff.exr. Index y * width + x (image coordinates).
+struct ClassMaps {
+  int width = 0;
+  int height = 0;
+  std::vector<PixelClass> pixel_class;
+  std::vector<float> depth_steps;      // |dZ| in steps where compared (NaN: non-finite), else 0
+  std::vector<float> depth_tolerance;  // warn + slope allowance where compared, else 0
+  std::vector<float> shading_abs;      // largest channel error where compared (NaN: non-finite)
+  std::vector<float> delta_rgba;       // (actual - expected) * 255 per channel, 4 per pixel
+};
+
+// Compares `actual` with `expected`. `uncertainty` is the reference frame whose
+// edge_dist/depth_gap and Z classify the pair: usually `expected` itself (pass the same
+// object), or the reference render of the same fixture when both sides are GL drivers.
+// Without uncertainty channels every mismatch is hard. Subpixel bits come from each
+// frame's meta["subpixel_bits"] (8 when absent). Throws InputError when sizes differ or
+// a frame's buffers do not match its size.
+PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                         const Tolerances& tolerances, ClassMaps* maps = nullptr);
+
+// The defaults for a pair, from the frames' meta depth_format/color_format (d24 and
+// rgba32f when absent). Throws InputError when the two frames name different formats.
+Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual);
+
+// Throws InputError naming both directories when the frames differ in size.
+void checkSameSize(const Frame& expected, const Frame& actual,
+                   const std::filesystem::path& expected_dir,
+                   const std::filesystem::path& actual_dir);
+
+}  // namespace rc

@@ -1,0 +1,205 @@
+// Per-pair error images: see pair_images.h. Heat maps go through OpenImageIO's
+// color_map so they use a perceptually uniform map people already know from idiff/oiiotool.
+#include "compare/pair_images.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+
+#include "compare/atomic_file.h"
+#include "fixtures/errors.h"
+#include "fixtures/frame_io.h"
+
+namespace rc {
+namespace fs = std::filesystem;
+namespace {
+
+using OIIO::ImageBuf;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+void writeImage(const fs::path& file, const ImageSpec& spec, TypeDesc format, const void* data,
+                const fs::path& target) {
+  auto out = OIIO::ImageOutput::create(file.string());
+  if (!out || !out->open(file.string(), spec) || !out->write_image(format, data) || !out->close())
+    throw InputError(fmt::format("{}: cannot write: {}", target.string(),
+                                 out ? out->geterror() : OIIO::geterror()));
+}
+
+void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_t>& rgb,
+               const fs::path& target) {
+  writeImage(file, ImageSpec(w, h, 3, TypeDesc::UINT8), TypeDesc::UINT8, rgb.data(), target);
+}
+
+float luminance(const float* c) {
+  const float l = 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+  return std::isfinite(l) ? std::clamp(l, 0.0f, 1.0f) : 0.0f;
+}
+
+// Colours `values` (NaN = non-finite) of compared pixels through the heat colour map.
+std::vector<std::uint8_t> heatImage(const ClassMaps& maps, const std::vector<float>& values,
+                                    double scale) {
+  const int w = maps.width;
+  const int h = maps.height;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  std::vector<float> position(n, 0.0f);
+  for (std::size_t i = 0; i < n; ++i) position[i] = heatPosition(values[i], scale);
+  ImageBuf src(ImageSpec(w, h, 1, TypeDesc::FLOAT), position.data());
+  ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, kHeatColorMap);
+  std::vector<float> rgb(n * 3, 0.0f);
+  if (mapped.has_error() || !mapped.get_pixels(mapped.roi(), TypeDesc::FLOAT, rgb.data()))
+    throw InputError(fmt::format("color map '{}' failed: {}", kHeatColorMap, mapped.geterror()));
+  std::vector<std::uint8_t> out(n * 3);
+  for (std::size_t i = 0; i < n; ++i) {
+    Rgb8 px;
+    if (maps.pixel_class[i] != PixelClass::Match) {
+      px = kNotComparedColor;
+    } else if (std::isnan(values[i])) {
+      px = kNonFiniteColor;
+    } else {
+      for (int c = 0; c < 3; ++c)
+        px[c] =
+            static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
+    }
+    std::copy(px.begin(), px.end(), out.begin() + static_cast<std::ptrdiff_t>(i * 3));
+  }
+  return out;
+}
+
+std::string safeName(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                    (ch >= '0' && ch <= '9') || ch == '.' || ch == '_' || ch == '-';
+    out += ok ? ch : '_';
+  }
+  if (out.empty() || out == "." || out == "..") out = "_" + out;
+  return out;
+}
+
+}  // namespace
+
+Rgb8 classColor(PixelClass c) {
+  switch (c) {
+    case PixelClass::Background:
+      return {0, 0, 0};
+    case PixelClass::Match:
+      return {96, 96, 96};
+    case PixelClass::MissingAmbiguous:
+      return {255, 170, 170};
+    case PixelClass::MissingHard:
+      return {230, 20, 20};
+    case PixelClass::ExtraAmbiguous:
+      return {160, 200, 255};
+    case PixelClass::ExtraHard:
+      return {30, 110, 255};
+    case PixelClass::WrongAmbiguous:
+      return {255, 240, 150};
+    case PixelClass::WrongHard:
+      return {255, 200, 0};
+  }
+  return {255, 0, 255};
+}
+
+float heatPosition(float value, double scale) {
+  if (!(value > 0.0f)) return 0.0f;  // zero and NaN
+  const double t = std::log2(1.0 + value) / std::log2(1.0 + std::max(scale, 1e-12));
+  return static_cast<float>(std::clamp(t, 0.0, 1.0));
+}
+
+std::vector<Rgb8> heatColorStops(int count) {
+  count = std::max(count, 2);
+  std::vector<float> ramp(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) ramp[i] = static_cast<float>(i) / static_cast<float>(count - 1);
+  ImageBuf src(ImageSpec(count, 1, 1, TypeDesc::FLOAT), ramp.data());
+  ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, kHeatColorMap);
+  std::vector<float> rgb(static_cast<std::size_t>(count) * 3, 0.0f);
+  mapped.get_pixels(mapped.roi(), TypeDesc::FLOAT, rgb.data());
+  std::vector<Rgb8> stops(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i)
+    for (int c = 0; c < 3; ++c)
+      stops[i][c] =
+          static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
+  return stops;
+}
+
+void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
+                     const fs::path& dir, PairResult& result) {
+  const int w = maps.width;
+  const int h = maps.height;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  if (w <= 0 || h <= 0 || expected.width != w || expected.height != h || actual.width != w ||
+      actual.height != h || maps.pixel_class.size() != n || maps.depth_steps.size() != n ||
+      maps.depth_tolerance.size() != n || maps.shading_abs.size() != n ||
+      maps.delta_rgba.size() != n * 4)
+    throw InputError(fmt::format("{}: class maps do not match the frames ({}x{})", dir.string(),
+                                 expected.width, expected.height));
+
+  AtomicFileSet files;
+  const fs::path expected_png = dir / "expected.png";
+  const fs::path actual_png = dir / "actual.png";
+  writeColorPng(expected, files.stage(expected_png));
+  writeColorPng(actual, files.stage(actual_png));
+
+  // Visibility: classes in colour over a dim copy of the expected image for context.
+  std::vector<std::uint8_t> vis(n * 3);
+  for (std::size_t i = 0; i < n; ++i) {
+    Rgb8 px = classColor(maps.pixel_class[i]);
+    if (maps.pixel_class[i] == PixelClass::Match) {
+      const auto g =
+          static_cast<std::uint8_t>(std::lround(48.0f + 96.0f * luminance(&expected.color[i * 4])));
+      px = {g, g, g};
+    }
+    std::copy(px.begin(), px.end(), vis.begin() + static_cast<std::ptrdiff_t>(i * 3));
+  }
+  const fs::path visibility_png = dir / "visibility.png";
+  writeRgb8(files.stage(visibility_png), w, h, vis, visibility_png);
+
+  result.depth_heat_scale = std::max({result.depth.max_steps, result.tolerances.depth.fail, 1.0});
+  result.shading_heat_scale =
+      std::max({result.shading.max_abs, result.tolerances.shading.fail, 1.0});
+  const fs::path depth_png = dir / "depth_heat.png";
+  writeRgb8(files.stage(depth_png), w, h,
+            heatImage(maps, maps.depth_steps, result.depth_heat_scale), depth_png);
+  const fs::path shading_png = dir / "shading_heat.png";
+  writeRgb8(files.stage(shading_png), w, h,
+            heatImage(maps, maps.shading_abs, result.shading_heat_scale), shading_png);
+
+  // diff.exr: every float a tool might want, one channel each.
+  const std::vector<std::string> names = {
+      "id_class", "depth_steps", "depth_tolerance", "shading_abs", "dR", "dG", "dB", "dA"};
+  const int nch = static_cast<int>(names.size());
+  ImageSpec spec(w, h, nch, TypeDesc::FLOAT);
+  spec.channelnames = names;
+  spec.attribute("compression", "zip");
+  spec.attribute("rastercheck:fixture", result.fixture);
+  spec.attribute("rastercheck:pair", result.expected + " vs " + result.actual);
+  std::vector<float> diff(n * nch);
+  for (std::size_t i = 0; i < n; ++i) {
+    float* p = &diff[i * nch];
+    p[0] = static_cast<float>(maps.pixel_class[i]);
+    p[1] = maps.depth_steps[i];
+    p[2] = maps.depth_tolerance[i];
+    p[3] = maps.shading_abs[i];
+    for (int c = 0; c < 4; ++c) p[4 + c] = maps.delta_rgba[i * 4 + c];
+  }
+  const fs::path diff_exr = dir / "diff.exr";
+  writeImage(files.stage(diff_exr), spec, TypeDesc::FLOAT, diff.data(), diff_exr);
+
+  files.commit();
+  result.images = {{"expected", expected_png},     {"actual", actual_png},
+                   {"visibility", visibility_png}, {"depth_heat", depth_png},
+                   {"shading_heat", shading_png},  {"diff_exr", diff_exr}};
+}
+
+fs::path pairDirectory(const fs::path& out_dir, const PairResult& result) {
+  return out_dir / safeName(result.fixture.empty() ? "fixture" : result.fixture) /
+         (safeName(result.expected) + "_vs_" + safeName(result.actual));
+}
+
+}  // namespace rc

@@ -1,0 +1,46 @@
+// The per-pair error images people look at (and the float diff.exr tools read): written
+// from the frames and the ClassMaps of one comparison, all-or-nothing.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "compare/compare.h"
+
+namespace rc {
+
+// The colour map of both heat maps (an OpenImageIO ImageBufAlgo::color_map name).
+inline constexpr const char* kHeatColorMap = "inferno";
+
+using Rgb8 = std::array<std::uint8_t, 3>;
+
+// visibility.png's colour for each class (match pixels are a dim grey of the expected
+// image's luminance; this is the colour shown in the legend for them).
+Rgb8 classColor(PixelClass c);
+// Heat-map pixels that were not compared (background or a visibility mismatch), and
+// compared pixels whose value is NaN or Inf.
+inline constexpr Rgb8 kNotComparedColor = {40, 44, 52};
+inline constexpr Rgb8 kNonFiniteColor = {0, 255, 255};
+
+// `count` evenly spaced colours of the heat colour map from 0 to 1, for legends.
+std::vector<Rgb8> heatColorStops(int count);
+
+// Where a heat map value v lands on the colour map: log2(1 + v) / log2(1 + scale), in
+// [0, 1]. Log-scaled so that one-step errors stay visible next to large ones.
+float heatPosition(float value, double scale);
+
+// Writes into `dir` (created if needed): expected.png, actual.png, visibility.png,
+// depth_heat.png, shading_heat.png and diff.exr (float channels id_class, depth_steps,
+// depth_tolerance, shading_abs, dR, dG, dB, dA), and records them in result.images and
+// the heat scales in result. Throws InputError when a file cannot be written; then none
+// of them is left behind.
+void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
+                     const std::filesystem::path& dir, PairResult& result);
+
+// A folder for one pair's images under a report folder: <out>/<fixture>/<expected>_vs_
+// <actual>, every name reduced to [A-Za-z0-9._-].
+std::filesystem::path pairDirectory(const std::filesystem::path& out_dir, const PairResult& result);
+
+}  // namespace rc

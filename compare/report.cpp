@@ -1,0 +1,252 @@
+// report.json, one-line descriptions, exit codes and the all-or-nothing report writer:
+// see report.h. The JSON layout is pinned by docs/report-schema.json.
+#include "compare/report.h"
+
+#include <cctype>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "compare/atomic_file.h"
+#include "compare/report_text.h"
+#include "fixtures/errors.h"
+
+namespace rc {
+namespace fs = std::filesystem;
+using nlohmann::json;
+namespace {
+
+// JSON has no NaN or Inf.
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json pixel(const PixelRef& p) { return p.valid() ? json::array({p.x, p.y}) : json(nullptr); }
+json windowPixel(const PixelRef& p, int height) {
+  return p.valid() ? json::array({p.x, height - 1 - p.y}) : json(nullptr);
+}
+
+json thresholds(const Thresholds& t) { return {{"warn", num(t.warn)}, {"fail", num(t.fail)}}; }
+
+json histogram(const ErrorHistogram& h, double max_value, const char* unit) {
+  const ErrorHistogram::Coarse c = h.coarse(max_value);
+  json edges = json::array();
+  for (double e : c.edges) edges.push_back(num(e));
+  return {{"unit", unit},
+          {"exact_zero_bin", h.exactMultiples()},
+          {"edges", edges},
+          {"counts", c.counts}};
+}
+
+json nonfinite(const NonFiniteCounts& n) {
+  json j = json::object();
+  for (std::size_t c = 0; c < kFrameChannels.size(); ++c)
+    j[kFrameChannels[c]] = {{"nan", n.nan[c]}, {"inf", n.inf[c]}};
+  return j;
+}
+
+std::string relativePath(const fs::path& file, const fs::path& base) {
+  std::error_code ec;
+  fs::path rel = fs::proximate(file, base.empty() ? fs::path(".") : base, ec);
+  if (ec) rel = file;
+  return rel.generic_string();
+}
+
+}  // namespace
+
+std::string where(const PixelRef& p, int height) {
+  return p.valid() ? fmt::format("({},{}) window ({},{})", p.x, p.y, p.x, height - 1 - p.y)
+                   : std::string("(none)");
+}
+
+std::string visibilityText(const PairResult& r) {
+  const VisibilityStats& v = r.visibility;
+  return fmt::format(
+      "visibility {}: {} hard mismatched px (missing {}, extra {}, wrong_primitive {}; "
+      "warn above {}, fail above {}), {} ambiguous within {:.4g} px{}; worst {}",
+      toString(v.status), v.hard, v.missing_hard, v.extra_hard, v.wrong_primitive_hard,
+      r.tolerances.visibility.warn, r.tolerances.visibility.fail, v.ambiguous, v.band_px,
+      v.uncertainty_available ? "" : " (no uncertainty channels: every mismatch is hard)",
+      where(v.worst, r.height));
+}
+
+std::string depthText(const PairResult& r) {
+  const DepthStats& d = r.depth;
+  std::string s = fmt::format(
+      "depth {}: {} px over tolerance ({} over fail; tolerance = warn {} / fail {} steps + "
+      "slope allowance), max {} steps, p99 {} steps",
+      toString(d.status), d.over_tolerance, d.over_fail, r.tolerances.depth.warn,
+      r.tolerances.depth.fail, d.max_steps, d.p99_steps);
+  if (d.nonfinite) s += fmt::format(", {} px with non-finite Z", d.nonfinite);
+  s += fmt::format("; worst {}", where(d.worst, r.height));
+  if (d.worst.valid())
+    s += std::isfinite(d.worst_steps)
+             ? fmt::format(": {:.6g} steps, allowance {:.4g}", d.worst_steps, d.worst_allowance)
+             : std::string(": non-finite Z");
+  return s;
+}
+
+std::string shadingText(const PairResult& r) {
+  const ShadingStats& s = r.shading;
+  std::string t = fmt::format(
+      "shading {}: max_abs {:.4g} (8-bit units; warn above {}, fail above {}), {} px over "
+      "warn, {} over fail",
+      toString(s.status), s.max_abs, r.tolerances.shading.warn, r.tolerances.shading.fail,
+      s.over_tolerance, s.over_fail);
+  if (s.nonfinite) t += fmt::format(", {} px with non-finite colour", s.nonfinite);
+  t += fmt::format("; worst {}", where(s.worst, r.height));
+  return t;
+}
+
+ReportSummary Report::summary() const {
+  ReportSummary s;
+  for (const PairResult& r : results) {
+    switch (r.status) {
+      case Status::Pass:
+        ++s.pass;
+        break;
+      case Status::Warn:
+        ++s.warn;
+        break;
+      case Status::Fail:
+        ++s.fail;
+        break;
+      case Status::Error:
+        ++s.error;
+        break;
+    }
+  }
+  return s;
+}
+
+int exitCodeFor(const Report& report) {
+  const ReportSummary s = report.summary();
+  if (s.error) return kExitBackend;
+  if (s.fail) return kExitFail;
+  return kExitPass;
+}
+
+json toJson(const PairResult& r, const fs::path& report_dir) {
+  json j = {{"fixture", r.fixture},
+            {"expected", r.expected},
+            {"actual", r.actual},
+            {"status", toString(r.status)},
+            {"pixels", r.pixels}};
+  if (r.status == Status::Error) {
+    j["error"] = r.error;
+    return j;
+  }
+  const Tolerances& t = r.tolerances;
+  const VisibilityStats& v = r.visibility;
+  const DepthStats& d = r.depth;
+  const ShadingStats& s = r.shading;
+  j["width"] = r.width;
+  j["height"] = r.height;
+  j["subpixel_bits"] = {{"expected", r.expected_subpixel_bits}, {"actual", r.actual_subpixel_bits}};
+  j["tolerances"] = {{"depth_format", toString(t.depth_format)},
+                     {"color_format", toString(t.color_format)},
+                     {"visibility", thresholds(t.visibility)},
+                     {"depth", thresholds(t.depth)},
+                     {"shading", thresholds(t.shading)},
+                     {"depth_slope_factor", num(t.depth_slope_factor)},
+                     {"window_error_ulps", num(t.window_error_ulps)},
+                     {"band_px_override", t.band_px ? num(*t.band_px) : json(nullptr)}};
+  j["visibility"] = {{"status", toString(v.status)},
+                     {"mismatched", v.mismatched},
+                     {"ambiguous", v.ambiguous},
+                     {"hard", v.hard},
+                     {"missing", v.missing},
+                     {"extra", v.extra},
+                     {"wrong_primitive", v.wrong_primitive},
+                     {"missing_hard", v.missing_hard},
+                     {"extra_hard", v.extra_hard},
+                     {"wrong_primitive_hard", v.wrong_primitive_hard},
+                     {"ambiguous_by_depth_gap", v.ambiguous_by_depth_gap},
+                     {"band_px", num(v.band_px)},
+                     {"uncertainty_available", v.uncertainty_available},
+                     {"worst", pixel(v.worst)},
+                     {"worst_window", windowPixel(v.worst, r.height)},
+                     {"worst_edge_dist", v.worst.valid() ? num(v.worst_edge_dist) : json(nullptr)}};
+  j["depth"] = {{"status", toString(d.status)},
+                {"compared", d.compared},
+                {"max_steps", num(d.max_steps)},
+                {"mean_steps", num(d.mean_steps)},
+                {"p99_steps", num(d.p99_steps)},
+                {"over_tolerance", d.over_tolerance},
+                {"over_fail", d.over_fail},
+                {"nonfinite", d.nonfinite},
+                {"slope_unknown", d.slope_unknown},
+                {"max_slope", num(d.max_slope)},
+                {"worst", pixel(d.worst)},
+                {"worst_window", windowPixel(d.worst, r.height)},
+                {"worst_steps", d.worst.valid() ? num(d.worst_steps) : json(nullptr)},
+                {"worst_allowance", d.worst.valid() ? num(d.worst_allowance) : json(nullptr)},
+                {"step", num(1.0 / depthStepsPerUnit(t.depth_format))},
+                {"histogram", histogram(d.histogram, d.max_steps, "steps")}};
+  j["shading"] = {{"status", toString(s.status)},
+                  {"compared", s.compared},
+                  {"max_abs", num(s.max_abs)},
+                  {"mean_abs", num(s.mean_abs)},
+                  {"rmse", num(s.rmse)},
+                  {"psnr_db", s.psnr_db ? num(*s.psnr_db) : json(nullptr)},
+                  {"p99_abs", num(s.p99_abs)},
+                  {"over_tolerance", s.over_tolerance},
+                  {"over_fail", s.over_fail},
+                  {"nonfinite", s.nonfinite},
+                  {"max_abs_rgba",
+                   {num(s.max_abs_rgba[0]), num(s.max_abs_rgba[1]), num(s.max_abs_rgba[2]),
+                    num(s.max_abs_rgba[3])}},
+                  {"worst", pixel(s.worst)},
+                  {"worst_window", windowPixel(s.worst, r.height)},
+                  {"histogram", histogram(s.histogram, s.max_abs, "8-bit units")}};
+  j["nonfinite"] = {{"expected", nonfinite(r.nonfinite_expected)},
+                    {"actual", nonfinite(r.nonfinite_actual)}};
+  json images = json::object();
+  for (const auto& [kind, file] : r.images) images[kind] = relativePath(file, report_dir);
+  j["images"] = images;
+  j["heat_scales"] = {{"depth_steps", num(r.depth_heat_scale)},
+                      {"shading_abs", num(r.shading_heat_scale)}};
+  j["seconds"] = num(r.seconds);
+  return j;
+}
+
+json toJson(const Report& report, const fs::path& report_dir) {
+  json results = json::array();
+  for (const PairResult& r : report.results) results.push_back(toJson(r, report_dir));
+  const ReportSummary s = report.summary();
+  json j = {{"format", kReportFormat},
+            {"tool", {{"name", report.tool_name}, {"version", report.tool_version}}},
+            {"results", results},
+            {"summary",
+             {{"pass", s.pass},
+              {"warn", s.warn},
+              {"fail", s.fail},
+              {"error", s.error},
+              {"total", s.total()}}},
+            {"exit_code", exitCodeFor(report)}};
+  if (!report.command.empty()) j["command"] = report.command;
+  return j;
+}
+
+std::string describe(const PairResult& r) {
+  std::string status = toString(r.status);
+  for (char& ch : status) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  const std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
+  if (r.status == Status::Error) return head + ": " + r.error;
+  // The classes that set the pair's status; at pass, nothing to say.
+  std::vector<std::string> parts;
+  if (r.visibility.status == r.status && r.status != Status::Pass)
+    parts.push_back(visibilityText(r));
+  if (r.depth.status == r.status && r.status != Status::Pass) parts.push_back(depthText(r));
+  if (r.shading.status == r.status && r.status != Status::Pass) parts.push_back(shadingText(r));
+  if (parts.empty()) return head;
+  return head + ": " + fmt::format("{}", fmt::join(parts, "; "));
+}
+
+void writeReport(const Report& report, const fs::path& out_dir) {
+  AtomicFileSet files;
+  files.stageText(out_dir / "report.json", toJson(report, out_dir).dump(2) + "\n");
+  files.stageText(out_dir / "junit.xml", junitXml(report));
+  files.stageText(out_dir / "report.html", reportHtml(report, out_dir));
+  files.commit();
+}
+
+}  // namespace rc

@@ -1,0 +1,58 @@
+// Reports of a set of comparisons: report.json (the contract in ../shared/DESIGN.md plus
+// the fields docs/report-schema.json lists), junit.xml for CI, and report.html for people.
+// docs/reports.md says what each file holds.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "compare/compare.h"
+
+namespace rc {
+
+inline constexpr const char* kReportFormat = "rastercheck-report/1";
+
+struct ReportSummary {
+  std::uint64_t pass = 0;
+  std::uint64_t warn = 0;
+  std::uint64_t fail = 0;
+  std::uint64_t error = 0;
+  std::uint64_t total() const { return pass + warn + fail + error; }
+};
+
+struct Report {
+  std::string tool_name = "rastercheck";
+  std::string tool_version;
+  std::string command;  // the command line that produced it, when known
+  std::vector<PairResult> results;
+
+  ReportSummary summary() const;
+};
+
+// Exit status of a command that produced this report: 3 when any row is an error (a
+// backend could not run), else 1 when any comparison failed, else 0 (warnings pass).
+int exitCodeFor(const Report& report);
+
+// report.json content. Image paths are written relative to report_dir (the folder the
+// report goes to), with '/' separators. Non-finite numbers become null.
+nlohmann::json toJson(const PairResult& result, const std::filesystem::path& report_dir);
+nlohmann::json toJson(const Report& report, const std::filesystem::path& report_dir);
+
+// One line on a pair, e.g. "FAIL shading/sphere ref vs gl:egl:llvmpipe: depth: 12 px over
+// tolerance, max 40 steps, worst (3,4) window (3,251)". Failing (else warning) classes
+// only; just "PASS <fixture> <expected> vs <actual>" when all pass.
+std::string describe(const PairResult& result);
+
+// The junit.xml and report.html texts (report_dir as for toJson).
+std::string junitXml(const Report& report);
+std::string reportHtml(const Report& report, const std::filesystem::path& report_dir);
+
+// Writes report.json, junit.xml and report.html into out_dir (created if needed), all or
+// none. Throws InputError when they cannot be written.
+void writeReport(const Report& report, const std::filesystem::path& out_dir);
+
+}  // namespace rc

@@ -1,0 +1,18 @@
+// Inside compare/: the sentences reports use for each class (report.cpp), shared by the
+// JUnit and HTML writers so that every output says the same thing in the same words.
+#pragma once
+
+#include <string>
+
+#include "compare/compare.h"
+
+namespace rc {
+
+// "(x,y) window (x,H-1-y)", or "(none)".
+std::string where(const PixelRef& p, int height);
+// One sentence per class: status, counts, thresholds, worst pixel.
+std::string visibilityText(const PairResult& r);
+std::string depthText(const PairResult& r);
+std::string shadingText(const PairResult& r);
+
+}  // namespace rc

@@ -1,0 +1,521 @@
+// The comparator against injected faults on reference-like frames: every fault must be
+// caught in exactly its pixels and class, and nothing else may move. Expected numbers
+// come from the injection (block sizes, offsets) and from the band formula, never from
+// running the comparator first.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "compare/compare.h"
+#include "fixtures/errors.h"
+#include "synthetic_frames.h"
+
+namespace rc {
+namespace {
+
+constexpr int kW = 256;
+constexpr int kH = 256;
+constexpr double kD24 = 16777215.0;
+
+struct Block {
+  int x0, y0, x1, y1;  // [x0, x1) x [y0, y1), image coordinates
+  int size() const { return (x1 - x0) * (y1 - y0); }
+  bool contains(PixelRef p) const { return p.x >= x0 && p.x < x1 && p.y >= y0 && p.y < y1; }
+};
+// Inside the back rectangle, above its diagonal (id 1), > 4 px from any edge.
+constexpr Block kBackBlock{70, 25, 100, 45};
+// Background, > 2 px from any rectangle.
+constexpr Block kEmptyBlock{20, 240, 40, 252};
+// Inside the steep rectangle.
+constexpr Block kSteepBlock{185, 30, 205, 50};
+
+template <typename F>
+void forBlock(const Block& b, F f) {
+  for (int y = b.y0; y < b.y1; ++y)
+    for (int x = b.x0; x < b.x1; ++x) f(x, y);
+}
+
+class CompareTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ref_ = testing::renderRects(kW, kH, testing::defaultRects(kW, kH));
+    gl_ = ref_;
+    gl_.edge_dist.clear();
+    gl_.depth_gap.clear();
+    gl_.meta["backend"] = "gl:test";
+    tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F);
+    baseline_ = compareFrames(ref_, ref_, ref_, tol_);
+  }
+  PairResult compare(ClassMaps* maps = nullptr) {
+    return compareFrames(ref_, gl_, ref_, tol_, maps);
+  }
+
+  Frame ref_;
+  Frame gl_;
+  Tolerances tol_;
+  PairResult baseline_;
+};
+
+void expectNoVisibilityChange(const PairResult& r) {
+  EXPECT_EQ(r.visibility.mismatched, 0u);
+  EXPECT_EQ(r.visibility.missing, 0u);
+  EXPECT_EQ(r.visibility.extra, 0u);
+  EXPECT_EQ(r.visibility.wrong_primitive, 0u);
+  EXPECT_EQ(r.visibility.status, Status::Pass);
+}
+
+TEST_F(CompareTest, SceneHasAllKindsOfPixels) {
+  // Guards the fixture the other tests rely on.
+  const std::size_t i = ref_.index(kBackBlock.x0, kBackBlock.y0);
+  EXPECT_EQ(ref_.id[i], 1u);
+  EXPECT_FLOAT_EQ(ref_.edge_dist[i], 1.0f);
+  EXPECT_EQ(ref_.id[ref_.index(kEmptyBlock.x0, kEmptyBlock.y0)], 0u);
+  EXPECT_NE(ref_.id[ref_.index(kSteepBlock.x0, kSteepBlock.y0)], 0u);
+  EXPECT_GT(baseline_.depth.compared, 30000u);
+  EXPECT_LT(baseline_.depth.compared, baseline_.pixels);
+}
+
+TEST_F(CompareTest, IdenticalFramesGiveZerosAndPass) {
+  const PairResult& r = baseline_;
+  EXPECT_EQ(r.status, Status::Pass);
+  expectNoVisibilityChange(r);
+  EXPECT_EQ(r.visibility.ambiguous, 0u);
+  EXPECT_EQ(r.visibility.hard, 0u);
+  EXPECT_EQ(r.depth.status, Status::Pass);
+  EXPECT_EQ(r.depth.max_steps, 0.0);
+  EXPECT_EQ(r.depth.mean_steps, 0.0);
+  EXPECT_EQ(r.depth.p99_steps, 0.0);
+  EXPECT_EQ(r.depth.over_tolerance, 0u);
+  EXPECT_EQ(r.shading.status, Status::Pass);
+  EXPECT_EQ(r.shading.max_abs, 0.0);
+  EXPECT_EQ(r.shading.mean_abs, 0.0);
+  EXPECT_EQ(r.shading.rmse, 0.0);
+  EXPECT_FALSE(r.shading.psnr_db.has_value());
+  EXPECT_EQ(r.shading.over_tolerance, 0u);
+  EXPECT_FALSE(r.depth.worst.valid());  // nothing differs: no worst pixel
+  EXPECT_FALSE(r.shading.worst.valid());
+  EXPECT_FALSE(r.visibility.worst.valid());
+  EXPECT_EQ(r.nonfinite_expected.total(), 0u);
+  EXPECT_EQ(r.pixels, static_cast<std::uint64_t>(kW * kH));
+  EXPECT_EQ(r.depth.compared, r.shading.compared);
+  EXPECT_EQ(r.fixture, "synthetic/rects");
+  EXPECT_EQ(r.expected, "ref");
+}
+
+TEST_F(CompareTest, BlankIdsAreExactlyThatManyMissing) {
+  forBlock(kBackBlock, [&](int x, int y) {
+    const std::size_t i = gl_.index(x, y);
+    gl_.id[i] = 0;
+    gl_.depth[i] = 1.0f;
+    for (int c = 0; c < 4; ++c) gl_.color[i * 4 + c] = 0.0f;
+  });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(kBackBlock.size());
+  EXPECT_EQ(r.visibility.missing, n);
+  EXPECT_EQ(r.visibility.missing_hard, n);
+  EXPECT_EQ(r.visibility.hard, n);
+  EXPECT_EQ(r.visibility.mismatched, n);
+  EXPECT_EQ(r.visibility.ambiguous, 0u);
+  EXPECT_EQ(r.visibility.extra, 0u);
+  EXPECT_EQ(r.visibility.wrong_primitive, 0u);
+  EXPECT_EQ(r.visibility.status, Status::Fail);
+  EXPECT_TRUE(kBackBlock.contains(r.visibility.worst));
+  // Nothing else moves: those pixels simply leave the depth/shading comparison.
+  EXPECT_EQ(r.depth.compared, baseline_.depth.compared - n);
+  EXPECT_EQ(r.depth.max_steps, 0.0);
+  EXPECT_EQ(r.shading.max_abs, 0.0);
+  EXPECT_EQ(r.depth.status, Status::Pass);
+  EXPECT_EQ(r.shading.status, Status::Pass);
+  EXPECT_EQ(r.status, Status::Fail);
+}
+
+TEST_F(CompareTest, SwappedIdsAreWrongPrimitive) {
+  forBlock(kBackBlock, [&](int x, int y) { gl_.id[gl_.index(x, y)] = 4; });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(kBackBlock.size());
+  EXPECT_EQ(r.visibility.wrong_primitive, n);
+  EXPECT_EQ(r.visibility.wrong_primitive_hard, n);  // one fragment there: depth_gap = inf
+  EXPECT_EQ(r.visibility.missing, 0u);
+  EXPECT_EQ(r.visibility.extra, 0u);
+  EXPECT_EQ(r.visibility.status, Status::Fail);
+  EXPECT_EQ(r.depth.compared, baseline_.depth.compared - n);
+  EXPECT_EQ(r.shading.max_abs, 0.0);
+}
+
+TEST_F(CompareTest, DrawnBackgroundIsExtra) {
+  forBlock(kEmptyBlock, [&](int x, int y) {
+    const std::size_t i = gl_.index(x, y);
+    gl_.id[i] = 7;
+    gl_.depth[i] = 0.5f;
+    gl_.color[i * 4] = 1.0f;
+  });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(kEmptyBlock.size());
+  EXPECT_EQ(r.visibility.extra, n);
+  EXPECT_EQ(r.visibility.extra_hard, n);
+  EXPECT_EQ(r.visibility.missing, 0u);
+  EXPECT_EQ(r.visibility.wrong_primitive, 0u);
+  EXPECT_EQ(r.depth.compared, baseline_.depth.compared);
+  EXPECT_TRUE(kEmptyBlock.contains(r.visibility.worst));
+}
+
+TEST_F(CompareTest, VisibilityThresholdsGiveWarnThenFail) {
+  forBlock(kEmptyBlock, [&](int x, int y) { gl_.id[gl_.index(x, y)] = 7; });
+  const auto n = static_cast<double>(kEmptyBlock.size());
+  tol_.visibility = {n - 1, n};
+  EXPECT_EQ(compare().visibility.status, Status::Warn);
+  tol_.visibility = {n, n + 1};
+  EXPECT_EQ(compare().visibility.status, Status::Pass);
+  tol_.visibility = {0, n - 1};
+  EXPECT_EQ(compare().visibility.status, Status::Fail);
+}
+
+TEST_F(CompareTest, DepthOffsetIsCaughtInExactlyItsBlock) {
+  constexpr int kN = 100;  // steps, far above the fail threshold on a gentle slope
+  forBlock(kBackBlock, [&](int x, int y) {
+    const std::size_t i = gl_.index(x, y);
+    gl_.depth[i] = static_cast<float>((std::nearbyint(ref_.depth[i] * kD24) + kN) / kD24);
+  });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(kBackBlock.size());
+  EXPECT_EQ(r.depth.over_tolerance, n);
+  EXPECT_EQ(r.depth.over_fail, n);
+  EXPECT_EQ(r.depth.max_steps, kN);
+  EXPECT_TRUE(kBackBlock.contains(r.depth.worst)) << r.depth.worst.x << "," << r.depth.worst.y;
+  EXPECT_EQ(r.depth.worst_steps, kN);
+  EXPECT_EQ(r.depth.status, Status::Fail);
+  EXPECT_EQ(r.depth.compared, baseline_.depth.compared);
+  EXPECT_DOUBLE_EQ(r.depth.mean_steps, kN * static_cast<double>(n) / r.depth.compared);
+  // Nearest-rank p99: N exactly when the block holds more than the top 1% of pixels.
+  const auto rank = static_cast<std::uint64_t>(std::ceil(0.99 * r.depth.compared));
+  EXPECT_EQ(r.depth.p99_steps, n > r.depth.compared - rank ? kN : 0.0);
+  // The slope there is sqrt(20^2 + 10^2) steps/px: the allowance is that times the band.
+  EXPECT_NEAR(r.depth.worst_allowance, std::hypot(20.0, 10.0) * r.visibility.band_px,
+              2.0 * r.visibility.band_px);
+  expectNoVisibilityChange(r);
+  EXPECT_EQ(r.shading.max_abs, 0.0);
+  EXPECT_EQ(r.status, Status::Fail);
+}
+
+TEST_F(CompareTest, DepthThresholdsGiveWarnThenFail) {
+  auto offset = [&](int steps) {
+    gl_ = ref_;
+    forBlock(kBackBlock, [&](int x, int y) {
+      const std::size_t i = gl_.index(x, y);
+      gl_.depth[i] = static_cast<float>((std::nearbyint(ref_.depth[i] * kD24) + steps) / kD24);
+    });
+    return compare();
+  };
+  tol_.depth = {4.0, 16.0};
+  EXPECT_EQ(offset(4).depth.status, Status::Pass);  // the allowance here is ~0.13 steps
+  const PairResult warn = offset(5);
+  EXPECT_EQ(warn.depth.status, Status::Warn);
+  EXPECT_EQ(warn.depth.over_tolerance, static_cast<std::uint64_t>(kBackBlock.size()));
+  EXPECT_EQ(warn.depth.over_fail, 0u);
+  EXPECT_EQ(offset(16).depth.status, Status::Warn);
+  EXPECT_EQ(offset(17).depth.status, Status::Fail);
+  EXPECT_EQ(offset(-17).depth.status, Status::Fail);  // |dZ|: nearer is as wrong as farther
+}
+
+TEST_F(CompareTest, DepthToleranceGrowsWithTheSlope) {
+  // The steep rectangle changes by 0.5 / (0.3 * 256) of the range per px in x.
+  const double slope = 0.5 / (0.30 * kW) * kD24;
+  const int steps = 200;
+  forBlock(kSteepBlock, [&](int x, int y) {
+    const std::size_t i = gl_.index(x, y);
+    gl_.depth[i] = static_cast<float>((std::nearbyint(ref_.depth[i] * kD24) + steps) / kD24);
+  });
+  const PairResult r = compare();
+  const double allowance = slope * r.visibility.band_px;
+  ASSERT_GT(allowance, steps + tol_.depth.fail);  // the premise of this test
+  EXPECT_EQ(r.depth.over_tolerance, 0u);
+  EXPECT_EQ(r.depth.max_steps, steps);
+  EXPECT_TRUE(kSteepBlock.contains(r.depth.worst));
+  EXPECT_NEAR(r.depth.worst_allowance, allowance, 0.01 * allowance);
+  EXPECT_NEAR(r.depth.max_slope, slope, 0.01 * slope);
+
+  // Without the slope allowance the same offset fails.
+  tol_.depth_slope_factor = 0.0;
+  EXPECT_EQ(compare().depth.over_fail, static_cast<std::uint64_t>(kSteepBlock.size()));
+}
+
+TEST_F(CompareTest, ColourOffsetIsCaughtInExactlyItsBlock) {
+  constexpr int kN = 9;
+  forBlock(kBackBlock, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4 + 1] += kN / 255.0f; });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(kBackBlock.size());
+  EXPECT_NEAR(r.shading.max_abs, kN, 1e-4);
+  EXPECT_NEAR(r.shading.max_abs_rgba[1], kN, 1e-4);
+  EXPECT_EQ(r.shading.max_abs_rgba[0], 0.0);
+  EXPECT_EQ(r.shading.over_tolerance, n);
+  EXPECT_EQ(r.shading.over_fail, n);
+  EXPECT_TRUE(kBackBlock.contains(r.shading.worst));
+  EXPECT_EQ(r.shading.status, Status::Fail);
+  const double values = 4.0 * static_cast<double>(r.shading.compared);
+  EXPECT_NEAR(r.shading.mean_abs, kN * static_cast<double>(n) / values, 1e-6);
+  const double rmse = std::sqrt(kN * kN * static_cast<double>(n) / values);
+  EXPECT_NEAR(r.shading.rmse, rmse, 1e-4);
+  ASSERT_TRUE(r.shading.psnr_db.has_value());
+  EXPECT_NEAR(*r.shading.psnr_db, 20.0 * std::log10(255.0 / rmse), 1e-3);
+  expectNoVisibilityChange(r);
+  EXPECT_EQ(r.depth.max_steps, 0.0);
+}
+
+TEST_F(CompareTest, Rgba8ColourDifferencesAreExactIntegers) {
+  auto quantize = [](Frame& f) {
+    for (float& c : f.color) c = std::nearbyint(std::clamp(c, 0.0f, 1.0f) * 255.0f) / 255.0f;
+  };
+  quantize(ref_);
+  gl_ = ref_;
+  forBlock(kBackBlock, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4] -= 3.0f / 255.0f; });
+  tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);
+  const PairResult r = compare();
+  EXPECT_EQ(r.shading.max_abs, 3.0);
+  const auto rank = static_cast<std::uint64_t>(std::ceil(0.99 * r.shading.compared));
+  const auto n = static_cast<std::uint64_t>(kBackBlock.size());
+  EXPECT_EQ(r.shading.p99_abs, n > r.shading.compared - rank ? 3.0 : 0.0);
+  EXPECT_EQ(r.shading.over_fail, n);
+}
+
+TEST_F(CompareTest, D16DepthCountsD16Steps) {
+  auto to16 = [](float z) { return static_cast<float>(std::nearbyint(z * 65535.0) / 65535.0); };
+  for (float& z : ref_.depth) z = to16(z);
+  gl_ = ref_;
+  forBlock(kBackBlock, [&](int x, int y) {
+    const std::size_t i = gl_.index(x, y);
+    gl_.depth[i] = static_cast<float>((std::nearbyint(ref_.depth[i] * 65535.0) + 3) / 65535.0);
+  });
+  tol_ = defaultTolerances(DepthFormat::D16, ColorFormat::RGBA32F);
+  const PairResult r = compare();
+  EXPECT_EQ(r.depth.max_steps, 3.0);
+  EXPECT_EQ(r.depth.status, Status::Fail);
+}
+
+TEST_F(CompareTest, MismatchNearAnEdgeIsAmbiguousFarFromItHard) {
+  const std::size_t near_px = ref_.index(80, 30);
+  const std::size_t far_px = ref_.index(90, 40);
+  ref_.edge_dist[near_px] = 0.001f;
+  ref_.edge_dist[far_px] = 0.5f;
+  gl_.id[near_px] = 0;
+  gl_.id[far_px] = 0;
+  const PairResult r = compare();
+  EXPECT_EQ(r.visibility.missing, 2u);
+  EXPECT_EQ(r.visibility.ambiguous, 1u);
+  EXPECT_EQ(r.visibility.hard, 1u);
+  EXPECT_EQ(r.visibility.worst.x, 90);
+  EXPECT_EQ(r.visibility.worst.y, 40);
+  EXPECT_FLOAT_EQ(static_cast<float>(r.visibility.worst_edge_dist), 0.5f);
+}
+
+TEST_F(CompareTest, BandComesFromBothSidesSubpixelBits) {
+  // Two pixels just inside and just outside the band of an 8-bit vs 4-bit pair.
+  gl_.meta["subpixel_bits"] = 4;
+  const double band = snapMovePx(8) + snapMovePx(4) + 16.0 * std::ldexp(1.0, -24) * kW;
+  const std::size_t inside = ref_.index(80, 30);
+  const std::size_t outside = ref_.index(90, 40);
+  ref_.edge_dist[inside] = static_cast<float>(band * 0.99);
+  ref_.edge_dist[outside] = static_cast<float>(band * 1.01);
+  gl_.id[inside] = 0;
+  gl_.id[outside] = 0;
+  const PairResult r = compare();
+  EXPECT_NEAR(r.visibility.band_px, band, 1e-12);
+  EXPECT_EQ(r.visibility.ambiguous, 1u);
+  EXPECT_EQ(r.visibility.hard, 1u);
+  EXPECT_EQ(r.actual_subpixel_bits, 4);
+  EXPECT_EQ(r.expected_subpixel_bits, 8);
+  // With 8 bits on both sides the same pixel is hard.
+  gl_.meta["subpixel_bits"] = 8;
+  EXPECT_EQ(compare().visibility.hard, 2u);
+}
+
+TEST_F(CompareTest, GlAgainstGlUsesTheReferenceUncertainty) {
+  Frame a = gl_;
+  Frame b = gl_;
+  a.meta["subpixel_bits"] = 8;
+  b.meta["subpixel_bits"] = 4;
+  const double band =
+      std::max(snapMovePx(8), snapMovePx(4)) + snapMovePx(8) + 16.0 * std::ldexp(1.0, -24) * kW;
+  const std::size_t inside = ref_.index(80, 30);
+  const std::size_t outside = ref_.index(90, 40);
+  ref_.edge_dist[inside] = static_cast<float>(band * 0.99);
+  ref_.edge_dist[outside] = static_cast<float>(band * 1.01);
+  b.id[inside] = 0;
+  b.id[outside] = 0;
+  const PairResult r = compareFrames(a, b, ref_, tol_);
+  EXPECT_NEAR(r.visibility.band_px, band, 1e-12);
+  EXPECT_TRUE(r.visibility.uncertainty_available);
+  EXPECT_EQ(r.visibility.ambiguous, 1u);
+  EXPECT_EQ(r.visibility.hard, 1u);
+}
+
+TEST_F(CompareTest, WithoutUncertaintyEveryMismatchIsHard) {
+  Frame plain = ref_;
+  plain.edge_dist.clear();
+  plain.depth_gap.clear();
+  ref_.edge_dist[ref_.index(80, 30)] = 0.0f;
+  gl_.id[ref_.index(80, 30)] = 0;
+  const PairResult r = compareFrames(plain, gl_, plain, tol_);
+  EXPECT_FALSE(r.visibility.uncertainty_available);
+  EXPECT_EQ(r.visibility.hard, 1u);
+}
+
+TEST_F(CompareTest, DepthTieExcusesWrongPrimitiveOnlyWithinTheDepthTolerance) {
+  const std::size_t tie = ref_.index(80, 30);
+  const std::size_t clear_win = ref_.index(90, 40);
+  ref_.depth_gap[tie] = 0.5f;
+  ref_.depth_gap[clear_win] = 1000.0f;
+  gl_.id[tie] = 3;
+  gl_.id[clear_win] = 3;
+  const PairResult r = compare();
+  EXPECT_EQ(r.visibility.wrong_primitive, 2u);
+  EXPECT_EQ(r.visibility.ambiguous, 1u);
+  EXPECT_EQ(r.visibility.ambiguous_by_depth_gap, 1u);
+  EXPECT_EQ(r.visibility.wrong_primitive_hard, 1u);
+  EXPECT_EQ(r.visibility.worst.x, 90);
+  // A gap is not an excuse for a missing pixel.
+  gl_.id[tie] = 0;
+  EXPECT_EQ(compare().visibility.missing_hard, 1u);
+}
+
+TEST_F(CompareTest, NonFiniteValuesAreCountedNeverCompared) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  gl_.color[gl_.index(75, 30) * 4 + 0] = nan;
+  gl_.color[gl_.index(76, 30) * 4 + 0] = nan;
+  gl_.color[gl_.index(77, 30) * 4 + 2] = -inf;
+  gl_.depth[gl_.index(78, 30)] = inf;
+  gl_.depth[gl_.index(79, 30)] = nan;
+  gl_.color[gl_.index(kEmptyBlock.x0, kEmptyBlock.y0) * 4 + 1] = inf;  // background: counted only
+  ref_.color[ref_.index(80, 31) * 4 + 3] = nan;
+  const PairResult r = compare();
+  EXPECT_EQ(r.nonfinite_actual.nan[0], 2u);
+  EXPECT_EQ(r.nonfinite_actual.inf[1], 1u);
+  EXPECT_EQ(r.nonfinite_actual.inf[2], 1u);
+  EXPECT_EQ(r.nonfinite_actual.inf[4], 1u);
+  EXPECT_EQ(r.nonfinite_actual.nan[4], 1u);
+  EXPECT_EQ(r.nonfinite_actual.total(), 6u);
+  EXPECT_EQ(r.nonfinite_expected.nan[3], 1u);
+  EXPECT_EQ(r.nonfinite_expected.total(), 1u);
+  EXPECT_EQ(r.shading.nonfinite, 4u);  // three actual pixels and one expected pixel
+  EXPECT_EQ(r.shading.over_fail, 4u);
+  EXPECT_EQ(r.shading.status, Status::Fail);
+  EXPECT_EQ(r.shading.max_abs, 0.0);  // the finite pixels still agree
+  EXPECT_EQ(r.shading.worst.y, 30);
+  EXPECT_EQ(r.shading.worst.x, 75);
+  EXPECT_EQ(r.depth.nonfinite, 2u);
+  EXPECT_EQ(r.depth.over_fail, 2u);
+  EXPECT_EQ(r.depth.max_steps, 0.0);
+  EXPECT_EQ(r.depth.worst.x, 78);
+  EXPECT_TRUE(std::isnan(r.depth.worst_steps));
+  EXPECT_EQ(r.status, Status::Fail);
+}
+
+TEST_F(CompareTest, ClassMapsHoldThePerPixelResults) {
+  constexpr int kN = 50;
+  forBlock(kBackBlock, [&](int x, int y) {
+    const std::size_t i = gl_.index(x, y);
+    gl_.depth[i] = static_cast<float>((std::nearbyint(ref_.depth[i] * kD24) + kN) / kD24);
+  });
+  const std::size_t missing = gl_.index(kBackBlock.x0 - 5, kBackBlock.y0);
+  gl_.id[missing] = 0;
+  gl_.color[gl_.index(60, 60) * 4 + 2] += 2.0f / 255.0f;
+  ClassMaps maps;
+  const PairResult with_maps = compare(&maps);
+  const PairResult without = compare();
+  EXPECT_EQ(with_maps.depth.over_tolerance, without.depth.over_tolerance);
+  EXPECT_EQ(with_maps.shading.max_abs, without.shading.max_abs);
+  ASSERT_EQ(maps.pixel_class.size(), static_cast<std::size_t>(kW * kH));
+  EXPECT_EQ(maps.pixel_class[missing], PixelClass::MissingHard);
+  EXPECT_EQ(maps.pixel_class[gl_.index(0, 0)], PixelClass::Background);
+  EXPECT_EQ(maps.pixel_class[gl_.index(kBackBlock.x0, kBackBlock.y0)], PixelClass::Match);
+  EXPECT_EQ(maps.depth_steps[gl_.index(kBackBlock.x0, kBackBlock.y0)], kN);
+  EXPECT_EQ(maps.depth_steps[gl_.index(kBackBlock.x0 - 1, kBackBlock.y0)], 0.0f);
+  EXPECT_NEAR(maps.shading_abs[gl_.index(60, 60)], 2.0f, 1e-4);
+  EXPECT_NEAR(maps.delta_rgba[gl_.index(60, 60) * 4 + 2], 2.0f, 1e-4);
+  EXPECT_GT(maps.depth_tolerance[gl_.index(60, 60)], tol_.depth.warn);
+}
+
+TEST_F(CompareTest, SizeMismatchIsAnInputErrorNamingBothSides) {
+  Frame small = testing::renderRects(128, 128, testing::defaultRects(128, 128));
+  small.meta["backend"] = "gl:small";
+  try {
+    compareFrames(ref_, small, ref_, tol_);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("256x256"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("gl:small"), std::string::npos) << e.what();
+  }
+  try {
+    checkSameSize(ref_, small, "out/ref", "out/gl");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("out/ref"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("out/gl"), std::string::npos) << e.what();
+  }
+  Frame broken = gl_;
+  broken.color.resize(10);
+  EXPECT_THROW(compareFrames(ref_, broken, ref_, tol_), InputError);
+  gl_.meta["subpixel_bits"] = "eight";
+  EXPECT_THROW(compare(), InputError);
+}
+
+TEST_F(CompareTest, FormatsComeFromFrameMeta) {
+  EXPECT_EQ(tolerancesForFrames(ref_, gl_).depth_format, DepthFormat::D24);
+  gl_.meta["color_format"] = "rgba8";
+  ref_.meta["color_format"] = "rgba8";
+  ref_.meta["depth_format"] = "d16";
+  gl_.meta.erase("depth_format");
+  const Tolerances t = tolerancesForFrames(ref_, gl_);
+  EXPECT_EQ(t.depth_format, DepthFormat::D16);
+  EXPECT_EQ(t.color_format, ColorFormat::RGBA8);
+  gl_.meta["depth_format"] = "d24";
+  EXPECT_THROW(tolerancesForFrames(ref_, gl_), InputError);
+  gl_.meta["depth_format"] = "d99";
+  ref_.meta.erase("depth_format");
+  EXPECT_THROW(tolerancesForFrames(ref_, gl_), InputError);
+}
+
+TEST(CompareEdgeCases, DegenerateFramesNeverCrash) {
+  const float clear[4] = {0, 0, 0, 0};
+  const Tolerances tol = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F);
+  Frame empty;
+  empty.allocate(0, 0, clear, 1.0f, true);
+  PairResult r = compareFrames(empty, empty, empty, tol);
+  EXPECT_EQ(r.status, Status::Pass);
+  EXPECT_EQ(r.pixels, 0u);
+
+  Frame one;
+  one.allocate(1, 1, clear, 1.0f, true);
+  one.id[0] = 0xFFFFFFFFu;
+  one.depth[0] = 0.5f;
+  Frame other = one;
+  other.depth[0] = 1e30f;  // absurd but finite
+  other.color[0] = -1e30f;
+  one.edge_dist[0] = std::numeric_limits<float>::quiet_NaN();
+  one.depth_gap[0] = std::numeric_limits<float>::quiet_NaN();
+  ClassMaps maps;
+  r = compareFrames(one, other, one, tol, &maps);
+  EXPECT_EQ(r.depth.slope_unknown, 1u);  // a one-pixel triangle has no neighbours
+  EXPECT_EQ(r.depth.status, Status::Fail);
+  EXPECT_EQ(r.shading.status, Status::Fail);
+  other.id[0] = 0;
+  r = compareFrames(one, other, one, tol);
+  EXPECT_EQ(r.visibility.hard, 1u);  // NaN edge_dist excuses nothing
+  other = one;
+  other.id[0] = 2;
+  r = compareFrames(one, other, one, tol);
+  EXPECT_EQ(r.visibility.wrong_primitive_hard, 1u);  // NaN depth_gap excuses nothing
+
+  // Every value NaN: counted, classified, no crash.
+  Frame nan_frame = one;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::fill(nan_frame.color.begin(), nan_frame.color.end(), nan);
+  std::fill(nan_frame.depth.begin(), nan_frame.depth.end(), nan);
+  r = compareFrames(one, nan_frame, one, tol);
+  EXPECT_EQ(r.nonfinite_actual.total(), 5u);
+  EXPECT_EQ(r.status, Status::Fail);
+}
+
+}  // namespace
+}  // namespace rc
