@@ -24,7 +24,7 @@ glm::dvec3 safeNormalize(const glm::dvec3& v) {
 double specularPower(double base, double shininess) {
   if (shininess == 0.0) return 1.0;  // max(0, x)^0 = 1, including pow(0, 0)
   if (!(base > 0.0)) return 0.0;
-  if (shininess > 0.0 && shininess <= 1024.0 && std::floor(shininess) == shininess) {
+  if (shininess > 0.0 && shininess <= 128.0 && std::floor(shininess) == shininess) {
     auto e = static_cast<unsigned>(shininess);
     double result = 1.0;
     double square = base;

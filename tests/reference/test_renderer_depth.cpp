@@ -1,0 +1,180 @@
+// Depth quantization per format against hand-computed values, the depth test, and the
+// uncertainty channels (depth_gap, edge_dist) against analytic values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "reference/fragment_ops.h"
+#include "reference/reference_renderer.h"
+#include "tests/reference/test_scenes.h"
+
+namespace rc {
+namespace {
+
+// A full-viewport rectangle at window depth 1 - z (test::windowScene).
+Frame renderPlane(DepthFormat format, float z) {
+  Scene s = test::windowScene(8, 8);
+  s.state.depth_format = format;
+  test::addRect(s, -1, -1, 9, 9, z);
+  return renderReference(s);
+}
+
+TEST(DepthQuantization, UnormRoundsToNearestEvenAtHandComputedValues) {
+  struct Case {
+    float z_world;       // window z = 1 - z_world, exact for these dyadic values
+    double q16, q24;     // hand-computed round-half-even(zw * (2^b - 1))
+  };
+  const Case cases[] = {
+      {0.75f, 16384.0, 4194304.0},    // zw 0.25:  16383.75 -> 16384, 4194303.75 -> 4194304
+      {0.6875f, 20480.0, 5242880.0},  // zw 0.3125: 20479.6875, 5242879.6875 (round up)
+      {0.25f, 49151.0, 12582911.0},   // zw 0.75:  49151.25, 12582911.25 (round down)
+      {0.5f, 32768.0, 8388608.0},     // zw 0.5:   32767.5 -> 32768, 8388607.5 -> 8388608 (tie, even)
+      {1.0f, 0.0, 0.0},               // zw 0 (the near plane)
+  };
+  for (const Case& c : cases) {
+    const Frame f16 = renderPlane(DepthFormat::D16, c.z_world);
+    const Frame f24 = renderPlane(DepthFormat::D24, c.z_world);
+    EXPECT_EQ(f16.depth[f16.index(3, 4)], static_cast<float>(c.q16 / 65535.0)) << c.z_world;
+    EXPECT_EQ(f24.depth[f24.index(3, 4)], static_cast<float>(c.q24 / 16777215.0)) << c.z_world;
+  }
+}
+
+TEST(DepthQuantization, Float32StoresTheFloatOfTheWindowDepth) {
+  // world z = 0.9f -> window z = 1 - 0.89999997615814209 = 0.10000002384185791 (exact).
+  const Frame f = renderPlane(DepthFormat::D32F, 0.9f);
+  EXPECT_EQ(f.depth[f.index(0, 0)], 0.10000002384185791f);
+  EXPECT_EQ(renderPlane(DepthFormat::D32F, 0.75f).depth[5], 0.25f);
+}
+
+TEST(DepthQuantization, KeysOrderLikeStoredValuesAndRoundTrip) {
+  using ref::depthKey;
+  using ref::storedDepth;
+  for (DepthFormat fmt : {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F}) {
+    double prev = -1.0;
+    std::uint32_t prev_key = 0;
+    for (int i = 0; i <= 1000; ++i) {
+      const double z = i / 1000.0;
+      const std::uint32_t k = depthKey(z, fmt);
+      const double stored = storedDepth(k, fmt);
+      EXPECT_NEAR(stored, z, fmt == DepthFormat::D16 ? 0.5 / 65535 : 0.5 / 16777215 + 1e-9);
+      if (i > 0) {
+        EXPECT_EQ(stored > prev, k > prev_key);
+      }
+      prev = stored;
+      prev_key = k;
+    }
+  }
+  EXPECT_EQ(ref::clampDepth(-0.0), 0.0);
+  EXPECT_FALSE(std::signbit(ref::clampDepth(-0.0)));
+  EXPECT_EQ(ref::clampDepth(std::nan("")), 0.0);
+  EXPECT_EQ(ref::clampDepth(1.5), 1.0);
+}
+
+TEST(DepthTest, LessKeepsTheFirstOfEqualDepthsAndTheNearest) {
+  Scene s = test::windowScene(8, 8);
+  test::addRect(s, 0, 0, 8, 8, 0.5f);   // ids 1, 2
+  test::addRect(s, 0, 0, 8, 8, 0.5f);   // ids 3, 4: equal depth, LESS fails
+  test::addRect(s, 0, 0, 4, 8, 0.25f);  // ids 5, 6: farther, fails
+  test::addRect(s, 4, 0, 8, 8, 0.75f);  // ids 7, 8: nearer, passes on the right half
+  const Frame f = renderReference(s);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const std::uint32_t id = f.id[f.index(x, y)];
+      if (x < 4)
+        EXPECT_TRUE(id == 1 || id == 2) << id;
+      else
+        EXPECT_TRUE(id == 7 || id == 8) << id;
+    }
+  s.state.depth_test = false;  // ALWAYS: the last drawn wins
+  const Frame g = renderReference(s);
+  EXPECT_TRUE(g.id[g.index(1, 1)] == 5 || g.id[g.index(1, 1)] == 6);
+  EXPECT_EQ(g.depth[g.index(1, 1)], static_cast<float>(std::round(0.75 * 16777215.0) / 16777215.0));
+}
+
+TEST(DepthGap, TwoParallelPlanesAKnownNumberOfStepsApart) {
+  for (DepthFormat fmt : {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F}) {
+    Scene s = test::windowScene(8, 8);
+    s.state.depth_format = fmt;
+    // Window depths 0.5 and 0.5 - 10 * 2^-24 (world z = 1 - window z, exact in float).
+    test::addRect(s, 0, 0, 8, 8, 0.5f);
+    test::addRect(s, 0, 0, 8, 4, 0.5f + 10.0f / 16777216.0f);
+    test::addRect(s, 0, 0, 8, 2, 0.25f);  // a third, farther plane on the bottom rows
+    const Frame f = renderReference(s);
+    const double steps = ref::depthStepsPerUnit(fmt);
+    const double expected = 10.0 / 16777216.0 * steps;  // d24: 9.9999994, d32f: 10
+    for (int y = 0; y < 8; ++y) {
+      const float gap = f.depth_gap[f.index(3, y)];
+      if (y < 4)
+        EXPECT_EQ(gap, std::numeric_limits<float>::infinity()) << y;  // one plane only
+      else
+        EXPECT_NEAR(gap, expected, 1e-6 * expected) << toString(fmt) << " row " << y;
+    }
+  }
+}
+
+// Distance from (px, py) to segment a-b: the test's own oracle.
+double segDist(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
+  const glm::dvec2 d = b - a;
+  const double t = std::clamp(glm::dot(p - a, d) / glm::dot(d, d), 0.0, 1.0);
+  return glm::length(p - (a + t * d));
+}
+
+TEST(EdgeDist, DistanceToEdgeSegmentsCappedAtOne) {
+  Scene s = test::windowScene(16, 16);
+  test::addTriangle(s, {3.25f, 1.0f, 0.5f}, {14.0f, 1.0f, 0.5f}, {3.25f, 15.0f, 0.5f});
+  const Frame f = renderReference(s);
+  auto at = [&](int x, int gl_y) { return f.edge_dist[f.index(x, 15 - gl_y)]; };
+  EXPECT_FLOAT_EQ(at(3, 8), 0.25f);  // centre 3.5: 0.25 right of x = 3.25
+  EXPECT_FLOAT_EQ(at(2, 8), 0.75f);
+  EXPECT_FLOAT_EQ(at(4, 8), 1.0f);   // 1.25 away: capped
+  EXPECT_FLOAT_EQ(at(8, 1), 0.5f);   // centre y 1.5 above the bottom edge y = 1
+  // Below-left of the vertex (3.25, 1): distance to the segment end, not to the line.
+  EXPECT_FLOAT_EQ(at(2, 0), static_cast<float>(std::hypot(0.75, 0.5)));
+  EXPECT_FLOAT_EQ(at(0, 0), 1.0f);
+  const Frame none = renderReference(s, ReferenceOptions{8, false, false});
+  EXPECT_FALSE(none.hasUncertainty());
+}
+
+// A triangle cut by the near plane becomes a quadrilateral drawn as a fan; edge_dist
+// follows the four boundary edges and ignores the fan's internal diagonal.
+TEST(EdgeDist, ClippedPolygonBoundaryOnlyNotTheFanDiagonal) {
+  Scene s = test::windowScene(64, 64);
+  // Window depth 1 - z: the vertex at z = 1.5 lies in front of the near plane (depth < 0),
+  // both edges to it are cut where z = 1, at y = 32.
+  test::addTriangle(s, {4, 4, 0.5f}, {60, 4, 0.5f}, {32, 60, 1.5f});
+  const Frame f = renderReference(s);
+  const glm::dvec2 A(4, 4), B(60, 4), P(46, 32), Q(18, 32);
+  int near_diagonal = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const glm::dvec2 c(x + 0.5, 63 - y + 0.5);
+      const double d = std::min({segDist(c, A, B), segDist(c, B, P), segDist(c, P, Q),
+                                 segDist(c, Q, A), 1.0});
+      ASSERT_NEAR(f.edge_dist[f.index(x, y)], d, 1e-6) << x << "," << y;
+      const bool inside = c.y > 4 && c.y < 32 && segDist(c, A, P) < 0.5 && d == 1.0;
+      near_diagonal += inside;
+      // Coverage of the trapezoid (no centre lies on its edges here).
+      const bool covered = c.y > 4 && c.y < 32 && (c.x - 4) * 28 > (c.y - 4) * 14 &&
+                           (60 - c.x) * 28 > (c.y - 4) * 14;
+      ASSERT_EQ(f.id[f.index(x, y)] != 0, covered) << x << "," << y;
+    }
+  EXPECT_GT(near_diagonal, 10);  // pixels within 0.5 px of the diagonal A-P, edge_dist 1
+}
+
+TEST(EdgeDist, CulledTrianglesCountOnlyWhenTheCullDecisionCouldFlip) {
+  Scene s = test::windowScene(16, 16);
+  s.state.cull = Cull::Back;
+  test::addTriangle(s, {2, 2, 0.5f}, {2, 14, 0.5f}, {14, 2, 0.5f});  // clockwise: culled
+  // A clockwise sliver 1/64 px thick: culled too, but its area could flip sign.
+  test::addTriangle(s, {2, 8.5f, 0.5f}, {14, 8.5f + 1.0f / 64, 0.5f}, {14, 8.5f, 0.5f});
+  const Frame f = renderReference(s);
+  for (std::uint32_t id : f.id) EXPECT_EQ(id, 0u);
+  const auto at = [&](int x, int gl_y) { return f.edge_dist[f.index(x, 15 - gl_y)]; };
+  EXPECT_FLOAT_EQ(at(1, 4), 1.0f);   // 0.5 from the culled big triangle's edge x = 2: ignored
+  EXPECT_NEAR(at(8, 8), 0.0, 1e-6);  // centre (8.5, 8.5) lies on the sliver's bottom edge
+  EXPECT_NEAR(at(8, 9), 1.0 - (6.5 / 12.0) / 64.0, 1e-3);  // below its top edge
+}
+
+}  // namespace
+}  // namespace rc
