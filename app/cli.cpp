@@ -38,6 +38,32 @@ int runCli(int argc, char** argv) {
   list_cmd->add_flag("--json", list.json, "Print JSON");
   list_cmd->add_flag("--markdown", list.markdown, "Print a Markdown table");
 
+  CompareArgs compare;
+  CLI::App* compare_cmd =
+      app.add_subcommand("compare", "Compare two frame folders written by `render`");
+  compare_cmd->add_option("expected", compare.expected, "Expected frame folder")->required();
+  compare_cmd->add_option("actual", compare.actual, "Actual frame folder")->required();
+  compare_cmd->add_option("--out,-o", compare.out, "Report folder")->required();
+  compare_cmd->add_option("--uncertainty", compare.uncertainty,
+                          "Reference frame folder whose edge_dist/depth_gap classify the pair "
+                          "(default: whichever side has them)");
+  compare_cmd->add_option("--tolerance,-t", compare.tolerance,
+                          "Override a threshold: CLASS.KEY=VALUE (visibility|depth|shading . "
+                          "warn|fail, depth.slope_factor); repeatable");
+
+  RunArgs run;
+  CLI::App* run_cmd = app.add_subcommand(
+      "run", "Render fixtures with several backends and compare each with --against");
+  run_cmd->add_option("inputs", run.inputs, "Fixture files or folders (default: the catalog)");
+  run_cmd->add_option("--backends,-b", run.backends, "Backend SPECs, comma separated")
+      ->required()
+      ->delimiter(',');
+  run_cmd->add_option("--against,-a", run.against, "SPEC every backend is compared with")
+      ->capture_default_str();
+  run_cmd->add_option("--out,-o", run.out, "Report folder")->required();
+  run_cmd->add_option("--tolerance,-t", run.tolerance, "As for compare; repeatable");
+  run_cmd->add_option("--jobs,-j", run.jobs, "Renders at a time (default: one per core)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -48,6 +74,8 @@ int runCli(int argc, char** argv) {
   try {
     if (*render_cmd) return renderCommand(render);
     if (*list_cmd) return listCommand(list);
+    if (*compare_cmd) return compareCommand(compare);
+    if (*run_cmd) return runCommand(run);
   } catch (const InputError& e) {
     std::cerr << "rastercheck: error: " << e.what() << '\n';
     return kExitInput;

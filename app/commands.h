@@ -23,3 +23,31 @@ struct ListArgs {
 int listCommand(const ListArgs& args);
 
 }  // namespace rc
+
+namespace rc {
+
+// `--tolerance CLASS.KEY=VALUE` as typed on the command line, e.g. "depth.fail=8",
+// "shading.warn=1.5", "visibility.fail=20", "depth.slope_factor=2".
+struct ToleranceOverrides;
+void parseToleranceArgs(const std::vector<std::string>& args, ToleranceOverrides& out);
+
+struct CompareArgs {
+  std::filesystem::path expected;
+  std::filesystem::path actual;
+  std::filesystem::path uncertainty;  // empty: the expected (or actual) frame's channels
+  std::filesystem::path out;
+  std::vector<std::string> tolerance;
+};
+int compareCommand(const CompareArgs& args);
+
+struct RunArgs {
+  std::vector<std::filesystem::path> inputs;  // fixtures or folders (default: the catalog)
+  std::vector<std::string> backends;
+  std::string against = "ref";
+  std::filesystem::path out;
+  std::vector<std::string> tolerance;
+  int jobs = 0;  // 0: one per core
+};
+int runCommand(const RunArgs& args);
+
+}  // namespace rc

@@ -42,7 +42,8 @@ pid_t spawn(const Job& job) {
 
 }  // namespace
 
-void runJobs(std::vector<Job>& jobs, int parallel, const std::function<void(std::size_t)>& on_done) {
+void runJobs(std::vector<Job>& jobs, int parallel,
+             const std::function<void(std::size_t)>& on_done) {
   parallel = std::max(1, parallel);
   std::map<pid_t, std::size_t> running;
   std::size_t next = 0;

@@ -10,10 +10,10 @@
 namespace rc {
 
 struct Job {
-  std::vector<std::string> argv;     // argv[0] is the program
-  std::filesystem::path log;         // stdout and stderr of the child go here
-  int exit_code = -1;                // set when finished; 128+N when killed by signal N
-  std::string signal_name;           // non-empty when killed by a signal
+  std::vector<std::string> argv;  // argv[0] is the program
+  std::filesystem::path log;      // stdout and stderr of the child go here
+  int exit_code = -1;             // set when finished; 128+N when killed by signal N
+  std::string signal_name;        // non-empty when killed by a signal
 };
 
 // Runs the jobs, at most `parallel` at a time, calling on_done(index) as each finishes
