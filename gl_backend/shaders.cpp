@@ -29,10 +29,10 @@ uniform vec3 u_material_diffuse;
 uniform vec3 u_material_specular;
 uniform float u_shininess;
 
-// normalize() with zero staying zero (a zero normal lights nothing).
+// normalize() with zero (or a non-finite length) staying zero: a zero normal lights nothing.
 vec3 safeNormalize(vec3 v) {
   float len = length(v);
-  return len > 0.0 ? v / len : vec3(0.0);
+  return (len > 0.0 && !isinf(len)) ? v / len : vec3(0.0);
 }
 
 // max(0, x)^s with pow(0, 0) := 1 (GLSL leaves pow(0, y <= 0) undefined).
@@ -56,7 +56,8 @@ void shadePoint(vec3 p, vec3 n, out vec3 ambient_diffuse, out vec3 specular) {
     } else {
       vec3 to_light = u_light_position[i] - p;
       float r = length(to_light);
-      l = safeNormalize(to_light);
+      if (!(r > 0.0)) continue;  // light at the shaded point: contributes nothing
+      l = to_light / r;
       if (u_attenuation == 1) att = 1.0 / r;
       else if (u_attenuation == 2) att = 1.0 / (r * r);
     }
