@@ -4,6 +4,8 @@
 #include <cmath>
 #include <memory>
 
+#include "reference/reference_renderer.h"
+
 namespace rc::test {
 
 Scene windowScene(int width, int height) {
@@ -206,6 +208,33 @@ std::vector<NamedScene> featureScenes() {
       addTriangle(s, a, b, c);
     }
     out.push_back({"window_random", s});
+  }
+  return out;
+}
+
+namespace {
+template <class T>
+void append(std::string& out, const std::vector<T>& v) {
+  out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+}  // namespace
+
+std::string frameBytes(const Frame& frame) {
+  std::string out;
+  append(out, frame.color);
+  append(out, frame.depth);
+  append(out, frame.id);
+  append(out, frame.edge_dist);
+  append(out, frame.depth_gap);
+  return out;
+}
+
+std::string featureCorpusBytes() {
+  std::string out;
+  for (const NamedScene& s : featureScenes()) {
+    out += frameBytes(renderReference(s.scene));
+    out += frameBytes(renderReference(s.scene, ReferenceOptions{4, false, true}));
+    out += frameBytes(renderReference(s.scene, ReferenceOptions{12, true, true}));
   }
   return out;
 }

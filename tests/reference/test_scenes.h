@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "fixtures/frame.h"
 #include "fixtures/scene.h"
 
 namespace rc::test {
@@ -46,5 +47,13 @@ struct NamedScene {
   Scene scene;
 };
 std::vector<NamedScene> featureScenes();
+
+// The pixel channels of a frame as raw bytes (colour, depth, id, edge_dist, depth_gap), for
+// bit-exact comparisons.
+std::string frameBytes(const Frame& frame);
+
+// Renders every feature scene with a few option sets and concatenates frameBytes(): what
+// the cross-optimisation-level dump tools write.
+std::string featureCorpusBytes();
 
 }  // namespace rc::test
