@@ -7,6 +7,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <fmt/format.h>
@@ -64,24 +65,86 @@ void checkBuffers(const Frame& f, const char* role, bool need_color) {
     throw InputError(fmt::format("{}: depth_gap does not match its size", frameLabel(f, role)));
 }
 
-// Counts NaN and Inf per channel in one row; a cheap vectorisable scan first, since
-// almost every row has none.
-bool countRowNonFinite(const float* color, const float* depth, int width, NonFiniteCounts& counts) {
-  unsigned bad = 0;
-  for (int k = 0; k < width * 4; ++k) bad += isNonFinite(color[k]) ? 1u : 0u;
-  for (int k = 0; k < width; ++k) bad += isNonFinite(depth[k]) ? 1u : 0u;
-  if (bad == 0) return false;
-  auto tally = [&](float v, int channel) {
-    if (std::isnan(v))
-      ++counts.nan[channel];
-    else if (std::isinf(v))
-      ++counts.inf[channel];
-  };
-  for (int x = 0; x < width; ++x) {
-    for (int c = 0; c < 4; ++c) tally(color[x * 4 + c], c);
-    tally(depth[x], 4);
+// Four pixels at a time with GCC/Clang vector extensions: portable, and 128-bit so that
+// x86-64's SSE2 baseline runs every operation as one instruction.
+using V4f = float __attribute__((vector_size(16)));
+using V4i = std::int32_t __attribute__((vector_size(16)));
+using V4u = std::uint32_t __attribute__((vector_size(16)));
+using V2d = double __attribute__((vector_size(16)));
+using V2l = std::int64_t __attribute__((vector_size(16)));
+
+template <typename V, typename T>
+inline V load(const T* p) {
+  V v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// Lane masks are 0 or -1.
+inline bool any(V4i m) {
+  const V4i h = m | __builtin_shufflevector(m, m, 2, 3, 0, 1);
+  return (h[0] | h[1]) != 0;
+}
+inline bool all(V4i m) { return !any(~m); }
+
+inline V4f absf(V4f v) { return reinterpret_cast<V4f>(reinterpret_cast<V4i>(v) & 0x7fffffff); }
+inline V2d absd(V2d v) {
+  return reinterpret_cast<V2d>(reinterpret_cast<V2l>(v) & 0x7fffffffffffffffLL);
+}
+inline V4f maxf(V4f a, V4f b) {
+  const V4i gt = a > b;
+  return reinterpret_cast<V4f>((gt & reinterpret_cast<V4i>(a)) | (~gt & reinterpret_cast<V4i>(b)));
+}
+inline V4i nonFiniteLanes(V4f v) { return (reinterpret_cast<V4i>(v) & 0x7f800000) == 0x7f800000; }
+// Largest lane (one pixel's R G B A).
+inline float lanesMax(V4f v) {
+  const V4f s1 = maxf(v, __builtin_shufflevector(v, v, 1, 0, 3, 2));
+  const V4f s2 = maxf(s1, __builtin_shufflevector(s1, s1, 2, 3, 0, 1));
+  return s2[0];
+}
+inline V2d lowHalf(V4f v) {
+  return __builtin_convertvector(__builtin_shufflevector(v, v, 0, 1), V2d);
+}
+inline V2d highHalf(V4f v) {
+  return __builtin_convertvector(__builtin_shufflevector(v, v, 2, 3), V2d);
+}
+
+// Small errors are by far the most common. Counting them in four interleaved tables (one
+// per pixel of a chunk) keeps back-to-back increments of one bin from waiting on each
+// other's store; the tables go into the ErrorHistogram at the end.
+class HotBins {
+ public:
+  static constexpr int kBins = 256;  // <= ErrorHistogram::kLinearBins
+  explicit HotBins(ErrorHistogram& h)
+      : h_(h), inverse_quantum_(1.0 / h.quantum()), counts_(4 * kBins, 0) {}
+  void add(int lane, double value) {
+    const double u = value * inverse_quantum_;
+    if (u < kBins) {
+      ++counts_[lane * kBins + static_cast<int>(u)];  // values are >= 0
+    } else {
+      h_.add(value);
+    }
   }
-  return true;
+  void flush() {
+    for (int b = 0; b < kBins; ++b) {
+      const std::uint64_t n = std::uint64_t{counts_[b]} + counts_[kBins + b] +
+                              counts_[2 * kBins + b] + counts_[3 * kBins + b];
+      if (n) h_.addToLinearBin(b, n);
+    }
+    std::fill(counts_.begin(), counts_.end(), 0u);
+  }
+
+ private:
+  ErrorHistogram& h_;
+  double inverse_quantum_;
+  std::vector<std::uint32_t> counts_;  // frames hold < 2^31 pixels: no overflow
+};
+
+void tally(float v, int channel, NonFiniteCounts& counts) {
+  if (std::isnan(v))
+    ++counts.nan[channel];
+  else if (std::isinf(v))
+    ++counts.inf[channel];
 }
 
 class Comparator {
@@ -93,8 +156,6 @@ class Comparator {
     quantized_color_ = tol.color_format == ColorFormat::RGBA8;
     have_uncertainty_ = u.hasUncertainty();
     band_ = r.visibility.band_px;
-    r_.depth.histogram = ErrorHistogram(quantized_depth_ ? 1.0 : 1.0 / 64.0, quantized_depth_);
-    r_.shading.histogram = ErrorHistogram(quantized_color_ ? 1.0 : 1.0 / 64.0, quantized_color_);
   }
 
   void run(ClassMaps* maps) {
@@ -109,16 +170,12 @@ class Comparator {
       maps->delta_rgba.assign(n * 4, 0.0f);
     }
     for (int y = 0; y < e_.height; ++y) {
-      const std::size_t row = static_cast<std::size_t>(y) * e_.width;
-      const bool bad_e =
-          countRowNonFinite(&e_.color[row * 4], &e_.depth[row], e_.width, r_.nonfinite_expected);
-      const bool bad_a =
-          countRowNonFinite(&a_.color[row * 4], &a_.depth[row], a_.width, r_.nonfinite_actual);
-      const bool finite = !bad_e && !bad_a;
       if (maps) {
-        finite ? runRow<true, true>(y, maps) : runRow<true, false>(y, maps);
+        runRange<true>(y, 0, e_.width, maps);
+      } else if (quantized_depth_) {
+        quantized_color_ ? runRowFast<true, true>(y) : runRowFast<true, false>(y);
       } else {
-        finite ? runRow<false, true>(y, maps) : runRow<false, false>(y, maps);
+        quantized_color_ ? runRowFast<false, true>(y) : runRowFast<false, false>(y);
       }
     }
     finish();
@@ -129,30 +186,49 @@ class Comparator {
     const double s = static_cast<double>(z) * step_scale_;
     return quantized_depth_ ? roundNearest(s) : s;
   }
+  // 8-bit error of one channel; rgba8 compares the stored 8-bit values.
+  float colorError(float a, float b) const {
+    if (!quantized_color_) return std::fabs(a - b) * 255.0f;
+    constexpr float kMagic = 12582912.0f;  // 1.5 * 2^23: round to nearest in float
+    return std::fabs(((a * 255.0f + kMagic) - kMagic) - ((b * 255.0f + kMagic) - kMagic));
+  }
 
-  template <bool kMaps, bool kRowFinite>
-  void runRow(int y, ClassMaps* maps) {
-    const int w = e_.width;
-    const std::size_t row = static_cast<std::size_t>(y) * w;
+  // The general path: any pixel, NaN/Inf, per-pixel maps. Pixels [x0, x1) of row y.
+  template <bool kMaps>
+  void runRange(int y, int x0, int x1, ClassMaps* maps) {
+    const std::size_t row = static_cast<std::size_t>(y) * e_.width;
     const std::uint32_t* ida = &e_.id[row];
     const std::uint32_t* idb = &a_.id[row];
     const float* za = &e_.depth[row];
     const float* zb = &a_.depth[row];
     const float* ca = &e_.color[row * 4];
     const float* cb = &a_.color[row * 4];
-    const float depth_warn = static_cast<float>(tol_.depth.warn);
+    const double depth_warn = tol_.depth.warn;
     const float shade_warn = static_cast<float>(tol_.shading.warn);
     const float shade_fail = static_cast<float>(tol_.shading.fail);
     double shade_sum = 0.0;
     double shade_sq = 0.0;
     double depth_sum = 0.0;
-    for (int x = 0; x < w; ++x) {
+    for (int x = x0; x < x1; ++x) {
       const std::uint32_t a = ida[x];
       const std::uint32_t b = idb[x];
       const std::size_t i = row + x;
+      const float* pa = ca + x * 4;
+      const float* pb = cb + x * 4;
+      bool depth_finite = !isNonFinite(za[x]) && !isNonFinite(zb[x]);
+      bool color_finite = true;
+      for (int c = 0; c < 4; ++c)
+        color_finite = color_finite && !isNonFinite(pa[c]) && !isNonFinite(pb[c]);
+      if (!depth_finite || !color_finite) {
+        for (int c = 0; c < 4; ++c) {
+          tally(pa[c], c, r_.nonfinite_expected);
+          tally(pb[c], c, r_.nonfinite_actual);
+        }
+        tally(za[x], 4, r_.nonfinite_expected);
+        tally(zb[x], 4, r_.nonfinite_actual);
+      }
       if (kMaps) {
-        for (int c = 0; c < 4; ++c)
-          maps->delta_rgba[i * 4 + c] = (cb[x * 4 + c] - ca[x * 4 + c]) * 255.0f;
+        for (int c = 0; c < 4; ++c) maps->delta_rgba[i * 4 + c] = (pb[c] - pa[c]) * 255.0f;
       }
       if (a != b) {
         const PixelClass cls = classifyMismatch(x, y, a, b);
@@ -164,12 +240,9 @@ class Comparator {
       if (kMaps) maps->pixel_class[i] = PixelClass::Match;
 
       // Depth.
-      if (!kRowFinite && (isNonFinite(za[x]) || isNonFinite(zb[x]))) {
+      if (!depth_finite) {
         depthNonFinite(x, y);
-        if (kMaps) {
-          maps->depth_steps[i] = std::numeric_limits<float>::quiet_NaN();
-          maps->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allowance(x, y));
-        }
+        if (kMaps) maps->depth_steps[i] = std::numeric_limits<float>::quiet_NaN();
       } else {
         const double dz = std::fabs(depthSteps(za[x]) - depthSteps(zb[x]));
         depth_sum += dz;
@@ -179,30 +252,18 @@ class Comparator {
           depth_max_at_ = i;
         }
         if (dz > depth_warn) depthOverBase(x, y, dz);
-        if (kMaps) {
-          maps->depth_steps[i] = static_cast<float>(dz);
-          maps->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allowance(x, y));
-        }
+        if (kMaps) maps->depth_steps[i] = static_cast<float>(dz);
       }
+      if (kMaps) maps->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allowance(x, y));
 
       // Shading.
-      const float* pa = ca + x * 4;
-      const float* pb = cb + x * 4;
-      if (!kRowFinite &&
-          (isNonFinite(pa[0]) || isNonFinite(pa[1]) || isNonFinite(pa[2]) || isNonFinite(pa[3]) ||
-           isNonFinite(pb[0]) || isNonFinite(pb[1]) || isNonFinite(pb[2]) || isNonFinite(pb[3]))) {
+      if (!color_finite) {
         shadingNonFinite(i);
         if (kMaps) maps->shading_abs[i] = std::numeric_limits<float>::quiet_NaN();
         continue;
       }
       float d[4];
-      if (quantized_color_) {
-        for (int c = 0; c < 4; ++c)
-          d[c] = static_cast<float>(
-              std::fabs(roundNearest(pa[c] * 255.0) - roundNearest(pb[c] * 255.0)));
-      } else {
-        for (int c = 0; c < 4; ++c) d[c] = std::fabs(pa[c] - pb[c]) * 255.0f;
-      }
+      for (int c = 0; c < 4; ++c) d[c] = colorError(pa[c], pb[c]);
       const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
       shade_sum += (d[0] + d[1]) + (d[2] + d[3]);
       shade_sq += (d[0] * d[0] + d[1] * d[1]) + (d[2] * d[2] + d[3] * d[3]);
@@ -221,6 +282,132 @@ class Comparator {
     shade_sum_ += shade_sum;
     shade_sq_ += shade_sq;
     depth_sum_ += depth_sum;
+  }
+
+  // The fast path for a row: chunks of four pixels that all show the same primitive on
+  // both sides with finite values go through vector code; background chunks are only
+  // checked for NaN/Inf; any other chunk, and the row's tail, takes runRange. Both paths
+  // compute every per-pixel value with the same operations, so results agree exactly
+  // (sums up to their order of addition).
+  template <bool kQuantizedDepth, bool kQuantizedColor>
+  void runRowFast(int y) {
+    const int w = e_.width;
+    const std::size_t row = static_cast<std::size_t>(y) * w;
+    const std::uint32_t* ida = &e_.id[row];
+    const std::uint32_t* idb = &a_.id[row];
+    const float* za = &e_.depth[row];
+    const float* zb = &a_.depth[row];
+    const float* ca = &e_.color[row * 4];
+    const float* cb = &a_.color[row * 4];
+    const double depth_warn = tol_.depth.warn;
+    const float shade_warn = static_cast<float>(tol_.shading.warn);
+    const float shade_fail = static_cast<float>(tol_.shading.fail);
+    const double scale = step_scale_;
+    constexpr double kMagic = 6755399441055744.0;
+    constexpr float kMagicF = 12582912.0f;
+    V2d depth_sum = {};
+    V2d shade_sum = {};
+    V2d shade_sq = {};
+    V4f color_sum = {};  // per channel, over at most 16 pixels, then into the doubles
+    V4f color_sq = {};
+    int summed = 0;
+    auto flushColorSums = [&] {
+      shade_sum += lowHalf(color_sum) + highHalf(color_sum);
+      shade_sq += lowHalf(color_sq) + highHalf(color_sq);
+      color_sum = V4f{};
+      color_sq = V4f{};
+      summed = 0;
+    };
+    V4f channel_max = {};
+    std::uint64_t matched = 0;
+    std::uint64_t over_warn = 0;
+    std::uint64_t over_fail = 0;
+    double depth_max = depth_max_;
+    float shade_max = shade_max_;
+    int x = 0;
+    for (; x + 4 <= w; x += 4) {
+      const V4u a = load<V4u>(ida + x);
+      const V4u b = load<V4u>(idb + x);
+      const V4f z_a = load<V4f>(za + x);
+      const V4f z_b = load<V4f>(zb + x);
+      V4f c_a[4];
+      V4f c_b[4];
+      V4i bad = nonFiniteLanes(z_a) | nonFiniteLanes(z_b);
+      for (int k = 0; k < 4; ++k) {
+        c_a[k] = load<V4f>(ca + (x + k) * 4);
+        c_b[k] = load<V4f>(cb + (x + k) * 4);
+        bad |= nonFiniteLanes(c_a[k]) | nonFiniteLanes(c_b[k]);
+      }
+      const V4i same = reinterpret_cast<V4i>(a == b);
+      const V4i drawn = reinterpret_cast<V4i>(a != 0u);
+      if (any(bad) || !all(same & drawn)) {
+        if (any(bad) || any(drawn | ~same)) {
+          depth_max_ = depth_max;
+          shade_max_ = shade_max;
+          runRange<false>(y, x, x + 4, nullptr);
+          depth_max = depth_max_;
+          shade_max = shade_max_;
+        }
+        continue;  // else background on both sides
+      }
+      matched += 4;
+
+      // Depth, in double like runRange.
+      V2d sa[2] = {lowHalf(z_a) * scale, highHalf(z_a) * scale};
+      V2d sb[2] = {lowHalf(z_b) * scale, highHalf(z_b) * scale};
+      if (kQuantizedDepth) {
+        for (int h = 0; h < 2; ++h) {
+          sa[h] = (sa[h] + kMagic) - kMagic;
+          sb[h] = (sb[h] + kMagic) - kMagic;
+        }
+      }
+      const V2d dz01 = absd(sa[0] - sb[0]);
+      const V2d dz23 = absd(sa[1] - sb[1]);
+      depth_sum += dz01 + dz23;
+      const double dz[4] = {dz01[0], dz01[1], dz23[0], dz23[1]};
+      for (int l = 0; l < 4; ++l) {
+        depth_hot_.add(l, dz[l]);
+        if (dz[l] > depth_max) {
+          depth_max = dz[l];
+          depth_max_at_ = row + x + l;
+        }
+        if (dz[l] > depth_warn) depthOverBase(x + l, y, dz[l]);
+      }
+
+      // Shading: one pixel's R G B A per vector.
+      for (int k = 0; k < 4; ++k) {
+        V4f d;
+        if (kQuantizedColor) {
+          d = absf(((c_a[k] * 255.0f + kMagicF) - kMagicF) -
+                   ((c_b[k] * 255.0f + kMagicF) - kMagicF));
+        } else {
+          d = absf(c_a[k] - c_b[k]) * 255.0f;
+        }
+        color_sum += d;
+        color_sq += d * d;
+        channel_max = maxf(channel_max, d);
+        const float e = lanesMax(d);
+        shade_hot_.add(k, e);
+        over_warn += e > shade_warn ? 1 : 0;
+        over_fail += e > shade_fail ? 1 : 0;
+        if (e > shade_max) {
+          shade_max = e;
+          shade_max_at_ = row + x + k;
+        }
+      }
+      if ((summed += 4) == 16) flushColorSums();
+    }
+    flushColorSums();
+    depth_max_ = depth_max;
+    shade_max_ = shade_max;
+    vis_match_ += matched;
+    r_.shading.over_tolerance += over_warn;
+    r_.shading.over_fail += over_fail;
+    depth_sum_ += depth_sum[0] + depth_sum[1];
+    shade_sum_ += shade_sum[0] + shade_sum[1];
+    shade_sq_ += shade_sq[0] + shade_sq[1];
+    for (int c = 0; c < 4; ++c) shade_max_rgba_[c] = std::max(shade_max_rgba_[c], channel_max[c]);
+    if (x < w) runRange<false>(y, x, w, nullptr);
   }
 
   // Local depth slope of the uncertainty frame at (x, y) in steps/px, from same-id
@@ -337,6 +524,8 @@ class Comparator {
   }
 
   void finish() {
+    depth_hot_.flush();
+    shade_hot_.flush();
     VisibilityStats& v = r_.visibility;
     auto count = [&](PixelClass c) { return class_counts_[static_cast<int>(c)]; };
     v.missing = count(PixelClass::MissingAmbiguous) + count(PixelClass::MissingHard);
@@ -423,6 +612,8 @@ class Comparator {
   std::size_t shade_max_at_ = 0;
   std::size_t shade_nonfinite_at_ = 0;
   float shade_max_rgba_[4] = {};
+  HotBins depth_hot_{r_.depth.histogram};
+  HotBins shade_hot_{r_.shading.histogram};
 };
 
 }  // namespace
@@ -504,6 +695,11 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
   band.height = expected.height;
   r.visibility.band_px = snapBandPx(tolerances, band);
 
+  // Quantized formats have integer errors: exact percentiles (histogram.h).
+  const bool int_depth = tolerances.depth_format != DepthFormat::D32F;
+  const bool int_color = tolerances.color_format == ColorFormat::RGBA8;
+  r.depth.histogram = ErrorHistogram(int_depth ? 1.0 : 1.0 / 64.0, int_depth);
+  r.shading.histogram = ErrorHistogram(int_color ? 1.0 : 1.0 / 64.0, int_color);
   Comparator(expected, actual, uncertainty, tolerances, r).run(maps);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

@@ -19,6 +19,9 @@ class ErrorHistogram {
   ErrorHistogram(double quantum, bool exact_multiples);
 
   void add(double value) { ++bins_[binOf(value)]; }
+  // Adds `count` values v with floor(v / quantum) == bin < kLinearBins, for callers that
+  // count small values in their own tables first.
+  void addToLinearBin(int bin, std::uint64_t count) { bins_[bin] += count; }
   void merge(const ErrorHistogram& other);
   std::uint64_t count() const;
 
@@ -36,8 +39,9 @@ class ErrorHistogram {
   double quantum() const { return quantum_; }
   bool exactMultiples() const { return exact_; }
 
- private:
   static constexpr int kLinearBins = 1024;
+
+ private:
   static constexpr int kSubBins = 64;
   static constexpr int kOctaves = 64;
 

@@ -387,7 +387,10 @@ std::string matrix(const Report& report) {
 std::string reportHtml(const Report& report, const fs::path& report_dir) {
   const ReportSummary sum = report.summary();
   std::string gradient;
-  for (const Rgb8& c : heatColorStops(9)) gradient += (gradient.empty() ? "" : ",") + hex(c);
+  for (const Rgb8& c : heatColorStops(9)) {
+    if (!gradient.empty()) gradient += ',';
+    gradient += hex(c);
+  }
 
   std::string out = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">";
   out += fmt::format("<title>{} report</title><style>{}</style></head><body>",

@@ -4,6 +4,7 @@
 // running the comparator first.
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -475,6 +476,96 @@ TEST_F(CompareTest, FormatsComeFromFrameMeta) {
   ref_.meta.erase("depth_format");
   EXPECT_THROW(tolerancesForFrames(ref_, gl_), InputError);
 }
+
+// The comparator has a vector path (whole chunks of matching pixels, no maps) and a
+// general path (everything else, and every pixel when maps are asked for). On a noisy
+// frame with every class, an odd width and NaNs, both must give the same answer.
+void expectSameResults(const PairResult& fast, const PairResult& general) {
+  EXPECT_EQ(fast.status, general.status);
+  EXPECT_EQ(fast.visibility.missing_hard, general.visibility.missing_hard);
+  EXPECT_EQ(fast.visibility.extra_hard, general.visibility.extra_hard);
+  EXPECT_EQ(fast.visibility.wrong_primitive_hard, general.visibility.wrong_primitive_hard);
+  EXPECT_EQ(fast.visibility.ambiguous, general.visibility.ambiguous);
+  EXPECT_EQ(fast.depth.compared, general.depth.compared);
+  EXPECT_EQ(fast.depth.max_steps, general.depth.max_steps);
+  EXPECT_NEAR(fast.depth.mean_steps, general.depth.mean_steps, 1e-9 * general.depth.mean_steps);
+  EXPECT_EQ(fast.depth.p99_steps, general.depth.p99_steps);
+  EXPECT_EQ(fast.depth.over_tolerance, general.depth.over_tolerance);
+  EXPECT_EQ(fast.depth.over_fail, general.depth.over_fail);
+  EXPECT_EQ(fast.depth.nonfinite, general.depth.nonfinite);
+  EXPECT_EQ(fast.depth.worst.x, general.depth.worst.x);
+  EXPECT_EQ(fast.depth.worst.y, general.depth.worst.y);
+  EXPECT_EQ(fast.shading.compared, general.shading.compared);
+  EXPECT_EQ(fast.shading.max_abs, general.shading.max_abs);
+  for (int c = 0; c < 4; ++c)
+    EXPECT_EQ(fast.shading.max_abs_rgba[c], general.shading.max_abs_rgba[c]);
+  EXPECT_NEAR(fast.shading.mean_abs, general.shading.mean_abs, 1e-6 * general.shading.mean_abs);
+  EXPECT_NEAR(fast.shading.rmse, general.shading.rmse, 1e-6 * general.shading.rmse);
+  EXPECT_EQ(fast.shading.p99_abs, general.shading.p99_abs);
+  EXPECT_EQ(fast.shading.over_tolerance, general.shading.over_tolerance);
+  EXPECT_EQ(fast.shading.over_fail, general.shading.over_fail);
+  EXPECT_EQ(fast.shading.nonfinite, general.shading.nonfinite);
+  EXPECT_EQ(fast.shading.worst.x, general.shading.worst.x);
+  EXPECT_EQ(fast.shading.worst.y, general.shading.worst.y);
+  EXPECT_EQ(fast.nonfinite_actual.nan, general.nonfinite_actual.nan);
+  EXPECT_EQ(fast.nonfinite_actual.inf, general.nonfinite_actual.inf);
+  EXPECT_EQ(fast.nonfinite_expected.nan, general.nonfinite_expected.nan);
+  const auto hf = fast.shading.histogram.coarse(fast.shading.max_abs);
+  const auto hg = general.shading.histogram.coarse(general.shading.max_abs);
+  EXPECT_EQ(hf.counts, hg.counts);
+  EXPECT_EQ(fast.depth.histogram.count(), general.depth.histogram.count());
+}
+
+class FastPathTest : public ::testing::TestWithParam<std::tuple<DepthFormat, ColorFormat>> {};
+
+TEST_P(FastPathTest, VectorAndGeneralPathsAgree) {
+  const auto [depth_format, color_format] = GetParam();
+  constexpr int kOddW = 251;
+  constexpr int kOddH = 97;
+  Frame ref = testing::renderRects(kOddW, kOddH, testing::defaultRects(kOddW, kOddH));
+  const double steps = depthStepsPerUnit(depth_format);
+  auto requantize = [&](Frame& f) {
+    if (depth_format != DepthFormat::D32F)
+      for (float& z : f.depth) z = static_cast<float>(std::nearbyint(z * steps) / steps);
+    if (color_format == ColorFormat::RGBA8)
+      for (float& c : f.color) c = std::nearbyint(std::clamp(c, 0.0f, 1.0f) * 255.0f) / 255.0f;
+  };
+  requantize(ref);
+  Frame gl = ref;
+  gl.edge_dist.clear();
+  gl.depth_gap.clear();
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> dz(-30, 30);
+  std::uniform_real_distribution<float> dc(-6.0f / 255.0f, 6.0f / 255.0f);
+  std::uniform_int_distribution<int> pick(0, 400);
+  for (std::size_t i = 0; i < gl.pixelCount(); ++i) {
+    if (gl.id[i] == 0) continue;
+    gl.depth[i] = static_cast<float>(gl.depth[i] + dz(rng) / steps);
+    for (int c = 0; c < 4; ++c) gl.color[i * 4 + c] += dc(rng);
+    const int p = pick(rng);  // sprinkle every other class
+    if (p == 0) gl.id[i] = 0;
+    if (p == 1) gl.id[i] = gl.id[i] % 6 + 1;
+    if (p == 2) gl.color[i * 4 + 1] = std::numeric_limits<float>::quiet_NaN();
+    if (p == 3) gl.depth[i] = std::numeric_limits<float>::infinity();
+    if (p == 4) gl.depth[i] += 5000.0f / static_cast<float>(steps);
+  }
+  gl.id[gl.index(3, kOddH - 2)] = 9;  // extra
+  requantize(gl);
+  const Tolerances tol = defaultTolerances(depth_format, color_format);
+  ClassMaps maps;
+  const PairResult general = compareFrames(ref, gl, ref, tol, &maps);
+  const PairResult fast = compareFrames(ref, gl, ref, tol);
+  ASSERT_GT(general.visibility.hard, 0u);
+  ASSERT_GT(general.depth.over_fail, 0u);
+  ASSERT_GT(general.shading.nonfinite, 0u);
+  ASSERT_GT(general.shading.mean_abs, 0.0);
+  expectSameResults(fast, general);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Formats, FastPathTest,
+    ::testing::Combine(::testing::Values(DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F),
+                       ::testing::Values(ColorFormat::RGBA32F, ColorFormat::RGBA8)));
 
 TEST(CompareEdgeCases, DegenerateFramesNeverCrash) {
   const float clear[4] = {0, 0, 0, 0};
