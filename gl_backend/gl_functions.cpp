@@ -9,11 +9,14 @@
 namespace rc::gl {
 
 void Functions::load(ProcLoader loader) {
+// The arguments are a type and a member name, which cannot be parenthesized.
+// NOLINTBEGIN(bugprone-macro-parentheses)
 #define RC_GL_LOAD(type, name)                                                       \
   name = reinterpret_cast<type>(loader("gl" #name));                                 \
   if (name == nullptr) {                                                             \
     throw BackendError("the GL provider does not export gl" #name " (GL 3.3 core)"); \
   }
+  // NOLINTEND(bugprone-macro-parentheses)
   RC_GL_CORE_FUNCTIONS(RC_GL_LOAD)
 #undef RC_GL_LOAD
 

@@ -109,6 +109,26 @@ struct Program {
   GLint opacity = -1, has_texture = -1, texture = -1;
 };
 
+// The FBO of the last render, kept for the next one of the same size and formats:
+// allocating 1080p attachments costs more than the rest of the upload.
+struct Framebuffer {
+  GLuint framebuffer = 0;
+  GLuint renderbuffers[3] = {0, 0, 0};  // colour, ids, depth
+  int width = 0;
+  int height = 0;
+  ColorFormat color = ColorFormat::RGBA32F;
+  DepthFormat depth = DepthFormat::D24;
+};
+
+// Readback lands here first (warm memory, reused between renders), then is flipped and
+// converted into the Frame in one pass.
+struct Scratch {
+  std::vector<float> floats;
+  std::vector<std::uint32_t> words;
+  std::vector<std::uint16_t> halves;
+  std::vector<std::uint8_t> bytes;
+};
+
 // One GL context per process (GALLIUM_DRIVER is read once per process), reused by every
 // call for a compatible spec.
 struct Session {
@@ -119,6 +139,8 @@ struct Session {
   int subpixel_bits = 0;
   std::map<std::string, Program> programs;  // by source text
   std::vector<std::string> debug_errors;    // KHR_debug error messages since the last check
+  Framebuffer framebuffer;
+  Scratch scratch;
 };
 
 std::mutex g_mutex;
@@ -306,8 +328,6 @@ const Program& programFor(Session& s, int max_lights) {
 // GL objects of one render, deleted on every exit path (the context is still current).
 struct RenderObjects {
   const gl::Functions& gl;
-  GLuint framebuffer = 0;
-  GLuint renderbuffers[3] = {0, 0, 0};  // colour, ids, depth
   GLuint vertex_buffer = 0;
   GLuint vertex_array = 0;
   std::vector<GLuint> textures;
@@ -320,9 +340,6 @@ struct RenderObjects {
       gl.DeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     if (vertex_array != 0) gl.DeleteVertexArrays(1, &vertex_array);
     if (vertex_buffer != 0) gl.DeleteBuffers(1, &vertex_buffer);
-    if (framebuffer != 0) gl.DeleteFramebuffers(1, &framebuffer);
-    gl.DeleteRenderbuffers(3, renderbuffers);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.GetError();  // cleanup after a failure must not leak an error into the next call
   }
 };
@@ -349,21 +366,27 @@ AttachmentFormat depthFormat(DepthFormat f) {
   return {GL_DEPTH_COMPONENT24, "d24"};
 }
 
+void deleteFramebuffer(const gl::Functions& gl, Framebuffer& fb) {
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (fb.framebuffer != 0) gl.DeleteFramebuffers(1, &fb.framebuffer);
+  gl.DeleteRenderbuffers(3, fb.renderbuffers);
+  fb = Framebuffer{};
+}
+
 // Allocates colour (RGBA32F/RGBA8), ids (R32UI) and depth attachments and checks that the
 // driver gave exactly the asked formats (no silent substitution).
-void createFramebuffer(RenderObjects& o, const Scene& scene) {
-  const gl::Functions& gl = o.gl;
+void createFramebuffer(const gl::Functions& gl, Framebuffer& fb, const Scene& scene) {
   const AttachmentFormat color = colorFormat(scene.state.color_format);
   const AttachmentFormat depth = depthFormat(scene.state.depth_format);
-  gl.GenFramebuffers(1, &o.framebuffer);
-  gl.BindFramebuffer(GL_FRAMEBUFFER, o.framebuffer);
-  gl.GenRenderbuffers(3, o.renderbuffers);
+  gl.GenFramebuffers(1, &fb.framebuffer);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fb.framebuffer);
+  gl.GenRenderbuffers(3, fb.renderbuffers);
   const GLenum internal[3] = {color.internal, GL_R32UI, depth.internal};
   const GLenum attachment[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_DEPTH_ATTACHMENT};
   for (int i = 0; i < 3; ++i) {
-    gl.BindRenderbuffer(GL_RENDERBUFFER, o.renderbuffers[i]);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, fb.renderbuffers[i]);
     gl.RenderbufferStorage(GL_RENDERBUFFER, internal[i], scene.width, scene.height);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, attachment[i], GL_RENDERBUFFER, o.renderbuffers[i]);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, attachment[i], GL_RENDERBUFFER, fb.renderbuffers[i]);
   }
   const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
@@ -393,6 +416,32 @@ void createFramebuffer(RenderObjects& o, const Scene& scene) {
     throw BackendError(fmt::format("asked for an {} colour buffer, the driver gave {} red bits",
                                    color.name, red_bits));
   }
+  fb.width = scene.width;
+  fb.height = scene.height;
+  fb.color = scene.state.color_format;
+  fb.depth = scene.state.depth_format;
+}
+
+// Binds an FBO for the scene, reusing the last one when size and formats match.
+void bindFramebuffer(Session& s, const Scene& scene) {
+  const gl::Functions& gl = s.gl;
+  Framebuffer& fb = s.framebuffer;
+  const bool reusable = fb.framebuffer != 0 && fb.width == scene.width &&
+                        fb.height == scene.height && fb.color == scene.state.color_format &&
+                        fb.depth == scene.state.depth_format;
+  if (reusable) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, fb.framebuffer);
+  } else {
+    deleteFramebuffer(gl, fb);
+    try {
+      createFramebuffer(gl, fb, scene);
+      checkGl(s, "framebuffer setup");
+    } catch (...) {
+      deleteFramebuffer(gl, fb);
+      gl.GetError();
+      throw;
+    }
+  }
   const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
   gl.DrawBuffers(2, draw_buffers);
 }
@@ -406,7 +455,10 @@ void uploadVertices(RenderObjects& o, const gl::VertexData& data) {
   gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.vertices.size() * sizeof(gl::Vertex)),
                 data.vertices.empty() ? nullptr : data.vertices.data(), GL_STATIC_DRAW);
   constexpr auto kStride = static_cast<GLsizei>(sizeof(gl::Vertex));
-  auto offset = [](std::size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+  // With a buffer bound, GL takes attribute offsets disguised as pointers.
+  auto offset = [](std::size_t bytes) {
+    return reinterpret_cast<const void*>(bytes);  // NOLINT(performance-no-int-to-ptr)
+  };
   auto floats = [&](GLuint location, GLint size, std::size_t bytes) {
     gl.EnableVertexAttribArray(location);
     gl.VertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, kStride, offset(bytes));
@@ -574,83 +626,92 @@ void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
   }
 }
 
-// Reverses the row order in place: GL's row 0 is the bottom, the Frame's the top.
-template <typename T>
-void flipRows(std::vector<T>& data, std::size_t row_elements, int height) {
-  std::vector<T> tmp(row_elements);
-  for (int y = 0; y < height / 2; ++y) {
-    T* a = data.data() + static_cast<std::size_t>(y) * row_elements;
-    T* b = data.data() + static_cast<std::size_t>(height - 1 - y) * row_elements;
-    std::memcpy(tmp.data(), a, row_elements * sizeof(T));
-    std::memcpy(a, b, row_elements * sizeof(T));
-    std::memcpy(b, tmp.data(), row_elements * sizeof(T));
-  }
-}
-
-// Reads a GL-row-ordered scratch image and writes frame rows top first through convert.
+// Appends a GL-row-ordered image (row 0 at the bottom) to dst top row first, converting
+// each element. dst was reserved, so this is the only pass over the Frame's memory.
 template <typename Src, typename Dst, typename Convert>
-void convertFlipped(const std::vector<Src>& src, std::vector<Dst>& dst, std::size_t row_elements,
-                    int height, Convert convert) {
-  for (int y = 0; y < height; ++y) {
-    const Src* s = src.data() + static_cast<std::size_t>(height - 1 - y) * row_elements;
-    Dst* d = dst.data() + static_cast<std::size_t>(y) * row_elements;
-    for (std::size_t i = 0; i < row_elements; ++i) d[i] = convert(s[i]);
+void appendFlipped(const Src* src, std::vector<Dst>& dst, std::size_t row_elements, int height,
+                   Convert convert) {
+  for (int y = height - 1; y >= 0; --y) {
+    const Src* row = src + static_cast<std::size_t>(y) * row_elements;
+    for (std::size_t i = 0; i < row_elements; ++i) dst.push_back(convert(row[i]));
   }
 }
 
-void readBack(const gl::Functions& gl, const Scene& scene, Frame& frame) {
+template <typename T>
+void appendFlipped(const T* src, std::vector<T>& dst, std::size_t row_elements, int height) {
+  for (int y = height - 1; y >= 0; --y) {
+    const T* row = src + static_cast<std::size_t>(y) * row_elements;
+    dst.insert(dst.end(), row, row + row_elements);
+  }
+}
+
+template <typename T>
+T* scratchFor(std::vector<T>& scratch, std::size_t n) {
+  if (scratch.size() < n) scratch.resize(n);
+  return scratch.data();
+}
+
+void readBack(Session& s, const Scene& scene, Frame& frame) {
+  const gl::Functions& gl = s.gl;
+  Scratch& scratch = s.scratch;
   const int w = scene.width;
   const int h = scene.height;
-  const std::size_t n = static_cast<std::size_t>(w) * h;
+  const auto row = static_cast<std::size_t>(w);
+  const std::size_t n = row * h;
   frame.width = w;
   frame.height = h;
-  frame.color.resize(n * 4);
-  frame.depth.resize(n);
-  frame.id.resize(n);
+  frame.color.clear();
+  frame.color.reserve(n * 4);
+  frame.depth.clear();
+  frame.depth.reserve(n);
+  frame.id.clear();
+  frame.id.reserve(n);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   if (scene.state.color_format == ColorFormat::RGBA8) {
-    std::vector<std::uint8_t> bytes(n * 4);
-    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
+    std::uint8_t* bytes = scratchFor(scratch.bytes, n * 4);
+    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bytes);
     static const auto kUnorm8 = [] {
       std::array<float, 256> t{};
       for (int q = 0; q < 256; ++q) t[q] = static_cast<float>(q / 255.0);
       return t;
     }();
-    convertFlipped(bytes, frame.color, static_cast<std::size_t>(w) * 4, h,
-                   [](std::uint8_t q) { return kUnorm8[q]; });
+    appendFlipped(bytes, frame.color, row * 4, h, [](std::uint8_t q) { return kUnorm8[q]; });
   } else {
-    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, frame.color.data());
-    flipRows(frame.color, static_cast<std::size_t>(w) * 4, h);
+    float* floats = scratchFor(scratch.floats, n * 4);
+    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, floats);
+    appendFlipped(floats, frame.color, row * 4, h);
   }
 
   gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-  gl.ReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, frame.id.data());
-  flipRows(frame.id, static_cast<std::size_t>(w), h);
+  std::uint32_t* ids = scratchFor(scratch.words, n);
+  gl.ReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, ids);
+  appendFlipped(ids, frame.id, row, h);
 
   // Depth comes back as the stored integer q (exactly), then q / (2^b - 1) like the
   // reference; GL_UNSIGNED_INT scales a 24-bit value to 32 bits, so q = v >> 8 whether
   // the driver replicates bits or rounds (see docs/gl_backend.md).
   switch (scene.state.depth_format) {
     case DepthFormat::D16: {
-      std::vector<std::uint16_t> q(n);
-      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, q.data());
-      convertFlipped(q, frame.depth, static_cast<std::size_t>(w), h,
-                     [](std::uint16_t v) { return static_cast<float>(v / 65535.0); });
+      std::uint16_t* q = scratchFor(scratch.halves, n);
+      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, q);
+      appendFlipped(q, frame.depth, row, h,
+                    [](std::uint16_t v) { return static_cast<float>(v / 65535.0); });
       break;
     }
     case DepthFormat::D24: {
-      std::vector<std::uint32_t> q(n);
-      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, q.data());
-      convertFlipped(q, frame.depth, static_cast<std::size_t>(w), h,
-                     [](std::uint32_t v) { return static_cast<float>((v >> 8) / 16777215.0); });
+      std::uint32_t* q = scratchFor(scratch.words, n);  // the ids were copied out already
+      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, q);
+      appendFlipped(q, frame.depth, row, h,
+                    [](std::uint32_t v) { return static_cast<float>((v >> 8) / 16777215.0); });
       break;
     }
-    case DepthFormat::D32F:
-      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, frame.depth.data());
-      flipRows(frame.depth, static_cast<std::size_t>(w), h);
+    case DepthFormat::D32F: {
+      float* z = scratchFor(scratch.floats, n);
+      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, z);
+      appendFlipped(z, frame.depth, row, h);
       break;
+    }
   }
 }
 
@@ -709,7 +770,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
         fmt::format("{} vertices exceed what one glDrawArrays can address", data.vertices.size()));
   }
   RenderObjects objects(gl);
-  createFramebuffer(objects, scene);
+  bindFramebuffer(s, scene);
   checkGl(s, "framebuffer setup");
   uploadVertices(objects, data);
   const std::vector<GLuint> textures =
@@ -729,7 +790,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
 
   start = Clock::now();
   Frame frame;
-  readBack(gl, scene, frame);
+  readBack(s, scene, frame);
   checkGl(s, "readback");
   const double readback_ms = msSince(start);
 

@@ -9,12 +9,18 @@ enum Plane { kNear, kFar, kLeft, kRight, kBottom, kTop, kPlaneCount };
 
 double distance(const glm::dvec4& c, int plane, const ClipVolume& vol) {
   switch (plane) {
-    case kNear: return c.z + c.w;  // z >= -w
-    case kFar: return c.w - c.z;   // z <= w
-    case kLeft: return vol.guard_x * c.w + c.x;
-    case kRight: return vol.guard_x * c.w - c.x;
-    case kBottom: return vol.guard_y * c.w + c.y;
-    default: return vol.guard_y * c.w - c.y;
+    case kNear:
+      return c.z + c.w;  // z >= -w
+    case kFar:
+      return c.w - c.z;  // z <= w
+    case kLeft:
+      return vol.guard_x * c.w + c.x;
+    case kRight:
+      return vol.guard_x * c.w - c.x;
+    case kBottom:
+      return vol.guard_y * c.w + c.y;
+    default:
+      return vol.guard_y * c.w - c.y;
   }
 }
 
@@ -35,8 +41,7 @@ unsigned rejectCode(const glm::dvec4& c, const ClipVolume& vol) {
   return code;
 }
 
-ClipVertex lerpFromInside(const ClipVertex& in, double d_in, const ClipVertex& out,
-                          double d_out) {
+ClipVertex lerpFromInside(const ClipVertex& in, double d_in, const ClipVertex& out, double d_out) {
   const double t = d_in / (d_in - d_out);
   return ClipVertex{in.clip + t * (out.clip - in.clip), in.bary + t * (out.bary - in.bary)};
 }

@@ -22,21 +22,24 @@
 
 namespace rc::ref {
 
-// z clamped to [0, 1]; -0 and NaN become +0.
+// z clamped to [0, 1]; -0 and NaN become +0 (written as two selects: maxsd, minsd).
 inline double clampDepth(double z) {
-  if (!(z > 0.0)) return 0.0;
+  z = z > 0.0 ? z : 0.0;
   return z < 1.0 ? z : 1.0;
 }
 
 // (2^b - 1) for d16/d24; for d32f the 2^24 steps per unit the depth_gap channel counts.
 double depthStepsPerUnit(DepthFormat format);
 
-// The key of a clamped depth.
+// The key of a clamped depth (z01 in [0, 1], so roundHalfEvenNonNegative applies).
 inline std::uint32_t depthKey(double z01, DepthFormat format) {
   switch (format) {
-    case DepthFormat::D16: return static_cast<std::uint32_t>(roundHalfEven(z01 * 65535.0));
-    case DepthFormat::D24: return static_cast<std::uint32_t>(roundHalfEven(z01 * 16777215.0));
-    case DepthFormat::D32F: break;
+    case DepthFormat::D16:
+      return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 65535.0));
+    case DepthFormat::D24:
+      return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 16777215.0));
+    case DepthFormat::D32F:
+      break;
   }
   return std::bit_cast<std::uint32_t>(static_cast<float>(z01));
 }
@@ -44,11 +47,32 @@ inline std::uint32_t depthKey(double z01, DepthFormat format) {
 // The stored depth a key stands for, in [0, 1].
 double storedDepth(std::uint32_t key, DepthFormat format);
 
-// The value a colour channel is stored as, and the exact value read back for blending.
-float storeColor(double c, ColorFormat format);
-double loadColor(float stored, ColorFormat format);
+// c clamped to [0, 1]; NaN becomes 0.
+inline double clampUnit(double c) {
+  c = c > 0.0 ? c : 0.0;
+  return c < 1.0 ? c : 1.0;
+}
+
+// The value a colour channel is stored as.
+inline float storeColor(double c, ColorFormat format) {
+  if (format == ColorFormat::RGBA32F) return static_cast<float>(c);
+  return static_cast<float>(roundHalfEvenNonNegative(clampUnit(c) * 255.0) / 255.0);
+}
+
+// The exact stored value, read back for blending (for rgba8 the float holds q / 255
+// rounded; q is recovered exactly).
+inline double loadColor(float stored, ColorFormat format) {
+  if (format == ColorFormat::RGBA32F) return stored;
+  return roundHalfEvenNonNegative(static_cast<double>(stored) * 255.0) / 255.0;
+}
 
 // src * a + dst * (1 - a) per channel, a = src alpha (source clamped first for rgba8).
-glm::dvec4 blendSourceOver(glm::dvec4 src, const glm::dvec4& dst, ColorFormat format);
+inline glm::dvec4 blendSourceOver(glm::dvec4 src, const glm::dvec4& dst, ColorFormat format) {
+  if (format == ColorFormat::RGBA8) {
+    for (int c = 0; c < 4; ++c) src[c] = clampUnit(src[c]);
+  }
+  const double a = src.a;
+  return src * a + dst * (1.0 - a);
+}
 
 }  // namespace rc::ref

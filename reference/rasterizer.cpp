@@ -45,8 +45,8 @@ std::int64_t snappedArea2(const FixedVertex& v0, const FixedVertex& v1, const Fi
   return (v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y);
 }
 
-bool TriangleCoverage::setup(const FixedVertex& v0, const FixedVertex& v1,
-                             const FixedVertex& v2, int subpixel_bits, const PixelRect& clip) {
+bool TriangleCoverage::setup(const FixedVertex& v0, const FixedVertex& v1, const FixedVertex& v2,
+                             int subpixel_bits, const PixelRect& clip) {
   const std::int64_t area2 = snappedArea2(v0, v1, v2);
   if (area2 == 0) return false;
   // Counter-clockwise order, so that the inside of every edge is E > 0.

@@ -48,8 +48,8 @@ class TriangleCoverage {
  public:
   // Prepares the edge functions of a triangle with non-zero snapped area (either winding)
   // restricted to `clip`. Returns false when it covers nothing (zero area or outside).
-  bool setup(const FixedVertex& v0, const FixedVertex& v1, const FixedVertex& v2,
-             int subpixel_bits, const PixelRect& clip);
+  bool setup(const FixedVertex& v0, const FixedVertex& v1, const FixedVertex& v2, int subpixel_bits,
+             const PixelRect& clip);
 
   // Calls fn(py, x_begin, x_end) for every row with covered pixels, bottom to top;
   // [x_begin, x_end) are the covered pixels of that row (a row's covered set is one run).

@@ -2,6 +2,7 @@
 // drawPasses(). See reference_renderer.h and docs/reference.md.
 #include "reference/reference_renderer.h"
 
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -37,11 +38,10 @@ void validate(const Scene& scene, const ReferenceOptions& options) {
   const std::string label = sceneLabel(scene);
   auto fail = [&](const std::string& what) { throw InputError(label + ": " + what); };
   if (options.subpixel_bits < 0 || options.subpixel_bits > kMaxSubpixelBits)
-    fail("reference subpixel bits " + std::to_string(options.subpixel_bits) +
-         " out of range [0, " + std::to_string(kMaxSubpixelBits) + "]");
+    fail("reference subpixel bits " + std::to_string(options.subpixel_bits) + " out of range [0, " +
+         std::to_string(kMaxSubpixelBits) + "]");
   if (scene.width < 1 || scene.height < 1 || scene.width > kMaxImageSide ||
-      scene.height > kMaxImageSide ||
-      std::int64_t{scene.width} * scene.height > kMaxImagePixels)
+      scene.height > kMaxImageSide || std::int64_t{scene.width} * scene.height > kMaxImagePixels)
     fail("image " + std::to_string(scene.width) + "x" + std::to_string(scene.height) +
          " outside what the reference renders (1..16384 a side, at most 2^26 pixels)");
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
@@ -87,7 +87,7 @@ struct TriangleContext {
   glm::dvec3 centroid{0.0};     // flat: world-space centroid of the original triangle
   glm::dvec3 face_normal{0.0};  // flat: normalize(cross(p1 - p0, p2 - p0))
   LitColor flat;
-  bool constant = false;        // flat, untextured, not blended: one stored colour
+  bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
 };
 
@@ -117,8 +117,8 @@ class Renderer {
   void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
   void prepareTriangle(TriangleContext& t) const;
   template <Shading kShading, bool kTrace>
-  void shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py,
-                 int x_begin, int x_end);
+  void shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py, int x_begin,
+                 int x_end);
   template <Shading kShading>
   glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b,
                            ShadingTerms* terms) const;
@@ -141,7 +141,7 @@ class Renderer {
 
   std::vector<std::vector<TransformedVertex>> vertices_;  // per object
   std::vector<std::vector<LitColor>> gouraud_;            // per object, Gouraud only
-  Frame frame_;                     // colour, id, edge_dist over the clip rectangle
+  Frame frame_;                       // colour, id, edge_dist over the clip rectangle
   std::vector<std::uint32_t> depth_;  // depth keys (fragment_ops.h)
   DepthGapTracker gaps_;
 };
@@ -158,7 +158,8 @@ void Renderer::transformVertices() {
     const Material& material = scene_.materials[obj.material];
     gouraud_[o].resize(vertices_[o].size());
     for (std::size_t i = 0; i < vertices_[o].size(); ++i)
-      gouraud_[o][i] = shadePoint(lighting_, material, vertices_[o][i].world, vertices_[o][i].normal);
+      gouraud_[o][i] =
+          shadePoint(lighting_, material, vertices_[o][i].world, vertices_[o][i].normal);
   }
 }
 
@@ -176,10 +177,16 @@ Frame Renderer::run() {
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter))
     for (const PrimitiveRef& prim : pass.primitives) drawTriangle(prim, pass);
 
-  for (std::size_t i = 0; i < frame_.pixelCount(); ++i) {
-    frame_.depth[i] = static_cast<float>(storedDepth(depth_[i], depth_format_));
-    if (uncertainty_) frame_.depth_gap[i] = gaps_.gapSteps(i, depth_format_);
+  // Stored depth back to [0, 1] (one simple loop per format, so that it vectorizes).
+  const std::size_t n = frame_.pixelCount();
+  if (depth_format_ == DepthFormat::D32F) {
+    for (std::size_t i = 0; i < n; ++i) frame_.depth[i] = std::bit_cast<float>(depth_[i]);
+  } else {
+    const double steps = depthStepsPerUnit(depth_format_);
+    for (std::size_t i = 0; i < n; ++i) frame_.depth[i] = static_cast<float>(depth_[i] / steps);
   }
+  if (uncertainty_)
+    for (std::size_t i = 0; i < n; ++i) frame_.depth_gap[i] = gaps_.gapSteps(i, depth_format_);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   frame_.meta = {{"renderer", "rastercheck reference"},
@@ -286,13 +293,13 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
 }
 
 template <Shading kShading>
-glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::dvec3& b,
-                                   ShadingTerms* terms) const {
+inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::dvec3& b,
+                                          ShadingTerms* terms) const {
   glm::dvec3 tex(1.0);
   if (t.texture) {
     const glm::dvec2 uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
-    tex = glm::dvec3(sampleTexture(*t.texture, uv, scene_.state.texture_filter,
-                                   scene_.state.texture_wrap));
+    tex = glm::dvec3(
+        sampleTexture(*t.texture, uv, scene_.state.texture_filter, scene_.state.texture_wrap));
   }
   LitColor lit;
   if constexpr (kShading == Shading::Flat) {
@@ -300,8 +307,8 @@ glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::dvec3& b
   } else if constexpr (kShading == Shading::Gouraud) {
     lit.ambient_diffuse = b.x * t.gouraud[0]->ambient_diffuse +
                           b.y * t.gouraud[1]->ambient_diffuse + b.z * t.gouraud[2]->ambient_diffuse;
-    lit.specular = b.x * t.gouraud[0]->specular + b.y * t.gouraud[1]->specular +
-                   b.z * t.gouraud[2]->specular;
+    lit.specular =
+        b.x * t.gouraud[0]->specular + b.y * t.gouraud[1]->specular + b.z * t.gouraud[2]->specular;
   } else {
     const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
     const glm::dvec3 n =
@@ -326,12 +333,13 @@ void Renderer::traceTerms(const TriangleContext& t, const glm::dvec3& b,
     return;
   }
   ShadingTerms vt[3];
-  for (int k = 0; k < 3; ++k) shadePoint(lighting_, *t.material, t.v[k]->world, t.v[k]->normal, &vt[k]);
+  for (int k = 0; k < 3; ++k)
+    shadePoint(lighting_, *t.material, t.v[k]->world, t.v[k]->normal, &vt[k]);
   terms.ambient = b.x * vt[0].ambient + b.y * vt[1].ambient + b.z * vt[2].ambient;
   terms.lights.assign(vt[0].lights.size(), LightTerms{});
   for (std::size_t i = 0; i < terms.lights.size(); ++i) {
-    terms.lights[i].diffuse =
-        b.x * vt[0].lights[i].diffuse + b.y * vt[1].lights[i].diffuse + b.z * vt[2].lights[i].diffuse;
+    terms.lights[i].diffuse = b.x * vt[0].lights[i].diffuse + b.y * vt[1].lights[i].diffuse +
+                              b.z * vt[2].lights[i].diffuse;
     terms.lights[i].specular = b.x * vt[0].lights[i].specular + b.y * vt[1].lights[i].specular +
                                b.z * vt[2].lights[i].specular;
   }
@@ -343,9 +351,13 @@ glm::dvec4 Renderer::storedColor(std::size_t index) const {
                     loadColor(c[2], color_format_), loadColor(c[3], color_format_));
 }
 
-void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool blend) {
-  const glm::dvec4 out = blend ? blendSourceOver(src, storedColor(index), color_format_) : src;
+inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool blend) {
   float* c = &frame_.color[4 * index];
+  if (!blend) {
+    for (int k = 0; k < 4; ++k) c[k] = storeColor(src[k], color_format_);
+    return;
+  }
+  const glm::dvec4 out = blendSourceOver(src, storedColor(index), color_format_);
   for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
 }
 
@@ -358,28 +370,34 @@ void Renderer::shadeSpan(const TriangleContext& t, const FragmentInterpolator& i
   const bool always = t.pass->depth_func == DepthFunc::Always;
   const bool depth_write = t.pass->depth_write;
   const bool blend = t.pass->blend;
+  const bool track_gaps = uncertainty_;
+  const DepthFormat depth_format = depth_format_;
+  std::uint32_t* const depth = depth_.data();  // locals: the stores below cannot alias them
+  std::uint32_t* const ids = frame_.id.data();
+  float* const colors = frame_.color.data();
+  const std::uint32_t id = t.prim->id;
   for (int px = x_begin; px < x_end; ++px) {
     const double cx = px + 0.5;
     const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
     const double z = clampDepth(interp.depth(cx, cy));
-    if (uncertainty_) gaps_.add(index, z);
-    const std::uint32_t key = depthKey(z, depth_format_);
-    const std::uint32_t against = depth_[index];
+    if (track_gaps) gaps_.add(index, z);
+    const std::uint32_t key = depthKey(z, depth_format);
+    const std::uint32_t against = depth[index];
     const bool pass = always || key < against;
 
     if constexpr (kTrace) {
       FragmentTrace f;
-      f.primitive = t.prim->id;
+      f.primitive = id;
       f.object = t.prim->object;
       f.barycentric = interp.barycentric(cx, cy);
       f.window_z = z;
-      f.stored_z = storedDepth(key, depth_format_);
+      f.stored_z = storedDepth(key, depth_format);
       f.depth_pass = pass;
-      f.depth_against = storedDepth(against, depth_format_);
+      f.depth_against = storedDepth(against, depth_format);
       const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading);
       if (pass) {
-        if (depth_write) depth_[index] = key;
-        frame_.id[index] = t.prim->id;
+        if (depth_write) depth[index] = key;
+        ids[index] = id;
         writeColor(index, color, blend);
       }
       f.color_written = storedColor(index);
@@ -388,12 +406,15 @@ void Renderer::shadeSpan(const TriangleContext& t, const FragmentInterpolator& i
     }
 
     if (!pass) continue;
-    if (depth_write) depth_[index] = key;
-    frame_.id[index] = t.prim->id;
+    if (depth_write) depth[index] = key;
+    ids[index] = id;
     if constexpr (kShading == Shading::Flat) {
-      if (t.constant) {
-        float* c = &frame_.color[4 * index];
-        for (int k = 0; k < 4; ++k) c[k] = t.constant_stored[k];
+      if (t.constant) {  // one stored colour for the whole triangle
+        float* c = colors + 4 * index;
+        c[0] = t.constant_stored[0];
+        c[1] = t.constant_stored[1];
+        c[2] = t.constant_stored[2];
+        c[3] = t.constant_stored[3];
         continue;
       }
     }

@@ -38,11 +38,11 @@ Frame renderReference(const Scene& scene, const ReferenceOptions& options = {});
 
 // One fragment that reached a pixel, in draw order (`rastercheck explain`).
 struct FragmentTrace {
-  std::uint32_t primitive = 0;    // primitive id (1-based)
-  std::uint32_t object = 0;       // index into Scene::objects
-  glm::dvec3 barycentric{0.0};    // w.r.t. the ORIGINAL triangle, perspective-correct
-  double window_z = 0.0;          // interpolated window z, clamped to [0, 1]
-  double stored_z = 0.0;          // window_z quantized to the depth format
+  std::uint32_t primitive = 0;  // primitive id (1-based)
+  std::uint32_t object = 0;     // index into Scene::objects
+  glm::dvec3 barycentric{0.0};  // w.r.t. the ORIGINAL triangle, perspective-correct
+  double window_z = 0.0;        // interpolated window z, clamped to [0, 1]
+  double stored_z = 0.0;        // window_z quantized to the depth format
   bool depth_pass = false;
   double depth_against = 0.0;     // the stored depth it was tested against
   ShadingTerms shading;           // every term of its colour (computed even if it failed)

@@ -16,4 +16,10 @@ inline double roundHalfEven(double v) {
   return v >= 0.0 ? (v + kTwo52) - kTwo52 : (v - kTwo52) + kTwo52;
 }
 
+// The same for 0 <= v < 2^51 (depth and colour quantization), without branches.
+inline double roundHalfEvenNonNegative(double v) {
+  constexpr double kTwo52 = 4503599627370496.0;
+  return (v + kTwo52) - kTwo52;
+}
+
 }  // namespace rc::ref

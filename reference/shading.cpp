@@ -15,16 +15,12 @@ Lighting sceneLighting(const Scene& scene) {
   return l;
 }
 
-glm::dvec3 safeNormalize(const glm::dvec3& v) {
-  const double len = std::sqrt(glm::dot(v, v));
-  if (!(len > 0.0) || !std::isfinite(len)) return glm::dvec3(0.0);
-  return v / len;
-}
-
 double specularPower(double base, double shininess) {
   if (shininess == 0.0) return 1.0;  // max(0, x)^0 = 1, including pow(0, 0)
   if (!(base > 0.0)) return 0.0;
-  if (shininess > 0.0 && shininess <= 128.0 && std::floor(shininess) == shininess) {
+  // Integral test by conversion (std::floor is a libm call without SSE4.1).
+  if (shininess > 0.0 && shininess <= 128.0 &&
+      static_cast<double>(static_cast<int>(shininess)) == shininess) {
     auto e = static_cast<unsigned>(shininess);
     double result = 1.0;
     double square = base;
@@ -61,8 +57,9 @@ LitColor shadePoint(const Lighting& lighting, const Material& material, const gl
       const glm::dvec3 to_light = light.position - p;
       const double r = std::sqrt(glm::dot(to_light, to_light));
       if (!(r > 0.0)) continue;  // light at the shaded point: contributes nothing
-      l = to_light / r;
-      if (lighting.attenuation == Attenuation::Inverse) att = 1.0 / r;
+      const double inv_r = 1.0 / r;
+      l = to_light * inv_r;
+      if (lighting.attenuation == Attenuation::Inverse) att = inv_r;
       if (lighting.attenuation == Attenuation::InverseSquare) att = 1.0 / (r * r);
     }
     const glm::dvec3 L = light.color * light.intensity * att;
@@ -82,10 +79,6 @@ LitColor shadePoint(const Lighting& lighting, const Material& material, const gl
     if (terms) terms->lights[i] = LightTerms{diffuse, specular};
   }
   return out;
-}
-
-glm::dvec4 finalColor(const LitColor& lit, const glm::dvec3& texture_rgb, double opacity) {
-  return glm::dvec4(lit.ambient_diffuse * texture_rgb + lit.specular, opacity);
 }
 
 }  // namespace rc::ref

@@ -14,6 +14,7 @@
 // are undefined there). It does not interpolate or sample textures.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -58,8 +59,13 @@ struct LitColor {
   glm::dvec3 specular{0.0};         // sum specular
 };
 
-// normalize(v) with zero (or a non-finite length) staying zero.
-glm::dvec3 safeNormalize(const glm::dvec3& v);
+// normalize(v) with zero (or a non-finite length) staying zero. One division, not three
+// (within an ulp of v / |v|).
+inline glm::dvec3 safeNormalize(const glm::dvec3& v) {
+  const double len = std::sqrt(glm::dot(v, v));
+  if (!(len > 0.0) || !std::isfinite(len)) return glm::dvec3(0.0);
+  return v * (1.0 / len);
+}
 
 // max(0, base)^shininess with x^0 = 1. Integral exponents up to 128 use repeated squaring
 // (relative error below shininess * 2^-52 against the exact power, and several times
@@ -72,6 +78,8 @@ LitColor shadePoint(const Lighting& lighting, const Material& material, const gl
                     const glm::dvec3& n, ShadingTerms* terms = nullptr);
 
 // (ambient + diffuse) o texture + specular, alpha = opacity.
-glm::dvec4 finalColor(const LitColor& lit, const glm::dvec3& texture_rgb, double opacity);
+inline glm::dvec4 finalColor(const LitColor& lit, const glm::dvec3& texture_rgb, double opacity) {
+  return glm::dvec4(lit.ambient_diffuse * texture_rgb + lit.specular, opacity);
+}
 
 }  // namespace rc::ref

@@ -23,7 +23,7 @@ int wrapIndex(double floored, int size, TextureWrap wrap) {
   if (!std::isfinite(floored)) return 0;
   if (wrap == TextureWrap::Clamp) return static_cast<int>(std::clamp(floored, 0.0, size - 1.0));
   const double m = floored - size * std::floor(floored / size);  // floor-mod, in [0, size]
-  return std::clamp(static_cast<int>(m), 0, size - 1);  // m == size only by rounding
+  return std::clamp(static_cast<int>(m), 0, size - 1);           // m == size only by rounding
 }
 
 glm::dvec4 texel(const Texture& t, int i, int j) {

@@ -68,8 +68,8 @@ void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& c
                 int height, float* edge_dist) {
   int row_first = 0;
   int row_end = 0;
-  if (!centreRange(std::min(a.y, b.y) - 1.0, std::max(a.y, b.y) + 1.0, clip.y0, clip.y1,
-                   row_first, row_end))
+  if (!centreRange(std::min(a.y, b.y) - 1.0, std::max(a.y, b.y) + 1.0, clip.y0, clip.y1, row_first,
+                   row_end))
     return;
   for (int py = row_first; py < row_end; ++py) {
     const double cy = py + 0.5;

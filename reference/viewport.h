@@ -12,8 +12,8 @@ namespace rc::ref {
 struct WindowVertex {
   double x = 0.0;
   double y = 0.0;
-  double z = 0.0;      // window depth, z_ndc * 0.5 + 0.5
-  double inv_w = 0.0;  // 1 / w_clip, for perspective-correct interpolation
+  double z = 0.0;        // window depth, z_ndc * 0.5 + 0.5
+  double inv_w = 0.0;    // 1 / w_clip, for perspective-correct interpolation
   glm::dvec3 bary{0.0};  // w.r.t. the original triangle (from the clipper)
 };
 

@@ -29,18 +29,18 @@ const Pair& pair1080p() {
     std::uniform_real_distribution<float> dc(-0.4f / 255.0f, 0.4f / 255.0f);
     for (std::size_t i = 0; i < p.gl.pixelCount(); ++i) {
       if (p.gl.id[i] == 0) continue;
-      p.gl.depth[i] = static_cast<float>(
-          (std::nearbyint(p.gl.depth[i] * 16777215.0) + dz(rng)) / 16777215.0);
+      p.gl.depth[i] =
+          static_cast<float>((std::nearbyint(p.gl.depth[i] * 16777215.0) + dz(rng)) / 16777215.0);
       for (int c = 0; c < 3; ++c) p.gl.color[i * 4 + c] += dc(rng);
     }
     auto block = [&](int x0, int y0, auto f) {
       for (int y = y0; y < y0 + 40; ++y)
         for (int x = x0; x < x0 + 40; ++x) f(p.gl.index(x, y));
     };
-    block(400, 200, [&](std::size_t i) { p.gl.id[i] = 0; });                      // missing
-    block(20, 1040, [&](std::size_t i) { p.gl.id[i] = 9; });                      // extra
-    block(500, 300, [&](std::size_t i) { p.gl.id[i] = 4; });                      // wrong
-    block(300, 400, [&](std::size_t i) { p.gl.depth[i] += 1e-4f; });              // depth
+    block(400, 200, [&](std::size_t i) { p.gl.id[i] = 0; });                       // missing
+    block(20, 1040, [&](std::size_t i) { p.gl.id[i] = 9; });                       // extra
+    block(500, 300, [&](std::size_t i) { p.gl.id[i] = 4; });                       // wrong
+    block(300, 400, [&](std::size_t i) { p.gl.depth[i] += 1e-4f; });               // depth
     block(200, 500, [&](std::size_t i) { p.gl.color[i * 4] += 10.0f / 255.0f; });  // shading
     return p;
   }();

@@ -66,10 +66,10 @@ Scene alphaScene(ColorFormat format) {
   s.state.blend = Blend::Alpha;
   s.state.color_format = format;
   s.materials = {flatColor({1, 0, 0}), flatColor({0, 1, 0}, 0.5), flatColor({0, 0, 1}, 0.5)};
-  test::addRect(s, 0, 0, 4, 8, 0.8f, 2);  // blue, nearest (ids 1, 2)
-  test::addRect(s, 0, 0, 4, 8, 0.6f, 1);  // green (ids 3, 4)
-  test::addRect(s, 0, 0, 8, 8, 0.25f, 0); // red, opaque (ids 5, 6)
-  test::addRect(s, 4, 0, 8, 8, 0.1f, 1);  // green behind red (ids 7, 8)
+  test::addRect(s, 0, 0, 4, 8, 0.8f, 2);   // blue, nearest (ids 1, 2)
+  test::addRect(s, 0, 0, 4, 8, 0.6f, 1);   // green (ids 3, 4)
+  test::addRect(s, 0, 0, 8, 8, 0.25f, 0);  // red, opaque (ids 5, 6)
+  test::addRect(s, 4, 0, 8, 8, 0.1f, 1);   // green behind red (ids 7, 8)
   return s;
 }
 
@@ -93,8 +93,8 @@ TEST(Visibility, TransparentPassInRgba8RoundsEachStep) {
   const Frame f = renderReference(alphaScene(ColorFormat::RGBA8));
   // After green: 127.5 -> 128, 191.25 -> 191. After blue: r = g = 64, b = 127.5 -> 128,
   // a = 0.25 + 0.5 * 191 / 255 = 159.25 / 255 -> 159.
-  EXPECT_EQ(colorAt(f, 1, 3), glm::dvec4(glm::vec4(64.0f / 255, 64.0f / 255, 128.0f / 255,
-                                                   159.0f / 255)));
+  EXPECT_EQ(colorAt(f, 1, 3),
+            glm::dvec4(glm::vec4(64.0f / 255, 64.0f / 255, 128.0f / 255, 159.0f / 255)));
 }
 
 TEST(ColorFormat, Rgba8RoundsHalfToEvenAndClampsRgba32fDoesNot) {

@@ -101,8 +101,8 @@ TEST(Coverage, SpanMethodsAgreeWithPerPixelTestAndOracle) {
       for (int px = clip.x0; px < clip.x1; ++px) {
         const bool expected = oracleCovers(t, px, py, bits);
         const bool in_span = by_div && px >= d0 && px < d1;
-        ASSERT_EQ(expected, in_span) << "iter " << iter << " pixel " << px << "," << py
-                                     << " bits " << bits;
+        ASSERT_EQ(expected, in_span)
+            << "iter " << iter << " pixel " << px << "," << py << " bits " << bits;
         ASSERT_EQ(expected, ok && c.covers(px, py));
         covered_total += expected;
       }
@@ -146,14 +146,16 @@ std::vector<std::string> coverageMap(int w, int h, const std::vector<Tri2>& tris
 }
 
 TEST(TieBreak, VerticalSharedEdgeThroughCentresGoesToTheRightTriangle) {
-  const auto map = coverageMap(8, 8, {{{{0, 0.5}, {3.5, 0}, {3.5, 8}}}, {{{3.5, 0}, {8, 4}, {3.5, 8}}}});
+  const auto map =
+      coverageMap(8, 8, {{{{0, 0.5}, {3.5, 0}, {3.5, 8}}}, {{{3.5, 0}, {8, 4}, {3.5, 8}}}});
   const std::vector<std::string> llvmpipe = {"...1....", "...11...", "..0111..", "..01111.",
                                              ".001111.", ".00111..", "00011...", "0001...."};
   EXPECT_EQ(map, llvmpipe);
 }
 
 TEST(TieBreak, HorizontalSharedEdgeThroughCentresGoesToTheUpperTriangle) {
-  const auto map = coverageMap(8, 8, {{{{0, 3.5}, {8, 3.5}, {4, 0}}}, {{{0, 3.5}, {4, 8}, {8, 3.5}}}});
+  const auto map =
+      coverageMap(8, 8, {{{{0, 3.5}, {8, 3.5}, {4, 0}}}, {{{0, 3.5}, {4, 8}, {8, 3.5}}}});
   const std::vector<std::string> llvmpipe = {"........", "...11...", "..1111..", ".111111.",
                                              "11111111", ".000000.", "..0000..", "...00..."};
   EXPECT_EQ(map, llvmpipe);
@@ -228,7 +230,7 @@ TEST(Coverage, JitteredGridCoversEveryPixelExactlyOnce) {
       for (int i = 0; i <= n; ++i) {
         glm::dvec2 p(-3.0 + i * 54.0 / n, -3.0 + j * 46.0 / n);
         if (i > 0 && i < n && j > 0 && j < n) p += glm::dvec2(jitter(rng), jitter(rng));
-        if (variant == 1) p = glm::floor(p) + 0.5;             // on pixel centres
+        if (variant == 1) p = glm::floor(p) + 0.5;            // on pixel centres
         if (variant == 2) p = glm::round(p * 256.0) / 256.0;  // on subpixel boundaries
         grid.push_back(p);
       }

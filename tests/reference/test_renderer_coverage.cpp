@@ -179,11 +179,11 @@ struct CullCase {
 
 TEST(RendererCoverage, CullingByWindowSpaceWindingAndFrontFace) {
   const CullCase cases[] = {
-      {true, FrontFace::CCW, Cull::None, true},  {false, FrontFace::CCW, Cull::None, true},
-      {true, FrontFace::CCW, Cull::Back, true},  {false, FrontFace::CCW, Cull::Back, false},
+      {true, FrontFace::CCW, Cull::None, true},   {false, FrontFace::CCW, Cull::None, true},
+      {true, FrontFace::CCW, Cull::Back, true},   {false, FrontFace::CCW, Cull::Back, false},
       {true, FrontFace::CCW, Cull::Front, false}, {false, FrontFace::CCW, Cull::Front, true},
-      {true, FrontFace::CW, Cull::Back, false},  {false, FrontFace::CW, Cull::Back, true},
-      {true, FrontFace::CW, Cull::Front, true},  {false, FrontFace::CW, Cull::Front, false},
+      {true, FrontFace::CW, Cull::Back, false},   {false, FrontFace::CW, Cull::Back, true},
+      {true, FrontFace::CW, Cull::Front, true},   {false, FrontFace::CW, Cull::Front, false},
   };
   for (const CullCase& c : cases) {
     Scene s = test::windowScene(16, 16);

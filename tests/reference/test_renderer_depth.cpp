@@ -22,15 +22,15 @@ Frame renderPlane(DepthFormat format, float z) {
 
 TEST(DepthQuantization, UnormRoundsToNearestEvenAtHandComputedValues) {
   struct Case {
-    float z_world;       // window z = 1 - z_world, exact for these dyadic values
-    double q16, q24;     // hand-computed round-half-even(zw * (2^b - 1))
+    float z_world;    // window z = 1 - z_world, exact for these dyadic values
+    double q16, q24;  // hand-computed round-half-even(zw * (2^b - 1))
   };
   const Case cases[] = {
       {0.75f, 16384.0, 4194304.0},    // zw 0.25:  16383.75 -> 16384, 4194303.75 -> 4194304
       {0.6875f, 20480.0, 5242880.0},  // zw 0.3125: 20479.6875, 5242879.6875 (round up)
       {0.25f, 49151.0, 12582911.0},   // zw 0.75:  49151.25, 12582911.25 (round down)
-      {0.5f, 32768.0, 8388608.0},     // zw 0.5:   32767.5 -> 32768, 8388607.5 -> 8388608 (tie, even)
-      {1.0f, 0.0, 0.0},               // zw 0 (the near plane)
+      {0.5f, 32768.0, 8388608.0},  // zw 0.5:   32767.5 -> 32768, 8388607.5 -> 8388608 (tie, even)
+      {1.0f, 0.0, 0.0},            // zw 0 (the near plane)
   };
   for (const Case& c : cases) {
     const Frame f16 = renderPlane(DepthFormat::D16, c.z_world);
@@ -127,8 +127,8 @@ TEST(EdgeDist, DistanceToEdgeSegmentsCappedAtOne) {
   auto at = [&](int x, int gl_y) { return f.edge_dist[f.index(x, 15 - gl_y)]; };
   EXPECT_FLOAT_EQ(at(3, 8), 0.25f);  // centre 3.5: 0.25 right of x = 3.25
   EXPECT_FLOAT_EQ(at(2, 8), 0.75f);
-  EXPECT_FLOAT_EQ(at(4, 8), 1.0f);   // 1.25 away: capped
-  EXPECT_FLOAT_EQ(at(8, 1), 0.5f);   // centre y 1.5 above the bottom edge y = 1
+  EXPECT_FLOAT_EQ(at(4, 8), 1.0f);  // 1.25 away: capped
+  EXPECT_FLOAT_EQ(at(8, 1), 0.5f);  // centre y 1.5 above the bottom edge y = 1
   // Below-left of the vertex (3.25, 1): distance to the segment end, not to the line.
   EXPECT_FLOAT_EQ(at(2, 0), static_cast<float>(std::hypot(0.75, 0.5)));
   EXPECT_FLOAT_EQ(at(0, 0), 1.0f);
@@ -149,8 +149,8 @@ TEST(EdgeDist, ClippedPolygonBoundaryOnlyNotTheFanDiagonal) {
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
       const glm::dvec2 c(x + 0.5, 63 - y + 0.5);
-      const double d = std::min({segDist(c, A, B), segDist(c, B, P), segDist(c, P, Q),
-                                 segDist(c, Q, A), 1.0});
+      const double d =
+          std::min({segDist(c, A, B), segDist(c, B, P), segDist(c, P, Q), segDist(c, Q, A), 1.0});
       ASSERT_NEAR(f.edge_dist[f.index(x, y)], d, 1e-6) << x << "," << y;
       const bool inside = c.y > 4 && c.y < 32 && segDist(c, A, P) < 0.5 && d == 1.0;
       near_diagonal += inside;

@@ -19,10 +19,10 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 TEST(Robustness, NonFiniteTrianglesAreDroppedOthersDrawn) {
   Scene s = test::windowScene(16, 16);
-  test::addTriangle(s, {kNaN, 1, 0.5f}, {15, 1, 0.5f}, {1, 15, 0.5f});   // id 1
-  test::addTriangle(s, {1, 1, kInf}, {15, 1, 0.5f}, {1, 15, 0.5f});      // id 2
-  test::addTriangle(s, {1, 1, 0.5f}, {-kInf, 1, 0.5f}, {1, 15, 0.5f});   // id 3
-  test::addTriangle(s, {1, 1, 0.75f}, {15, 1, 0.75f}, {1, 15, 0.75f});   // id 4: valid
+  test::addTriangle(s, {kNaN, 1, 0.5f}, {15, 1, 0.5f}, {1, 15, 0.5f});  // id 1
+  test::addTriangle(s, {1, 1, kInf}, {15, 1, 0.5f}, {1, 15, 0.5f});     // id 2
+  test::addTriangle(s, {1, 1, 0.5f}, {-kInf, 1, 0.5f}, {1, 15, 0.5f});  // id 3
+  test::addTriangle(s, {1, 1, 0.75f}, {15, 1, 0.75f}, {1, 15, 0.75f});  // id 4: valid
   s.objects[0].mesh.normals[1] = {kNaN, 0, 0};
   for (Shading sh : {Shading::Flat, Shading::Gouraud, Shading::Phong}) {
     s.state.shading = sh;
@@ -65,7 +65,7 @@ TEST(Robustness, EnormousButFiniteCoordinates) {
 TEST(Robustness, EmptyMeshesAndEmptyScenes) {
   Scene s = test::windowScene(8, 8);
   s.clear_depth = 0.5;
-  s.objects.emplace_back();  // no vertices, no triangles
+  s.objects.emplace_back();                            // no vertices, no triangles
   test::addMesh(s, {{0, 0, 0.5f}, {1, 0, 0.5f}}, {});  // vertices, no triangles
   const Frame f = renderReference(s);
   for (std::size_t i = 0; i < f.pixelCount(); ++i) {

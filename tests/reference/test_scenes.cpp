@@ -98,9 +98,9 @@ std::shared_ptr<const Texture> checkerTexture() {
   for (int j = 0; j < 4; ++j)
     for (int i = 0; i < 4; ++i) {
       const bool odd = ((i + j) & 1) != 0;
-      t->rgba.insert(t->rgba.end(), {static_cast<std::uint8_t>(odd ? 230 : 20),
-                                     static_cast<std::uint8_t>(60 * i),
-                                     static_cast<std::uint8_t>(60 * j), 255});
+      t->rgba.insert(t->rgba.end(),
+                     {static_cast<std::uint8_t>(odd ? 230 : 20), static_cast<std::uint8_t>(60 * i),
+                      static_cast<std::uint8_t>(60 * j), 255});
     }
   return t;
 }
@@ -118,7 +118,8 @@ Scene litScene(Shading shading) {
   s.camera.near = 0.5;
   s.camera.far = 30.0;
   s.ambient_light = {0.1, 0.1, 0.12};
-  s.lights.push_back(Light{LightType::Point, {2.0, 3.0, 4.0}, {0.0, -1.0, 0.0}, {1.0, 0.9, 0.8}, 1.5});
+  s.lights.push_back(
+      Light{LightType::Point, {2.0, 3.0, 4.0}, {0.0, -1.0, 0.0}, {1.0, 0.9, 0.8}, 1.5});
   s.lights.push_back(
       Light{LightType::Directional, {0.0, 0.0, 0.0}, {-0.3, -1.0, -0.2}, {0.4, 0.5, 0.6}, 0.7});
   s.state.shading = shading;

@@ -69,19 +69,39 @@ TEST(ShadingAtKnownPixel, EachTermAgainstHandComputedValues) {
   const Case cases[] = {
       // ambient (0.1, 0.2, 0.3) + diffuse 0.5 * L * 0.8 = (0.8, 0.4, 0.2)
       // + Blinn-Phong: h = (0, 0.6, 1.8)/|.|, (n.h)^2 = 0.9, (n.h)^8 = 0.6561: L * 0.6561.
-      {"blinn-phong", SpecularModel::BlinnPhong, Attenuation::None, 8.0, pointLight(),
+      {"blinn-phong",
+       SpecularModel::BlinnPhong,
+       Attenuation::None,
+       8.0,
+       pointLight(),
        {0.1 + 0.8 + 1.3122, 0.2 + 0.4 + 0.6561, 0.3 + 0.2 + 0.32805, 1.0}},
       // Phong: r = 2(n.l)n - l = (0, -0.6, 0.8), r.v = 0.8, ^2 = 0.64.
-      {"phong", SpecularModel::Phong, Attenuation::None, 2.0, pointLight(),
+      {"phong",
+       SpecularModel::Phong,
+       Attenuation::None,
+       2.0,
+       pointLight(),
        {0.1 + 0.8 + 1.28, 0.2 + 0.4 + 0.64, 0.3 + 0.2 + 0.32, 1.0}},
       // 1/r: L = (0.4, 0.2, 0.1).
-      {"inverse", SpecularModel::BlinnPhong, Attenuation::Inverse, 8.0, pointLight(),
+      {"inverse",
+       SpecularModel::BlinnPhong,
+       Attenuation::Inverse,
+       8.0,
+       pointLight(),
        {0.1 + 0.16 + 0.26244, 0.2 + 0.08 + 0.13122, 0.3 + 0.04 + 0.06561, 1.0}},
       // 1/r^2: L = (0.08, 0.04, 0.02).
-      {"inverse_square", SpecularModel::BlinnPhong, Attenuation::InverseSquare, 8.0, pointLight(),
+      {"inverse_square",
+       SpecularModel::BlinnPhong,
+       Attenuation::InverseSquare,
+       8.0,
+       pointLight(),
        {0.1 + 0.032 + 0.052488, 0.2 + 0.016 + 0.026244, 0.3 + 0.008 + 0.013122, 1.0}},
       // Directional lights are never attenuated: same as the unattenuated point light.
-      {"directional", SpecularModel::BlinnPhong, Attenuation::InverseSquare, 8.0, directional,
+      {"directional",
+       SpecularModel::BlinnPhong,
+       Attenuation::InverseSquare,
+       8.0,
+       directional,
        {0.1 + 0.8 + 1.3122, 0.2 + 0.4 + 0.6561, 0.3 + 0.2 + 0.32805, 1.0}},
       // Light behind the surface: n.l = -1, h = 0: ambient only.
       {"behind", SpecularModel::BlinnPhong, Attenuation::None, 8.0, behind, {0.1, 0.2, 0.3, 1.0}},
@@ -157,8 +177,8 @@ Scene barycentricScene(Scene s, const glm::vec3& a, const glm::vec3& b, const gl
 }
 
 TEST(Gouraud, OrthographicColourIsTheScreenSpaceBarycentric) {
-  const Scene s = barycentricScene(test::windowScene(16, 16), {1, 1, 0.5f}, {15, 1, 0.5f},
-                                   {1, 15, 0.5f});
+  const Scene s =
+      barycentricScene(test::windowScene(16, 16), {1, 1, 0.5f}, {15, 1, 0.5f}, {1, 15, 0.5f});
   const Frame f = renderReference(s);
   // Pixel (4, GL row 6): centre (4.5, 6.5): b1 = 3.5 / 14, b2 = 5.5 / 14, b0 = 5 / 14.
   expectColor(colorAt(f, 4, 15 - 6), {5.0 / 14, 3.5 / 14, 5.5 / 14, 1.0}, "gouraud");
@@ -280,7 +300,9 @@ std::shared_ptr<Texture> gradientTexture() {
   return t;
 }
 
-glm::dvec4 texel(int i, int j) { return glm::dvec4(16 * i + 64 * j, 255 - 16 * i, 64 * j, 255) / 255.0; }
+glm::dvec4 texel(int i, int j) {
+  return glm::dvec4(16 * i + 64 * j, 255 - 16 * i, 64 * j, 255) / 255.0;
+}
 
 TEST(TextureSampling, NearestAndLinearAtTexelCentresAndBetween) {
   const auto t = gradientTexture();
@@ -299,9 +321,12 @@ TEST(TextureSampling, NearestAndLinearAtTexelCentresAndBetween) {
       sampleTexture(*t, {0.5, 0.375}, TextureFilter::Linear, TextureWrap::Repeat);
   EXPECT_NEAR(mid.r, (texel(1, 1).r + texel(2, 1).r) / 2, 1e-15);
   // Wrapping: u = -0.1 -> texel 3 (repeat) or 0 (clamp); u = 1.3 -> 1 or 3.
-  EXPECT_EQ(sampleTexture(*t, {-0.1, 0.1}, TextureFilter::Nearest, TextureWrap::Repeat), texel(3, 0));
-  EXPECT_EQ(sampleTexture(*t, {-0.1, 0.1}, TextureFilter::Nearest, TextureWrap::Clamp), texel(0, 0));
-  EXPECT_EQ(sampleTexture(*t, {1.3, 0.1}, TextureFilter::Nearest, TextureWrap::Repeat), texel(1, 0));
+  EXPECT_EQ(sampleTexture(*t, {-0.1, 0.1}, TextureFilter::Nearest, TextureWrap::Repeat),
+            texel(3, 0));
+  EXPECT_EQ(sampleTexture(*t, {-0.1, 0.1}, TextureFilter::Nearest, TextureWrap::Clamp),
+            texel(0, 0));
+  EXPECT_EQ(sampleTexture(*t, {1.3, 0.1}, TextureFilter::Nearest, TextureWrap::Repeat),
+            texel(1, 0));
   EXPECT_EQ(sampleTexture(*t, {1.3, 0.1}, TextureFilter::Nearest, TextureWrap::Clamp), texel(3, 0));
   // Non-finite coordinates sample texel 0 instead of crashing.
   EXPECT_EQ(sampleTexture(*t, {std::nan(""), 0.1}, TextureFilter::Linear, TextureWrap::Repeat).g,
@@ -350,8 +375,8 @@ TEST(TextureSampling, TextureMultipliesAmbientAndDiffuseNotSpecular) {
   s.materials[0].texture = t;
   const Frame f = renderReference(s);
   // (ambient + diffuse) * t + specular; the texture's alpha is not used.
-  expectColor(colorAt(f, 8, 7),
-              {0.9 * 0.2 + 1.3122, 0.6 * 0.4 + 0.6561, 0.5 * 1.0 + 0.32805, 1.0}, "textured");
+  expectColor(colorAt(f, 8, 7), {0.9 * 0.2 + 1.3122, 0.6 * 0.4 + 0.6561, 0.5 * 1.0 + 0.32805, 1.0},
+              "textured");
 }
 
 TEST(ShadingUnit, SpecularPowerAndZeroNormals) {

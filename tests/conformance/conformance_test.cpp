@@ -1,0 +1,112 @@
+// The conformance suite: every catalog fixture x every GL backend, compared with the
+// reference, one GoogleTest test per pair (suite = topic folder, name = fixture and
+// backend), so ctest -R / -L and GTEST_TOTAL_SHARDS/GTEST_SHARD_INDEX work as for any
+// GoogleTest suite. A pair passes when exactly the classes listed for it in
+// expectations.json fail: an unexpected failure and an unexpected pass both fail.
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "compare/report.h"
+#include "fixtures/catalog.h"
+#include "fixtures/loader.h"
+#include "tests/conformance/conformance_support.h"
+
+namespace fs = std::filesystem;
+using namespace rc;
+using namespace rc::conformance;
+
+namespace {
+
+std::string identifier(const std::string& s) {
+  std::string out;
+  for (char c : s) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
+class ConformancePair : public testing::Test {
+ public:
+  ConformancePair(fs::path file, std::string backend)
+      : file_(std::move(file)), backend_(std::move(backend)) {}
+
+  void TestBody() override {
+    std::string why;
+    if (!backendStarts(backend_, why)) {
+      if (glRequired()) FAIL() << backend_ << " cannot start: " << why;
+      GTEST_SKIP() << backend_ << " cannot start on this machine: " << why;
+    }
+    const Scene scene = loadScene(file_);
+    std::string error;
+    int code = 0;
+    const auto ref = renderInChild(file_, "ref", error, code);
+    ASSERT_TRUE(ref) << "reference failed on " << file_ << ": " << error;
+    const auto gl = renderInChild(file_, backend_, error, code);
+    ASSERT_TRUE(gl) << backend_ << " failed on " << scene.name << " (exit " << code
+                    << "): " << error;
+
+    PairResult result = compareFrames(*ref, *gl, *ref, tolerancesFor(scene, *ref, *gl));
+    result.fixture = scene.name;
+    result.expected = "ref";
+    result.actual = backend_;
+    const std::set<std::string> failing = failingClasses(result);
+    std::set<std::string> expected;
+    std::string reasons;
+    for (const Expectation& e : expectationsFor(scene.name, backend_)) {
+      expected.insert(e.cls);
+      reasons += fmt::format("\n  expected {} to fail: {}", e.cls, e.reason);
+    }
+    if (failing != expected) {
+      const fs::path artifacts = writeArtifacts(
+          testing::UnitTest::GetInstance()->current_test_info()->name(), *ref, *gl, *ref, result);
+      for (const std::string& c : failing) {
+        EXPECT_TRUE(expected.count(c)) << "unexpected failure: " << describe(result);
+      }
+      for (const std::string& c : expected) {
+        EXPECT_TRUE(failing.count(c))
+            << "unexpected pass of " << c
+            << " (remove it from expectations.json): " << describe(result) << reasons;
+      }
+      ADD_FAILURE() << "images and report: " << artifacts.string();
+    }
+    RecordProperty("verdict", toString(result.status));
+  }
+
+ private:
+  fs::path file_;
+  std::string backend_;
+};
+
+void registerCatalog() {
+  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
+  for (const fs::path& file : findFixtures({catalog})) {
+    // Registration only reads the name, so that listing tests stays cheap; the test
+    // body loads and validates the whole fixture.
+    std::ifstream in(file);
+    const auto doc = nlohmann::json::parse(in, nullptr, false);
+    std::string name = file.stem().string();
+    if (doc.is_object() && doc.contains("name") && doc["name"].is_string())
+      name = doc["name"].get<std::string>();
+    const std::size_t slash = name.find('/');
+    const std::string topic = slash == std::string::npos ? "misc" : name.substr(0, slash);
+    const std::string rest = slash == std::string::npos ? name : name.substr(slash + 1);
+    for (const std::string& backend : backends()) {
+      const std::string suite = identifier(topic);
+      const std::string test = identifier(rest) + "__" + identifier(backend);
+      testing::RegisterTest(
+          suite.c_str(), test.c_str(), nullptr, backend.c_str(), __FILE__, __LINE__,
+          [file, backend]() -> testing::Test* { return new ConformancePair(file, backend); });
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  registerCatalog();
+  return RUN_ALL_TESTS();
+}
