@@ -81,8 +81,7 @@ class ConformancePair : public testing::Test {
 };
 
 void registerCatalog() {
-  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
-  for (const fs::path& file : findFixtures({catalog})) {
+  for (const fs::path& file : findFixtures({catalogDir()})) {
     // Registration only reads the name, so that listing tests stays cheap; the test
     // body loads and validates the whole fixture.
     std::ifstream in(file);
@@ -96,8 +95,9 @@ void registerCatalog() {
     for (const std::string& backend : backends()) {
       const std::string suite = identifier(topic);
       const std::string test = identifier(rest) + "__" + identifier(backend);
+      // No value parameter: it would end up in the test's name as "# GetParam() = ...".
       testing::RegisterTest(
-          suite.c_str(), test.c_str(), nullptr, backend.c_str(), __FILE__, __LINE__,
+          suite.c_str(), test.c_str(), nullptr, nullptr, __FILE__, __LINE__,
           [file, backend]() -> testing::Test* { return new ConformancePair(file, backend); });
     }
   }
