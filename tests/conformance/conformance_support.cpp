@@ -71,10 +71,10 @@ std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& s
                                    std::string& error, int& exit_code, const std::string& env) {
   static int counter = 0;
   const fs::path out = scratchRoot() / fmt::format("frame{}", counter++);
-  const std::string cmd = fmt::format("{}{} render {} --backend {} --out {} 2>&1",
-                                      env.empty() ? "" : "env " + shellQuote(env) + " ", RC_EXE,
-                                      shellQuote(fixture.string()), shellQuote(spec),
-                                      shellQuote(out.string()));
+  const std::string cmd =
+      fmt::format("{}{} render {} --backend {} --out {} 2>&1",
+                  env.empty() ? "" : "env " + shellQuote(env) + " ", RC_EXE,
+                  shellQuote(fixture.string()), shellQuote(spec), shellQuote(out.string()));
   std::string output;
   FILE* p = ::popen(cmd.c_str(), "r");
   if (p == nullptr) {
@@ -197,20 +197,22 @@ Expectations parseExpectations(const nlohmann::json& doc, const std::set<std::st
     for (const char* key : {"fixture", "backend", "class", "reason"}) {
       if (!e.contains(key)) out.errors.push_back(fmt::format("{}.{}: missing", at, key));
     }
-    if (e.contains("fixture") && !fixtures.count(x.fixture))
+    // Values are checked only where they are strings (else that is the error already).
+    auto given = [&e](const char* key) { return e.contains(key) && e[key].is_string(); };
+    if (given("fixture") && !fixtures.count(x.fixture))
       out.errors.push_back(
           fmt::format("{}.fixture: no fixture named \"{}\" in the catalog", at, x.fixture));
-    if (e.contains("backend")) {
+    if (given("backend")) {
       bool any = false;
       for (const std::string& b : known) any = any || backendMatches(x.backend, b);
       if (!any)
-        out.errors.push_back(fmt::format("{}.backend: \"{}\" matches none of the suite's backends",
-                                         at, x.backend));
+        out.errors.push_back(
+            fmt::format("{}.backend: \"{}\" matches none of the suite's backends", at, x.backend));
     }
-    if (e.contains("class") && !classes.count(x.cls))
-      out.errors.push_back(fmt::format(
-          "{}.class: \"{}\" is not one of visibility, depth, shading", at, x.cls));
-    if (e.contains("reason") && x.reason.find_first_not_of(" \t") == std::string::npos)
+    if (given("class") && !classes.count(x.cls))
+      out.errors.push_back(
+          fmt::format("{}.class: \"{}\" is not one of visibility, depth, shading", at, x.cls));
+    if (given("reason") && x.reason.find_first_not_of(" \t") == std::string::npos)
       out.errors.push_back(fmt::format("{}.reason: must say why", at));
     if (out.errors.size() != before) continue;
     if (!seen.emplace(x.fixture, x.backend, x.cls).second) {
