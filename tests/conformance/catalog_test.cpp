@@ -4,8 +4,12 @@
 // scripts/gen-fixture-readme.sh makes of the catalog today.
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -138,4 +142,129 @@ TEST(Catalog, ReadmeIsCurrent) {
   const std::string cmd = fmt::format("RASTERCHECK='{}' '{}/scripts/gen-fixture-readme.sh' --check",
                                       RC_EXE, RC_SOURCE_DIR);
   EXPECT_EQ(run(cmd, output), 0) << output;
+}
+
+// --- Fixture design: the scenes show what their descriptions say, with the reference.
+
+namespace {
+
+Frame renderRef(const std::string& fixture) {
+  std::string error;
+  int code = 0;
+  auto frame = renderInChild(catalogDir() / (fixture + ".json"), "ref", error, code);
+  if (!frame) throw std::runtime_error(fixture + ": " + error);
+  return *frame;
+}
+
+nlohmann::json readJson(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
+}  // namespace
+
+// Painter's algorithm cannot resolve a cyclic overlap: the painter image differs from the
+// z-buffer image at exactly one crossing (sticks 0 and 1, ids 1 and 2), with hard
+// mismatches; no two sticks come near each other in depth (none intersects another).
+TEST(FixtureDesign, CyclicOverlapDefeatsPainterAtOneCrossing) {
+  const Frame zbuffer = renderRef("zbuffer/cyclic_overlap_zbuffer");
+  const Frame painter = renderRef("visibility/cyclic_overlap_painter");
+  const PairResult r =
+      compareFrames(zbuffer, painter, zbuffer, tolerancesForFrames(zbuffer, painter));
+  EXPECT_EQ(r.visibility.status, Status::Fail);
+  EXPECT_GT(r.visibility.hard, 100u);
+  std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  float min_gap = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < zbuffer.pixelCount(); ++i) {
+    if (zbuffer.id[i] != painter.id[i]) pairs.insert({zbuffer.id[i], painter.id[i]});
+    min_gap = std::min(min_gap, zbuffer.depth_gap[i]);
+  }
+  // Stick 0 (id 1) is over stick 1 (id 2); painter draws 1 after 0.
+  EXPECT_EQ(pairs, (std::set<std::pair<std::uint32_t, std::uint32_t>>{{1, 2}}));
+  // Where two sticks overlap they are at least ~0.1 apart in eye space: thousands of steps.
+  EXPECT_GT(min_gap, 1000.0f);
+}
+
+namespace {
+
+// The ladder of depth/zfight_*: 17 rows of 8 px (bottom first), separations 2^(row-4)
+// d24 steps; fixtures/scenes/depth/zfight_ladder.py writes them.
+constexpr int kLadderRows = 17;
+
+// Pixels of the strips (ids above the plane's 1 and 2).
+std::size_t stripPixels(const Frame& f) {
+  std::size_t n = 0;
+  for (std::uint32_t id : f.id) n += id > 2;
+  return n;
+}
+
+}  // namespace
+
+// Each format resolves what its precision allows, so the images differ: d16 < d24 < d32f
+// at window z 0.1 (a float's ulp there is 1/8 of a d24 step), d16 < d24 at z 0.99975.
+TEST(FixtureDesign, ZFightFormatsDiffer) {
+  const std::size_t o16 = stripPixels(renderRef("depth/zfight_ortho_d16"));
+  const std::size_t o24 = stripPixels(renderRef("depth/zfight_ortho_d24"));
+  const std::size_t o32 = stripPixels(renderRef("depth/zfight_ortho_d32f"));
+  const std::size_t p16 = stripPixels(renderRef("depth/zfight_perspective_d16"));
+  const std::size_t p24 = stripPixels(renderRef("depth/zfight_perspective_d24"));
+  // A row is 6 px x 128 = 768 strip pixels. d16 resolves rows >= 256 steps (5 rows),
+  // d24 rows >= 1 step (13), d32f at z 0.1 rows >= 1/8 step (16); finer rows partly.
+  const std::size_t row = 768;
+  EXPECT_GE(o16, 5 * row);
+  EXPECT_LT(o16, 7 * row);
+  EXPECT_GE(o24, 13 * row);
+  EXPECT_LT(o24, 15 * row);
+  EXPECT_GE(o32, 16 * row);
+  EXPECT_GE(p16, 5 * row);
+  EXPECT_LT(p16, 7 * row);
+  EXPECT_GE(p24, 13 * row);
+  EXPECT_LT(p24, 15 * row);
+}
+
+// The ladder can fail: a renderer that shows the plane over every strip (as if the
+// planes were swapped) fails hard on every row whose separation exceeds twice the depth
+// fail tolerance, and is excused (ambiguous) on the rows below.
+TEST(FixtureDesign, ZFightLadderCatchesSwappedPlanes) {
+  for (const char* name :
+       {"depth/zfight_ortho_d16", "depth/zfight_ortho_d24", "depth/zfight_ortho_d32f",
+        "depth/zfight_perspective_d16", "depth/zfight_perspective_d24"}) {
+    const Frame ref = renderRef(name);
+    Frame swapped = ref;
+    for (std::uint32_t& id : swapped.id) id = id > 2 ? 1 : id;
+    const Tolerances tol = tolerancesForFrames(ref, swapped);
+    const PairResult r = compareFrames(ref, swapped, ref, tol);
+    // Separations in steps of the format: d16 steps are 256 d24 steps.
+    const double per_d24 = tol.depth_format == DepthFormat::D16 ? 1.0 / 256.0 : 1.0;
+    std::uint64_t sure_hard = 0, maybe_hard = 0;
+    for (int row = 0; row < kLadderRows; ++row) {
+      const double steps = std::ldexp(1.0, row - 4) * per_d24;
+      if (steps > 4.0 * tol.depth.fail) sure_hard += 768;  // well clear of the allowance
+      if (steps > 2.0 * tol.depth.fail) maybe_hard += 768;
+    }
+    EXPECT_EQ(r.visibility.status, Status::Fail) << name;
+    EXPECT_GE(r.visibility.hard, sure_hard) << name;
+    EXPECT_LE(r.visibility.hard, maybe_hard) << name;
+    EXPECT_GT(r.visibility.ambiguous, 0u) << name;
+  }
+}
+
+// The grazing checkerboards differ in texture filter and wrap only.
+TEST(FixtureDesign, CheckerGrazingDiffersOnlyInFilterAndWrap) {
+  std::optional<nlohmann::json> first;
+  std::set<std::pair<std::string, std::string>> variants;
+  for (const char* filter : {"nearest", "linear"}) {
+    for (const char* wrap : {"repeat", "clamp"}) {
+      auto doc =
+          readJson(catalogDir() / fmt::format("texture/checker_grazing_{}_{}.json", filter, wrap));
+      variants.insert({doc["state"]["texture_filter"].get<std::string>(),
+                       doc["state"]["texture_wrap"].get<std::string>()});
+      for (const char* key : {"name", "description"}) doc.erase(key);
+      doc["state"].erase("texture_filter");
+      doc["state"].erase("texture_wrap");
+      if (!first) first = doc;
+      EXPECT_EQ(doc, *first) << filter << " " << wrap;
+    }
+  }
+  EXPECT_EQ(variants.size(), 4u);
 }
