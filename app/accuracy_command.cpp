@@ -17,7 +17,7 @@ int accuracyCommand(const AccuracyArgs& args) {
   if (catalogs.empty()) catalogs.push_back(defaultCatalogDir());
   AccuracyData data = readAccuracyRuns(args.runs, catalogs);
   if (!args.expectations.empty()) data.known = readKnownDifferences(args.expectations);
-  const std::string command = args.command.empty() ? "rastercheck accuracy" : args.command;
+  const std::string command = args.command.empty() ? "`rastercheck accuracy`" : args.command;
   const std::string md = accuracyMarkdown(data, command);
   if (args.out.empty()) {
     std::cout << md;

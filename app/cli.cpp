@@ -74,7 +74,7 @@ int runCli(int argc, char** argv) {
   accuracy_cmd->add_option("--expectations", accuracy.expectations,
                            "Known differences to list (tests/conformance/expectations.json)");
   accuracy_cmd->add_option("--command", accuracy.command,
-                           "The regenerating command the document names");
+                           "How the document says it was made (Markdown)");
 
   try {
     app.parse(argc, argv);

@@ -78,7 +78,7 @@ AccuracyData readAccuracyRuns(const std::vector<std::filesystem::path>& runs,
 // Reads an expectations file ({"expectations": [{fixture, backend, class, reason}]}).
 std::vector<KnownDifference> readKnownDifferences(const std::filesystem::path& file);
 
-// The Markdown document. `command` is printed as the way to regenerate it.
+// The Markdown document. `command` (Markdown) is printed as the way to regenerate it.
 std::string accuracyMarkdown(const AccuracyData& data, const std::string& command);
 
 }  // namespace rc

@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 std::vector<std::string> backends() {
   std::vector<std::string> out = {"gl:egl:llvmpipe", "gl:egl:softpipe"};
 #ifdef RC_HAVE_OSMESA
-  out.push_back("gl:osmesa:llvmpipe");
+  out.emplace_back("gl:osmesa:llvmpipe");
 #endif
   return out;
 }
@@ -275,7 +275,7 @@ Tolerances tolerancesFor(const Scene& scene, const Frame& expected, const Frame&
 
 fs::path writeArtifacts(const std::string& test_name, const Frame& expected, const Frame& actual,
                         const Frame& uncertainty, PairResult& result) {
-  const fs::path dir = fs::path(RC_BINARY_DIR) / "conformance-artifacts" / fixtureSlug(test_name);
+  fs::path dir = fs::path(RC_BINARY_DIR) / "conformance-artifacts" / fixtureSlug(test_name);
   ClassMaps maps;
   PairResult again = compareFrames(expected, actual, uncertainty, result.tolerances, &maps);
   again.fixture = result.fixture;

@@ -4,6 +4,7 @@
 // GoogleTest suite. A pair passes when exactly the classes listed for it in
 // expectations.json fail: an unexpected failure and an unexpected pass both fail.
 #include <cctype>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -106,7 +107,12 @@ void registerCatalog() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  registerCatalog();
-  return RUN_ALL_TESTS();
+  try {
+    testing::InitGoogleTest(&argc, argv);
+    registerCatalog();
+    return RUN_ALL_TESTS();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cannot register the tests: %s\n", e.what());
+    return 1;
+  }
 }

@@ -5,6 +5,7 @@
 // ORIGINAL, must fail in exactly the class mutations.json names and in no other; the
 // original rendered by the same backend (the control) must fail in none, so that the
 // failure is the mutation's. One GoogleTest per mutation x backend.
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -126,7 +127,12 @@ TEST(MutationManifest, MatchesTheFolders) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  registerMutations();
-  return RUN_ALL_TESTS();
+  try {
+    testing::InitGoogleTest(&argc, argv);
+    registerMutations();
+    return RUN_ALL_TESTS();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cannot register the tests: %s\n", e.what());
+    return 1;
+  }
 }
