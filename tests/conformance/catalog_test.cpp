@@ -268,3 +268,13 @@ TEST(FixtureDesign, CheckerGrazingDiffersOnlyInFilterAndWrap) {
   }
   EXPECT_EQ(variants.size(), 4u);
 }
+
+// A backend that cannot start is told apart from one that fails on a fixture: the GL
+// tests skip on the first and fail on the second.
+TEST(Support, BackendThatCannotStartIsUnavailable) {
+  const BackendRender r =
+      renderWithBackend(catalogDir() / "coverage" / "triangle_fan.json", "gl:egl-device:99");
+  EXPECT_FALSE(r.frame);
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_TRUE(r.unavailable) << r.error;
+}

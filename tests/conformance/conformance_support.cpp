@@ -132,6 +132,20 @@ bool backendStarts(const std::string& spec, std::string& why) {
   return it->second.first;
 }
 
+BackendRender renderWithBackend(const fs::path& fixture, const std::string& spec,
+                                const std::string& env) {
+  BackendRender r;
+  r.frame = renderInChild(fixture, spec, r.error, r.exit_code, env);
+  if (!r.frame && r.exit_code == 3) {
+    std::string why;
+    if (!backendStarts(spec, why)) {
+      r.unavailable = true;
+      r.error = why;
+    }
+  }
+  return r;
+}
+
 std::set<std::string> failingClasses(const PairResult& r) {
   std::set<std::string> out;
   if (r.visibility.status == Status::Fail) out.insert("visibility");

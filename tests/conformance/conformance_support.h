@@ -38,6 +38,18 @@ std::optional<Frame> renderInChild(const std::filesystem::path& fixture, const s
 bool backendStarts(const std::string& spec, std::string& why);
 bool glRequired();
 
+// renderInChild for a GL backend. Only when the child exits 3 is the probe scene tried
+// (one process fewer per test on the usual path): if the backend cannot render even that,
+// `unavailable` is set and the caller skips; a failure on this fixture alone is an error.
+struct BackendRender {
+  std::optional<Frame> frame;
+  bool unavailable = false;
+  std::string error;
+  int exit_code = 0;
+};
+BackendRender renderWithBackend(const std::filesystem::path& fixture, const std::string& spec,
+                                const std::string& env = "");
+
 // The classes ("visibility", "depth", "shading") whose status is fail in `result`.
 std::set<std::string> failingClasses(const PairResult& result);
 

@@ -35,21 +35,20 @@ class ConformancePair : public testing::Test {
       : file_(std::move(file)), backend_(std::move(backend)) {}
 
   void TestBody() override {
-    std::string why;
-    if (!backendStarts(backend_, why)) {
-      if (glRequired()) FAIL() << backend_ << " cannot start: " << why;
-      GTEST_SKIP() << backend_ << " cannot start on this machine: " << why;
+    const BackendRender gl = renderWithBackend(file_, backend_);
+    if (gl.unavailable) {
+      if (glRequired()) FAIL() << backend_ << " cannot start: " << gl.error;
+      GTEST_SKIP() << backend_ << " cannot start on this machine: " << gl.error;
     }
     const Scene scene = loadScene(file_);
+    ASSERT_TRUE(gl.frame) << backend_ << " failed on " << scene.name << " (exit " << gl.exit_code
+                          << "): " << gl.error;
     std::string error;
     int code = 0;
     const auto ref = renderInChild(file_, "ref", error, code);
     ASSERT_TRUE(ref) << "reference failed on " << file_ << ": " << error;
-    const auto gl = renderInChild(file_, backend_, error, code);
-    ASSERT_TRUE(gl) << backend_ << " failed on " << scene.name << " (exit " << code
-                    << "): " << error;
 
-    PairResult result = compareFrames(*ref, *gl, *ref, tolerancesFor(scene, *ref, *gl));
+    PairResult result = compareFrames(*ref, *gl.frame, *ref, tolerancesFor(scene, *ref, *gl.frame));
     result.fixture = scene.name;
     result.expected = "ref";
     result.actual = backend_;
@@ -61,8 +60,9 @@ class ConformancePair : public testing::Test {
       reasons += fmt::format("\n  expected {} to fail: {}", e.cls, e.reason);
     }
     if (failing != expected) {
-      const fs::path artifacts = writeArtifacts(
-          testing::UnitTest::GetInstance()->current_test_info()->name(), *ref, *gl, *ref, result);
+      const fs::path artifacts =
+          writeArtifacts(testing::UnitTest::GetInstance()->current_test_info()->name(), *ref,
+                         *gl.frame, *ref, result);
       for (const std::string& c : failing) {
         EXPECT_TRUE(expected.count(c)) << "unexpected failure: " << describe(result);
       }

@@ -43,35 +43,37 @@ class MutationTest : public testing::Test {
       : name_(std::move(name)), cls_(std::move(cls)), backend_(std::move(backend)) {}
 
   void TestBody() override {
-    std::string why;
-    if (!backendStarts(backend_, why)) {
-      if (glRequired()) FAIL() << backend_ << " cannot start: " << why;
-      GTEST_SKIP() << backend_ << " cannot start on this machine: " << why;
-    }
     const fs::path original_file = kMutations / name_ / "original.json";
     const fs::path mutant_file = kMutations / name_ / "mutant.json";
+    const BackendRender control = renderWithBackend(original_file, backend_);
+    if (control.unavailable) {
+      if (glRequired()) FAIL() << backend_ << " cannot start: " << control.error;
+      GTEST_SKIP() << backend_ << " cannot start on this machine: " << control.error;
+    }
+    ASSERT_TRUE(control.frame) << backend_ << " failed on " << original_file << ": "
+                               << control.error;
+    const BackendRender mutant = renderWithBackend(mutant_file, backend_);
+    ASSERT_TRUE(mutant.frame) << backend_ << " failed on " << mutant_file << ": " << mutant.error;
     const Scene original = loadScene(original_file);
     std::string error;
     int code = 0;
     const auto ref = renderInChild(original_file, "ref", error, code);
     ASSERT_TRUE(ref) << "reference failed on " << original_file << ": " << error;
-    const auto control = renderInChild(original_file, backend_, error, code);
-    ASSERT_TRUE(control) << backend_ << " failed on " << original_file << ": " << error;
-    const auto mutant = renderInChild(mutant_file, backend_, error, code);
-    ASSERT_TRUE(mutant) << backend_ << " failed on " << mutant_file << ": " << error;
 
     const std::string test = testing::UnitTest::GetInstance()->current_test_info()->name();
-    PairResult c = compareFrames(*ref, *control, *ref, tolerancesFor(original, *ref, *control));
+    PairResult c =
+        compareFrames(*ref, *control.frame, *ref, tolerancesFor(original, *ref, *control.frame));
     c.fixture = original.name;
     c.expected = "ref";
     c.actual = backend_;
     if (!failingClasses(c).empty()) {
       ADD_FAILURE() << "the unmutated fixture already fails, so the mutant proves nothing: "
                     << describe(c) << "\nimages and report: "
-                    << writeArtifacts(test + "__control", *ref, *control, *ref, c).string();
+                    << writeArtifacts(test + "__control", *ref, *control.frame, *ref, c).string();
     }
 
-    PairResult m = compareFrames(*ref, *mutant, *ref, tolerancesFor(original, *ref, *mutant));
+    PairResult m =
+        compareFrames(*ref, *mutant.frame, *ref, tolerancesFor(original, *ref, *mutant.frame));
     m.fixture = original.name + " (mutant)";
     m.expected = "ref";
     m.actual = backend_;
@@ -79,7 +81,7 @@ class MutationTest : public testing::Test {
     if (failing != std::set<std::string>{cls_}) {
       ADD_FAILURE() << "the mutant must fail in " << cls_ << " only, fails in " << joined(failing)
                     << ": " << describe(m) << "\nimages and report: "
-                    << writeArtifacts(test, *ref, *mutant, *ref, m).string();
+                    << writeArtifacts(test, *ref, *mutant.frame, *ref, m).string();
     }
   }
 
