@@ -149,11 +149,7 @@ TEST(Catalog, ReadmeIsCurrent) {
 namespace {
 
 Frame renderRef(const std::string& fixture) {
-  std::string error;
-  int code = 0;
-  auto frame = renderInChild(catalogDir() / (fixture + ".json"), "ref", error, code);
-  if (!frame) throw std::runtime_error(fixture + ": " + error);
-  return *frame;
+  return renderReference(catalogDir() / (fixture + ".json"));
 }
 
 nlohmann::json readJson(const fs::path& file) {

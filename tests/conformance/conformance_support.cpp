@@ -12,10 +12,12 @@
 
 #include <fmt/format.h>
 
+#include "app/backends.h"
 #include "compare/pair_images.h"
 #include "compare/report.h"
 #include "fixtures/catalog.h"
 #include "fixtures/frame_io.h"
+#include "fixtures/loader.h"
 #include "fixtures/scene_writer.h"
 
 namespace rc::conformance {
@@ -98,6 +100,11 @@ std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& s
   std::error_code ec;
   fs::remove_all(out, ec);
   return frame;
+}
+
+Frame renderReference(const fs::path& fixture) {
+  static const BackendSpec ref = parseBackendSpec("ref");
+  return renderWith(ref, loadScene(fixture));
 }
 
 bool glRequired() {

@@ -33,6 +33,11 @@ std::filesystem::path scratchRoot();
 std::optional<Frame> renderInChild(const std::filesystem::path& fixture, const std::string& spec,
                                    std::string& error, int& exit_code, const std::string& env = "");
 
+// The reference render of a fixture, in this process (the same code path as
+// `rastercheck render --backend ref`, without a child process: the reference is plain
+// deterministic CPU code). Throws InputError on a bad fixture.
+Frame renderReference(const std::filesystem::path& fixture);
+
 // True when `spec` can render at all on this machine (a one-triangle scene), cached per
 // process. When it cannot, GL tests skip, or fail under RASTERCHECK_REQUIRE_GL=1.
 bool backendStarts(const std::string& spec, std::string& why);

@@ -43,12 +43,9 @@ class ConformancePair : public testing::Test {
     const Scene scene = loadScene(file_);
     ASSERT_TRUE(gl.frame) << backend_ << " failed on " << scene.name << " (exit " << gl.exit_code
                           << "): " << gl.error;
-    std::string error;
-    int code = 0;
-    const auto ref = renderInChild(file_, "ref", error, code);
-    ASSERT_TRUE(ref) << "reference failed on " << file_ << ": " << error;
+    const Frame ref = renderReference(file_);
 
-    PairResult result = compareFrames(*ref, *gl.frame, *ref, tolerancesFor(scene, *ref, *gl.frame));
+    PairResult result = compareFrames(ref, *gl.frame, ref, tolerancesFor(scene, ref, *gl.frame));
     result.fixture = scene.name;
     result.expected = "ref";
     result.actual = backend_;
@@ -61,8 +58,8 @@ class ConformancePair : public testing::Test {
     }
     if (failing != expected) {
       const fs::path artifacts =
-          writeArtifacts(testing::UnitTest::GetInstance()->current_test_info()->name(), *ref,
-                         *gl.frame, *ref, result);
+          writeArtifacts(testing::UnitTest::GetInstance()->current_test_info()->name(), ref,
+                         *gl.frame, ref, result);
       for (const std::string& c : failing) {
         EXPECT_TRUE(expected.count(c)) << "unexpected failure: " << describe(result);
       }

@@ -55,25 +55,22 @@ class MutationTest : public testing::Test {
     const BackendRender mutant = renderWithBackend(mutant_file, backend_);
     ASSERT_TRUE(mutant.frame) << backend_ << " failed on " << mutant_file << ": " << mutant.error;
     const Scene original = loadScene(original_file);
-    std::string error;
-    int code = 0;
-    const auto ref = renderInChild(original_file, "ref", error, code);
-    ASSERT_TRUE(ref) << "reference failed on " << original_file << ": " << error;
+    const Frame ref = renderReference(original_file);
 
     const std::string test = testing::UnitTest::GetInstance()->current_test_info()->name();
     PairResult c =
-        compareFrames(*ref, *control.frame, *ref, tolerancesFor(original, *ref, *control.frame));
+        compareFrames(ref, *control.frame, ref, tolerancesFor(original, ref, *control.frame));
     c.fixture = original.name;
     c.expected = "ref";
     c.actual = backend_;
     if (!failingClasses(c).empty()) {
       ADD_FAILURE() << "the unmutated fixture already fails, so the mutant proves nothing: "
                     << describe(c) << "\nimages and report: "
-                    << writeArtifacts(test + "__control", *ref, *control.frame, *ref, c).string();
+                    << writeArtifacts(test + "__control", ref, *control.frame, ref, c).string();
     }
 
     PairResult m =
-        compareFrames(*ref, *mutant.frame, *ref, tolerancesFor(original, *ref, *mutant.frame));
+        compareFrames(ref, *mutant.frame, ref, tolerancesFor(original, ref, *mutant.frame));
     m.fixture = original.name + " (mutant)";
     m.expected = "ref";
     m.actual = backend_;
@@ -81,7 +78,7 @@ class MutationTest : public testing::Test {
     if (failing != std::set<std::string>{cls_}) {
       ADD_FAILURE() << "the mutant must fail in " << cls_ << " only, fails in " << joined(failing)
                     << ": " << describe(m) << "\nimages and report: "
-                    << writeArtifacts(test, *ref, *mutant.frame, *ref, m).string();
+                    << writeArtifacts(test, ref, *mutant.frame, ref, m).string();
     }
   }
 
