@@ -120,6 +120,11 @@ TEST(Accuracy, TablesShowTheReportsNumbers) {
                       "| `t/a` | warn | 0 / 0 (0) | 3, 2 at (5,6) [window 5,3] | 1.5, 0.25 at "
                       "(1,2) [window 1,7] |"))
       << md;
+  EXPECT_TRUE(hasLine(md,
+                      "- Colour differs in 1 fixtures, by up to 1.5 8-bit units (`t/a` at (1,2) "
+                      "[window 1,7])."))
+      << md;
+  EXPECT_TRUE(hasLine(md, "- Hard visibility differences: none.")) << md;
   EXPECT_TRUE(hasLine(md, "| `t/b` | `gl:*:y` | visibility | a reason \\| with a bar |")) << md;
 }
 
