@@ -1,10 +1,11 @@
-// The mutation self-test of the harness: each folder under mutations/ holds an original
-// fixture and a mutant that differs from it in one thing (an object moved half a pixel, a
+// The mutation self-test of the harness: mutations/mutations.json pairs an original
+// fixture with a mutant fixture that differs in one thing (an object moved half a pixel, a
 // depth offset, a light 1% brighter, normals without the inverse transpose, a triangle
-// dropped). The mutant, rendered by a GL backend and compared with the reference of the
-// ORIGINAL, must fail in exactly the class mutations.json names and in no other; the
-// original rendered by the same backend (the control) must fail in none, so that the
-// failure is the mutation's. One GoogleTest per mutation x backend.
+// dropped) or with a GL-side fault (RASTERCHECK_GL_FAULT, test-only; skipped where the
+// GL backend does not read it). The mutant, rendered by a GL backend and compared with
+// the reference of the ORIGINAL, must fail in exactly the class the entry names and in no
+// other; the original rendered by the same backend (the control) must fail in none, so
+// that the failure is the mutation's. One GoogleTest per mutation x backend.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +25,7 @@ using namespace rc::conformance;
 namespace {
 
 const fs::path kMutations = fs::path(RC_SOURCE_DIR) / "tests" / "conformance" / "mutations";
+const char* const kFaultVariable = "RASTERCHECK_GL_FAULT";
 
 std::string identifier(const std::string& s) {
   std::string out;
@@ -37,25 +39,54 @@ std::string joined(const std::set<std::string>& s) {
   return out.empty() ? "none" : out;
 }
 
+// One entry of mutations.json: a mutant fixture, or a fault injected into GL.
+struct Mutation {
+  std::string name;
+  std::string cls;
+  fs::path original;
+  fs::path mutant;       // empty for a GL fault
+  std::string gl_fault;  // RASTERCHECK_GL_FAULT value, empty for a mutant fixture
+};
+
+std::vector<Mutation> readManifest() {
+  std::ifstream in(kMutations / "mutations.json");
+  const auto doc = nlohmann::json::parse(in);
+  std::vector<Mutation> out;
+  for (const auto& m : doc.at("mutations")) {
+    Mutation x;
+    x.name = m.at("name").get<std::string>();
+    x.cls = m.at("class").get<std::string>();
+    x.original = kMutations / m.at("original").get<std::string>();
+    if (m.contains("mutant")) x.mutant = kMutations / m.at("mutant").get<std::string>();
+    if (m.contains("gl_fault")) x.gl_fault = m.at("gl_fault").get<std::string>();
+    out.push_back(x);
+  }
+  return out;
+}
+
 class MutationTest : public testing::Test {
  public:
-  MutationTest(std::string name, std::string cls, std::string backend)
-      : name_(std::move(name)), cls_(std::move(cls)), backend_(std::move(backend)) {}
+  MutationTest(Mutation mutation, std::string backend)
+      : m_(std::move(mutation)), backend_(std::move(backend)) {}
 
   void TestBody() override {
-    const fs::path original_file = kMutations / name_ / "original.json";
-    const fs::path mutant_file = kMutations / name_ / "mutant.json";
-    const BackendRender control = renderWithBackend(original_file, backend_);
+    const BackendRender control = renderWithBackend(m_.original, backend_);
     if (control.unavailable) {
       if (glRequired()) FAIL() << backend_ << " cannot start: " << control.error;
       GTEST_SKIP() << backend_ << " cannot start on this machine: " << control.error;
     }
-    ASSERT_TRUE(control.frame) << backend_ << " failed on " << original_file << ": "
-                               << control.error;
-    const BackendRender mutant = renderWithBackend(mutant_file, backend_);
-    ASSERT_TRUE(mutant.frame) << backend_ << " failed on " << mutant_file << ": " << mutant.error;
-    const Scene original = loadScene(original_file);
-    const Frame ref = renderReference(original_file);
+    ASSERT_TRUE(control.frame) << backend_ << " failed on " << m_.original << ": " << control.error;
+    const BackendRender mutant =
+        m_.gl_fault.empty() ? renderWithBackend(m_.mutant, backend_)
+                            : renderWithBackend(m_.original, backend_,
+                                                fmt::format("{}={}", kFaultVariable, m_.gl_fault));
+    ASSERT_TRUE(mutant.frame) << backend_ << " failed on the mutant: " << mutant.error;
+    if (!m_.gl_fault.empty() && !mutant.frame->meta.contains("fault_injected")) {
+      // A GL backend without the test-only fault hook ignores the variable.
+      GTEST_SKIP() << "this build's GL backend does not read " << kFaultVariable;
+    }
+    const Scene original = loadScene(m_.original);
+    const Frame ref = renderReference(m_.original);
 
     const std::string test = testing::UnitTest::GetInstance()->current_test_info()->name();
     PairResult c =
@@ -69,60 +100,53 @@ class MutationTest : public testing::Test {
                     << writeArtifacts(test + "__control", ref, *control.frame, ref, c).string();
     }
 
-    PairResult m =
+    PairResult r =
         compareFrames(ref, *mutant.frame, ref, tolerancesFor(original, ref, *mutant.frame));
-    m.fixture = original.name + " (mutant)";
-    m.expected = "ref";
-    m.actual = backend_;
-    const std::set<std::string> failing = failingClasses(m);
-    if (failing != std::set<std::string>{cls_}) {
-      ADD_FAILURE() << "the mutant must fail in " << cls_ << " only, fails in " << joined(failing)
-                    << ": " << describe(m) << "\nimages and report: "
-                    << writeArtifacts(test, ref, *mutant.frame, ref, m).string();
+    r.fixture = original.name + " (" + m_.name + ")";
+    r.expected = "ref";
+    r.actual = backend_;
+    const std::set<std::string> failing = failingClasses(r);
+    if (failing != std::set<std::string>{m_.cls}) {
+      ADD_FAILURE() << "the mutant must fail in " << m_.cls << " only, fails in " << joined(failing)
+                    << ": " << describe(r) << "\nimages and report: "
+                    << writeArtifacts(test, ref, *mutant.frame, ref, r).string();
     }
   }
 
  private:
-  std::string name_;
-  std::string cls_;
+  Mutation m_;
   std::string backend_;
 };
 
 void registerMutations() {
-  std::ifstream in(kMutations / "mutations.json");
-  const auto doc = nlohmann::json::parse(in);
-  for (const auto& m : doc.at("mutations")) {
-    const std::string name = m.at("name").get<std::string>();
-    const std::string cls = m.at("class").get<std::string>();
+  for (const Mutation& m : readManifest()) {
     for (const std::string& backend : backends()) {
-      const std::string test = identifier(name) + "__" + identifier(backend);
-      testing::RegisterTest("mutation", test.c_str(), nullptr, nullptr, __FILE__, __LINE__,
-                            [name, cls, backend]() -> testing::Test* {
-                              return new MutationTest(name, cls, backend);
-                            });
+      const std::string test = identifier(m.name) + "__" + identifier(backend);
+      testing::RegisterTest(
+          "mutation", test.c_str(), nullptr, nullptr, __FILE__, __LINE__,
+          [m, backend]() -> testing::Test* { return new MutationTest(m, backend); });
     }
   }
 }
 
 }  // namespace
 
-// Every folder has its manifest entry and every entry its folder, with a known class.
+// Every entry names existing files, a known class and exactly one of mutant / gl_fault;
+// every folder is used by some entry.
 TEST(MutationManifest, MatchesTheFolders) {
-  std::ifstream in(kMutations / "mutations.json");
-  const auto doc = nlohmann::json::parse(in);
-  std::set<std::string> listed;
-  for (const auto& m : doc.at("mutations")) {
-    const std::string name = m.at("name").get<std::string>();
-    listed.insert(name);
-    const std::string cls = m.at("class").get<std::string>();
-    EXPECT_TRUE(cls == "visibility" || cls == "depth" || cls == "shading") << name << ": " << cls;
-    EXPECT_TRUE(fs::exists(kMutations / name / "original.json")) << name;
-    EXPECT_TRUE(fs::exists(kMutations / name / "mutant.json")) << name;
+  std::set<std::string> used;
+  for (const Mutation& m : readManifest()) {
+    EXPECT_TRUE(m.cls == "visibility" || m.cls == "depth" || m.cls == "shading")
+        << m.name << ": " << m.cls;
+    EXPECT_TRUE(fs::exists(m.original)) << m.name << ": " << m.original;
+    EXPECT_NE(m.mutant.empty(), m.gl_fault.empty()) << m.name << ": mutant or gl_fault";
+    if (!m.mutant.empty()) EXPECT_TRUE(fs::exists(m.mutant)) << m.name << ": " << m.mutant;
+    used.insert(m.original.parent_path().filename().string());
   }
   std::set<std::string> folders;
   for (const auto& entry : fs::directory_iterator(kMutations))
     if (entry.is_directory()) folders.insert(entry.path().filename().string());
-  EXPECT_EQ(listed, folders);
+  EXPECT_EQ(used, folders);
 }
 
 int main(int argc, char** argv) {
