@@ -64,6 +64,18 @@ int runCli(int argc, char** argv) {
   run_cmd->add_option("--tolerance,-t", run.tolerance, "As for compare; repeatable");
   run_cmd->add_option("--jobs,-j", run.jobs, "Renders at a time (default: one per core)");
 
+  AccuracyArgs accuracy;
+  CLI::App* accuracy_cmd = app.add_subcommand(
+      "accuracy", "Write the accuracy report (Markdown) from the report.json of run folders");
+  accuracy_cmd->add_option("runs", accuracy.runs, "Folders written by `run`")->required();
+  accuracy_cmd->add_option("--out,-o", accuracy.out, "Markdown file (default: stdout)");
+  accuracy_cmd->add_option("--catalog", accuracy.catalogs,
+                           "Fixture folders to find tags by name (default: the catalog)");
+  accuracy_cmd->add_option("--expectations", accuracy.expectations,
+                           "Known differences to list (tests/conformance/expectations.json)");
+  accuracy_cmd->add_option("--command", accuracy.command,
+                           "How the document says it was made (Markdown)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -76,6 +88,7 @@ int runCli(int argc, char** argv) {
     if (*list_cmd) return listCommand(list);
     if (*compare_cmd) return compareCommand(compare);
     if (*run_cmd) return runCommand(run);
+    if (*accuracy_cmd) return accuracyCommand(accuracy);
   } catch (const InputError& e) {
     std::cerr << "rastercheck: error: " << e.what() << '\n';
     return kExitInput;

@@ -50,4 +50,13 @@ struct RunArgs {
 };
 int runCommand(const RunArgs& args);
 
+struct AccuracyArgs {
+  std::vector<std::filesystem::path> runs;      // folders written by `run`
+  std::vector<std::filesystem::path> catalogs;  // where to find fixtures by name (tags)
+  std::filesystem::path expectations;           // known differences to list (optional)
+  std::filesystem::path out;                    // empty: stdout
+  std::string command;                          // how the document says it was made
+};
+int accuracyCommand(const AccuracyArgs& args);
+
 }  // namespace rc

@@ -8,14 +8,16 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <tuple>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
+#include "app/backends.h"
 #include "compare/pair_images.h"
 #include "compare/report.h"
 #include "fixtures/catalog.h"
 #include "fixtures/frame_io.h"
+#include "fixtures/loader.h"
 #include "fixtures/scene_writer.h"
 
 namespace rc::conformance {
@@ -24,18 +26,35 @@ namespace fs = std::filesystem;
 std::vector<std::string> backends() {
   std::vector<std::string> out = {"gl:egl:llvmpipe", "gl:egl:softpipe"};
 #ifdef RC_HAVE_OSMESA
-  out.push_back("gl:osmesa:llvmpipe");
+  out.emplace_back("gl:osmesa:llvmpipe");
 #endif
   return out;
 }
 
+std::vector<std::string> knownBackends() {
+  return {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:osmesa:llvmpipe"};
+}
+
 namespace {
 
-fs::path scratchRoot() {
-  fs::path p = fs::temp_directory_path() / fmt::format("rc_conformance_{}", ::getpid());
-  fs::create_directories(p);
-  return p;
-}
+// Owns the scratch folder; its destructor runs when the test process exits normally
+// (ctest runs one process per test, so every process would otherwise leave one behind).
+class ScratchDir {
+ public:
+  ScratchDir() : path_(fs::temp_directory_path() / fmt::format("rc_conformance_{}", ::getpid())) {
+    fs::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
 
 std::string shellQuote(const std::string& s) {
   std::string out = "'";
@@ -45,13 +64,19 @@ std::string shellQuote(const std::string& s) {
 
 }  // namespace
 
+fs::path scratchRoot() {
+  static const ScratchDir dir;
+  return dir.path();
+}
+
 std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& spec,
-                                   std::string& error, int& exit_code) {
+                                   std::string& error, int& exit_code, const std::string& env) {
   static int counter = 0;
   const fs::path out = scratchRoot() / fmt::format("frame{}", counter++);
   const std::string cmd =
-      fmt::format("{} render {} --backend {} --out {} 2>&1", RC_EXE, shellQuote(fixture.string()),
-                  shellQuote(spec), shellQuote(out.string()));
+      fmt::format("{}{} render {} --backend {} --out {} 2>&1",
+                  env.empty() ? "" : "env " + shellQuote(env) + " ", RC_EXE,
+                  shellQuote(fixture.string()), shellQuote(spec), shellQuote(out.string()));
   std::string output;
   FILE* p = ::popen(cmd.c_str(), "r");
   if (p == nullptr) {
@@ -64,14 +89,22 @@ std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& s
   while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) output.append(buf, n);
   const int status = ::pclose(p);
   exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::optional<Frame> frame;
   if (exit_code != 0) {
     while (!output.empty() && output.back() == '\n') output.pop_back();
-    error = output.substr(output.rfind('\n') == std::string::npos ? 0 : output.rfind('\n') + 1);
-    return std::nullopt;
+    const std::size_t nl = output.rfind('\n');
+    error = output.substr(nl == std::string::npos ? 0 : nl + 1);
+  } else {
+    frame = readFrameDir(out);
   }
-  Frame frame = readFrameDir(out);
-  fs::remove_all(out);
+  std::error_code ec;
+  fs::remove_all(out, ec);
   return frame;
+}
+
+Frame renderReference(const fs::path& fixture) {
+  static const BackendSpec ref = parseBackendSpec("ref");
+  return renderWith(ref, loadScene(fixture));
 }
 
 bool glRequired() {
@@ -106,6 +139,20 @@ bool backendStarts(const std::string& spec, std::string& why) {
   return it->second.first;
 }
 
+BackendRender renderWithBackend(const fs::path& fixture, const std::string& spec,
+                                const std::string& env) {
+  BackendRender r;
+  r.frame = renderInChild(fixture, spec, r.error, r.exit_code, env);
+  if (!r.frame && r.exit_code == 3) {
+    std::string why;
+    if (!backendStarts(spec, why)) {
+      r.unavailable = true;
+      r.error = why;
+    }
+  }
+  return r;
+}
+
 std::set<std::string> failingClasses(const PairResult& r) {
   std::set<std::string> out;
   if (r.visibility.status == Status::Fail) out.insert("visibility");
@@ -114,19 +161,104 @@ std::set<std::string> failingClasses(const PairResult& r) {
   return out;
 }
 
-const std::vector<Expectation>& expectations() {
-  static const std::vector<Expectation> list = [] {
-    std::vector<Expectation> out;
-    const fs::path file = fs::path(RC_SOURCE_DIR) / "tests/conformance/expectations.json";
+fs::path catalogDir() { return fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes"; }
+
+std::vector<std::string> catalogNames() {
+  std::vector<std::string> out;
+  for (const fs::path& file : findFixtures({catalogDir()})) {
     std::ifstream in(file);
-    const nlohmann::json doc = nlohmann::json::parse(in);
-    for (const auto& e : doc.at("expectations")) {
-      out.push_back({e.at("fixture").get<std::string>(), e.at("backend").get<std::string>(),
-                     e.at("class").get<std::string>(), e.at("reason").get<std::string>()});
-    }
+    const auto doc = nlohmann::json::parse(in, nullptr, false);
+    if (doc.is_object() && doc.contains("name") && doc["name"].is_string())
+      out.push_back(doc["name"].get<std::string>());
+  }
+  return out;
+}
+
+fs::path expectationsFile() {
+  return fs::path(RC_SOURCE_DIR) / "tests" / "conformance" / "expectations.json";
+}
+
+Expectations parseExpectations(const nlohmann::json& doc, const std::set<std::string>& fixtures,
+                               const std::vector<std::string>& known) {
+  Expectations out;
+  if (!doc.is_object() || !doc.contains("expectations") || !doc["expectations"].is_array()) {
+    out.errors.emplace_back("expectations: must be an array under the top-level object");
     return out;
+  }
+  for (const auto& [key, value] : doc.items()) {
+    if (key != "about" && key != "expectations")
+      out.errors.push_back(fmt::format("{}: unknown key", key));
+  }
+  static const std::set<std::string> classes = {"visibility", "depth", "shading"};
+  std::set<std::tuple<std::string, std::string, std::string>> seen;
+  const auto& list = doc["expectations"];
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const auto& e = list[i];
+    const std::string at = fmt::format("expectations[{}]", i);
+    const std::size_t before = out.errors.size();
+    if (!e.is_object()) {
+      out.errors.push_back(fmt::format("{}: must be an object", at));
+      continue;
+    }
+    Expectation x;
+    for (const auto& [key, value] : e.items()) {
+      std::string* field = key == "fixture"   ? &x.fixture
+                           : key == "backend" ? &x.backend
+                           : key == "class"   ? &x.cls
+                           : key == "reason"  ? &x.reason
+                                              : nullptr;
+      if (field == nullptr) {
+        out.errors.push_back(fmt::format("{}.{}: unknown key", at, key));
+      } else if (!value.is_string()) {
+        out.errors.push_back(fmt::format("{}.{}: must be a string", at, key));
+      } else {
+        *field = value.get<std::string>();
+      }
+    }
+    for (const char* key : {"fixture", "backend", "class", "reason"}) {
+      if (!e.contains(key)) out.errors.push_back(fmt::format("{}.{}: missing", at, key));
+    }
+    // Values are checked only where they are strings (else that is the error already).
+    auto given = [&e](const char* key) { return e.contains(key) && e[key].is_string(); };
+    if (given("fixture") && !fixtures.count(x.fixture))
+      out.errors.push_back(
+          fmt::format("{}.fixture: no fixture named \"{}\" in the catalog", at, x.fixture));
+    if (given("backend")) {
+      bool any = false;
+      for (const std::string& b : known) any = any || backendMatches(x.backend, b);
+      if (!any)
+        out.errors.push_back(
+            fmt::format("{}.backend: \"{}\" matches none of the suite's backends", at, x.backend));
+    }
+    if (given("class") && !classes.count(x.cls))
+      out.errors.push_back(
+          fmt::format("{}.class: \"{}\" is not one of visibility, depth, shading", at, x.cls));
+    if (given("reason") && x.reason.find_first_not_of(" \t") == std::string::npos)
+      out.errors.push_back(fmt::format("{}.reason: must say why", at));
+    if (out.errors.size() != before) continue;
+    if (!seen.emplace(x.fixture, x.backend, x.cls).second) {
+      out.errors.push_back(fmt::format("{}: repeats an earlier entry ({}, {}, {})", at, x.fixture,
+                                       x.backend, x.cls));
+      continue;
+    }
+    out.entries.push_back(x);
+  }
+  return out;
+}
+
+const Expectations& expectations() {
+  static const Expectations parsed = [] {
+    std::ifstream in(expectationsFile());
+    const auto doc = nlohmann::json::parse(in, nullptr, false);
+    if (doc.is_discarded()) {
+      Expectations bad;
+      bad.errors.push_back(fmt::format("{}: not valid JSON", expectationsFile().string()));
+      return bad;
+    }
+    const std::vector<std::string> names = catalogNames();
+    return parseExpectations(doc, {names.begin(), names.end()}, knownBackends());
   }();
-  return list;
+  return parsed;
 }
 
 bool backendMatches(const std::string& pattern, const std::string& backend) {
@@ -151,7 +283,7 @@ bool backendMatches(const std::string& pattern, const std::string& backend) {
 
 std::vector<Expectation> expectationsFor(const std::string& fixture, const std::string& backend) {
   std::vector<Expectation> out;
-  for (const Expectation& e : expectations())
+  for (const Expectation& e : expectations().entries)
     if (e.fixture == fixture && backendMatches(e.backend, backend)) out.push_back(e);
   return out;
 }
@@ -164,7 +296,7 @@ Tolerances tolerancesFor(const Scene& scene, const Frame& expected, const Frame&
 
 fs::path writeArtifacts(const std::string& test_name, const Frame& expected, const Frame& actual,
                         const Frame& uncertainty, PairResult& result) {
-  const fs::path dir = fs::path(RC_BINARY_DIR) / "conformance-artifacts" / fixtureSlug(test_name);
+  fs::path dir = fs::path(RC_BINARY_DIR) / "conformance-artifacts" / fixtureSlug(test_name);
   ClassMaps maps;
   PairResult again = compareFrames(expected, actual, uncertainty, result.tolerances, &maps);
   again.fixture = result.fixture;

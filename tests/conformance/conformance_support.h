@@ -1,6 +1,7 @@
-// Shared by the conformance and mutation suites: rendering a fixture with a GL backend in
-// a child process (`rastercheck render`, one driver per process), the skip-or-fail rule
-// when no GL driver can start, and the expectations file of known differences.
+// Shared by the conformance, catalog and mutation suites: rendering a fixture in a child
+// process (`rastercheck render`, one driver per process) into a scratch folder that is
+// removed when the test process exits, the skip-or-fail rule when no GL driver can start,
+// and the expectations file of known differences (loaded and validated).
 #pragma once
 
 #include <filesystem>
@@ -8,6 +9,8 @@
 #include <set>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "compare/compare.h"
 #include "fixtures/frame.h"
@@ -17,31 +20,68 @@ namespace rc::conformance {
 
 // The backends every fixture is checked against (osmesa only where it was built).
 std::vector<std::string> backends();
+// Every backend the suite knows, built or not: what expectations may name.
+std::vector<std::string> knownBackends();
+
+// This process's scratch folder (created on first use, removed at exit).
+std::filesystem::path scratchRoot();
 
 // Renders `fixture` with `spec` through the rastercheck binary into a scratch folder and
-// reads the frame back. On failure returns nullopt and sets `error` to the child's last
-// line and `exit_code` to its exit code.
+// reads the frame back. `env` (e.g. "RASTERCHECK_GL_FAULT=shift_x=0.5") is set for the
+// child only. On failure returns nullopt and sets `error` to the child's last line and
+// `exit_code` to its exit code.
 std::optional<Frame> renderInChild(const std::filesystem::path& fixture, const std::string& spec,
-                                   std::string& error, int& exit_code);
+                                   std::string& error, int& exit_code, const std::string& env = "");
+
+// The reference render of a fixture, in this process (the same code path as
+// `rastercheck render --backend ref`, without a child process: the reference is plain
+// deterministic CPU code). Throws InputError on a bad fixture.
+Frame renderReference(const std::filesystem::path& fixture);
 
 // True when `spec` can render at all on this machine (a one-triangle scene), cached per
-// process. When it cannot, conformance tests skip, or fail under RASTERCHECK_REQUIRE_GL=1.
+// process. When it cannot, GL tests skip, or fail under RASTERCHECK_REQUIRE_GL=1.
 bool backendStarts(const std::string& spec, std::string& why);
 bool glRequired();
+
+// renderInChild for a GL backend. Only when the child exits 3 is the probe scene tried
+// (one process fewer per test on the usual path): if the backend cannot render even that,
+// `unavailable` is set and the caller skips; a failure on this fixture alone is an error.
+struct BackendRender {
+  std::optional<Frame> frame;
+  bool unavailable = false;
+  std::string error;
+  int exit_code = 0;
+};
+BackendRender renderWithBackend(const std::filesystem::path& fixture, const std::string& spec,
+                                const std::string& env = "");
 
 // The classes ("visibility", "depth", "shading") whose status is fail in `result`.
 std::set<std::string> failingClasses(const PairResult& result);
 
+// The catalog folder and its fixtures' names (as written in each file's "name").
+std::filesystem::path catalogDir();
+std::vector<std::string> catalogNames();
+
 // tests/conformance/expectations.json: known, understood differences. Each entry names a
-// fixture, a backend (exact, or with '*' as a wildcard for one ':'-separated part), a
-// class that is expected to fail, and the reason.
+// fixture of the catalog, a backend (exact, or with '*' as a wildcard for one
+// ':'-separated part) that matches at least one known backend, a class that is expected
+// to fail, and the reason.
 struct Expectation {
   std::string fixture;
   std::string backend;
   std::string cls;
   std::string reason;
 };
-const std::vector<Expectation>& expectations();
+struct Expectations {
+  std::vector<Expectation> entries;  // the valid ones
+  std::vector<std::string> errors;   // one line per problem, naming the JSON path
+};
+// Validates `doc` against the fixture names and backends given; never throws.
+Expectations parseExpectations(const nlohmann::json& doc, const std::set<std::string>& fixtures,
+                               const std::vector<std::string>& backends);
+// The file in the source tree, parsed and validated against the catalog (cached).
+const Expectations& expectations();
+std::filesystem::path expectationsFile();
 bool backendMatches(const std::string& pattern, const std::string& backend);
 std::vector<Expectation> expectationsFor(const std::string& fixture, const std::string& backend);
 

@@ -4,6 +4,7 @@
 // GoogleTest suite. A pair passes when exactly the classes listed for it in
 // expectations.json fail: an unexpected failure and an unexpected pass both fail.
 #include <cctype>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -34,21 +35,17 @@ class ConformancePair : public testing::Test {
       : file_(std::move(file)), backend_(std::move(backend)) {}
 
   void TestBody() override {
-    std::string why;
-    if (!backendStarts(backend_, why)) {
-      if (glRequired()) FAIL() << backend_ << " cannot start: " << why;
-      GTEST_SKIP() << backend_ << " cannot start on this machine: " << why;
+    const BackendRender gl = renderWithBackend(file_, backend_);
+    if (gl.unavailable) {
+      if (glRequired()) FAIL() << backend_ << " cannot start: " << gl.error;
+      GTEST_SKIP() << backend_ << " cannot start on this machine: " << gl.error;
     }
     const Scene scene = loadScene(file_);
-    std::string error;
-    int code = 0;
-    const auto ref = renderInChild(file_, "ref", error, code);
-    ASSERT_TRUE(ref) << "reference failed on " << file_ << ": " << error;
-    const auto gl = renderInChild(file_, backend_, error, code);
-    ASSERT_TRUE(gl) << backend_ << " failed on " << scene.name << " (exit " << code
-                    << "): " << error;
+    ASSERT_TRUE(gl.frame) << backend_ << " failed on " << scene.name << " (exit " << gl.exit_code
+                          << "): " << gl.error;
+    const Frame ref = renderReference(file_);
 
-    PairResult result = compareFrames(*ref, *gl, *ref, tolerancesFor(scene, *ref, *gl));
+    PairResult result = compareFrames(ref, *gl.frame, ref, tolerancesFor(scene, ref, *gl.frame));
     result.fixture = scene.name;
     result.expected = "ref";
     result.actual = backend_;
@@ -60,8 +57,9 @@ class ConformancePair : public testing::Test {
       reasons += fmt::format("\n  expected {} to fail: {}", e.cls, e.reason);
     }
     if (failing != expected) {
-      const fs::path artifacts = writeArtifacts(
-          testing::UnitTest::GetInstance()->current_test_info()->name(), *ref, *gl, *ref, result);
+      const fs::path artifacts =
+          writeArtifacts(testing::UnitTest::GetInstance()->current_test_info()->name(), ref,
+                         *gl.frame, ref, result);
       for (const std::string& c : failing) {
         EXPECT_TRUE(expected.count(c)) << "unexpected failure: " << describe(result);
       }
@@ -81,8 +79,7 @@ class ConformancePair : public testing::Test {
 };
 
 void registerCatalog() {
-  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
-  for (const fs::path& file : findFixtures({catalog})) {
+  for (const fs::path& file : findFixtures({catalogDir()})) {
     // Registration only reads the name, so that listing tests stays cheap; the test
     // body loads and validates the whole fixture.
     std::ifstream in(file);
@@ -96,8 +93,9 @@ void registerCatalog() {
     for (const std::string& backend : backends()) {
       const std::string suite = identifier(topic);
       const std::string test = identifier(rest) + "__" + identifier(backend);
+      // No value parameter: it would end up in the test's name as "# GetParam() = ...".
       testing::RegisterTest(
-          suite.c_str(), test.c_str(), nullptr, backend.c_str(), __FILE__, __LINE__,
+          suite.c_str(), test.c_str(), nullptr, nullptr, __FILE__, __LINE__,
           [file, backend]() -> testing::Test* { return new ConformancePair(file, backend); });
     }
   }
@@ -106,7 +104,12 @@ void registerCatalog() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  registerCatalog();
-  return RUN_ALL_TESTS();
+  try {
+    testing::InitGoogleTest(&argc, argv);
+    registerCatalog();
+    return RUN_ALL_TESTS();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cannot register the tests: %s\n", e.what());
+    return 1;
+  }
 }

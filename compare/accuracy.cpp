@@ -1,0 +1,491 @@
+// The accuracy report: see accuracy.h.
+#include "compare/accuracy.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+#include <tuple>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "fixtures/catalog.h"
+#include "fixtures/errors.h"
+
+namespace rc {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// --- reading -------------------------------------------------------------------------
+
+// Reads fields of one report.json; every error names the file and the JSON path.
+class ReportReader {
+ public:
+  explicit ReportReader(fs::path file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw InputError(fmt::format("{}: {}: {}", file_.string(), path, what));
+  }
+
+  const json& member(const json& j, const char* key, const std::string& path) const {
+    if (!j.is_object() || !j.contains(key)) fail(path + "." + key, "missing");
+    return j[key];
+  }
+  std::string text(const json& j, const char* key, const std::string& path) const {
+    const json& v = member(j, key, path);
+    if (!v.is_string()) fail(path + "." + key, "must be a string");
+    return v.get<std::string>();
+  }
+  // Numbers the writer may leave out or write as null (non-finite): 0 then.
+  double number(const json& j, const char* key, const std::string& path) const {
+    if (!j.is_object() || !j.contains(key) || j[key].is_null()) return 0.0;
+    if (!j[key].is_number()) fail(path + "." + key, "must be a number");
+    return j[key].get<double>();
+  }
+  std::uint64_t count(const json& j, const char* key, const std::string& path) const {
+    const double v = number(j, key, path);
+    if (v < 0) fail(path + "." + key, "must not be negative");
+    return static_cast<std::uint64_t>(v);
+  }
+  std::optional<double> optionalNumber(const json& j, const char* key,
+                                       const std::string& path) const {
+    if (!j.is_object() || !j.contains(key) || j[key].is_null()) return std::nullopt;
+    return number(j, key, path);
+  }
+  std::optional<PixelRef> pixel(const json& j, const char* key, const std::string& path) const {
+    if (!j.is_object() || !j.contains(key) || j[key].is_null()) return std::nullopt;
+    const json& v = j[key];
+    if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() || !v[1].is_number_integer())
+      fail(path + "." + key, "must be [x, y]");
+    return PixelRef{v[0].get<int>(), v[1].get<int>()};
+  }
+  Status status(const json& j, const char* key, const std::string& path) const {
+    if (!j.is_object() || !j.contains(key)) return Status::Pass;
+    const std::string s = text(j, key, path);
+    for (Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error})
+      if (s == toString(st)) return st;
+    fail(path + "." + key, fmt::format("unknown status \"{}\"", s));
+  }
+
+ private:
+  fs::path file_;
+};
+
+json readJsonFile(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(fmt::format("{}: cannot be read", file.string()));
+  json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) throw InputError(fmt::format("{}: not valid JSON", file.string()));
+  return doc;
+}
+
+// The "tags" of a fixture file, or nullopt when it cannot be read.
+std::optional<std::vector<std::string>> fixtureTags(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return std::nullopt;
+  const json doc = json::parse(in, nullptr, false);
+  if (!doc.is_object()) return std::nullopt;
+  std::vector<std::string> tags;
+  if (doc.contains("tags") && doc["tags"].is_array())
+    for (const json& t : doc["tags"])
+      if (t.is_string()) tags.push_back(t.get<std::string>());
+  return tags;
+}
+
+// fixture name -> fixture file, from the frame.json files of a run folder.
+void collectFixtureFiles(const fs::path& run, std::map<std::string, fs::path>& out) {
+  std::error_code ec;
+  const fs::path frames = run / "frames";
+  if (!fs::is_directory(frames, ec)) return;
+  for (const auto& entry : fs::recursive_directory_iterator(frames, ec)) {
+    if (!entry.is_regular_file() || entry.path().filename() != "frame.json") continue;
+    std::ifstream in(entry.path());
+    const json meta = json::parse(in, nullptr, false);
+    if (meta.is_object() && meta.contains("fixture") && meta["fixture"].is_string() &&
+        meta.contains("fixture_file") && meta["fixture_file"].is_string())
+      out.emplace(meta["fixture"].get<std::string>(), meta["fixture_file"].get<std::string>());
+  }
+}
+
+AccuracyPair readPair(const ReportReader& r, const json& j, const std::string& at) {
+  AccuracyPair p;
+  p.fixture = r.text(j, "fixture", at);
+  p.expected = r.text(j, "expected", at);
+  p.actual = r.text(j, "actual", at);
+  p.status = r.status(j, "status", at);
+  if (j.contains("error") && j["error"].is_string()) p.error = j["error"].get<std::string>();
+  p.height = static_cast<int>(r.number(j, "height", at));
+  p.pixels = r.count(j, "pixels", at);
+  if (j.contains("subpixel_bits") && j["subpixel_bits"].is_object()) {
+    p.expected_subpixel_bits = static_cast<int>(r.number(j["subpixel_bits"], "expected", at));
+    p.actual_subpixel_bits = static_cast<int>(r.number(j["subpixel_bits"], "actual", at));
+  }
+  static const json kEmpty = json::object();
+  const json& v = j.contains("visibility") ? j["visibility"] : kEmpty;
+  const std::string vat = at + ".visibility";
+  p.visibility_status = r.status(v, "status", vat);
+  p.mismatched = r.count(v, "mismatched", vat);
+  p.ambiguous = r.count(v, "ambiguous", vat);
+  p.hard = r.count(v, "hard", vat);
+  p.ambiguous_by_depth_gap = r.count(v, "ambiguous_by_depth_gap", vat);
+  p.visibility_worst = r.pixel(v, "worst", vat);
+  const json& d = j.contains("depth") ? j["depth"] : kEmpty;
+  const std::string dat = at + ".depth";
+  p.depth_status = r.status(d, "status", dat);
+  p.depth_compared = r.count(d, "compared", dat);
+  p.depth_max = r.number(d, "max_steps", dat);
+  p.depth_mean = r.number(d, "mean_steps", dat);
+  p.depth_p99 = r.number(d, "p99_steps", dat);
+  p.depth_over = r.count(d, "over_tolerance", dat);
+  p.depth_worst = r.pixel(d, "worst", dat);
+  const json& s = j.contains("shading") ? j["shading"] : kEmpty;
+  const std::string sat = at + ".shading";
+  p.shading_status = r.status(s, "status", sat);
+  p.shading_compared = r.count(s, "compared", sat);
+  p.shading_max = r.number(s, "max_abs", sat);
+  p.shading_mean = r.number(s, "mean_abs", sat);
+  p.shading_rmse = r.number(s, "rmse", sat);
+  p.psnr_db = r.optionalNumber(s, "psnr_db", sat);
+  p.shading_over = r.count(s, "over_tolerance", sat);
+  p.shading_worst = r.pixel(s, "worst", sat);
+  return p;
+}
+
+// --- writing -------------------------------------------------------------------------
+
+// Short numbers for tables: 3 significant digits, no exponent below 1e6.
+std::string num(double v) {
+  if (v == 0.0) return "0";
+  if (std::abs(v) >= 1000.0) return fmt::format("{:.0f}", v);
+  return fmt::format("{:.3g}", v);
+}
+
+std::string at(const std::optional<PixelRef>& p, int height) {
+  if (!p || !p->valid()) return "";
+  return fmt::format(" at ({},{}) [window {},{}]", p->x, p->y, p->x, height - 1 - p->y);
+}
+
+std::string cell(const std::string& s) {
+  std::string out;
+  for (char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
+bool isReference(const std::string& spec) { return spec == "ref" || spec.rfind("ref:", 0) == 0; }
+
+struct Totals {
+  std::uint64_t pairs = 0;
+  std::uint64_t by_status[4] = {0, 0, 0, 0};
+  std::uint64_t hard = 0;
+  std::uint64_t ambiguous = 0;
+  double depth_max = 0.0;
+  double depth_p99 = 0.0;
+  double shading_max = 0.0;
+  double shading_sum = 0.0;  // mean_abs x compared, for a pixel-weighted mean
+  std::uint64_t shading_compared = 0;
+  std::optional<double> psnr_min;
+
+  void add(const AccuracyPair& p) {
+    ++pairs;
+    ++by_status[static_cast<int>(p.status)];
+    hard += p.hard;
+    ambiguous += p.ambiguous;
+    depth_max = std::max(depth_max, p.depth_max);
+    depth_p99 = std::max(depth_p99, p.depth_p99);
+    shading_max = std::max(shading_max, p.shading_max);
+    shading_sum += p.shading_mean * static_cast<double>(p.shading_compared);
+    shading_compared += p.shading_compared;
+    if (p.psnr_db) psnr_min = std::min(psnr_min.value_or(*p.psnr_db), *p.psnr_db);
+  }
+  double shadingMean() const {
+    return shading_compared ? shading_sum / static_cast<double>(shading_compared) : 0.0;
+  }
+  std::string verdicts() const {
+    return fmt::format("{} | {} | {} | {}", by_status[0], by_status[1], by_status[2], by_status[3]);
+  }
+};
+
+using Group = std::pair<std::string, std::string>;  // expected, actual
+
+// "warn: shading 1.25 at (..)" for a cell of the per-fixture table.
+std::string verdictCell(const AccuracyPair& p) {
+  if (p.status == Status::Error) return "error: " + cell(p.error);
+  if (p.status == Status::Pass) return "pass";
+  std::vector<std::string> parts;
+  if (p.visibility_status != Status::Pass)
+    parts.push_back(
+        fmt::format("visibility {} hard px{}", p.hard, at(p.visibility_worst, p.height)));
+  if (p.depth_status != Status::Pass)
+    parts.push_back(fmt::format("depth {} steps{}", num(p.depth_max), at(p.depth_worst, p.height)));
+  if (p.shading_status != Status::Pass)
+    parts.push_back(fmt::format("shading {}{}", num(p.shading_max), at(p.shading_worst, p.height)));
+  std::string out = toString(p.status);
+  for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? "; " : ": ") + parts[i];
+  return out;
+}
+
+// The kinds of difference between two drivers, one sentence each, from the numbers.
+std::vector<std::string> differenceSummary(const std::vector<const AccuracyPair*>& list) {
+  std::vector<std::string> out;
+  std::uint64_t edge_px = 0, edge_fx = 0, tie_px = 0, tie_fx = 0, hard_px = 0, hard_fx = 0;
+  std::uint64_t depth_fx = 0, shading_fx = 0;
+  const AccuracyPair* depth_worst = nullptr;
+  const AccuracyPair* shading_worst = nullptr;
+  for (const AccuracyPair* p : list) {
+    const std::uint64_t edge = p->ambiguous - std::min(p->ambiguous, p->ambiguous_by_depth_gap);
+    edge_px += edge;
+    edge_fx += edge > 0;
+    tie_px += p->ambiguous_by_depth_gap;
+    tie_fx += p->ambiguous_by_depth_gap > 0;
+    hard_px += p->hard;
+    hard_fx += p->hard > 0;
+    depth_fx += p->depth_max > 0.0;
+    shading_fx += p->shading_max > 0.0;
+    if (!depth_worst || p->depth_max > depth_worst->depth_max) depth_worst = p;
+    if (!shading_worst || p->shading_max > shading_worst->shading_max) shading_worst = p;
+  }
+  out.push_back(
+      fmt::format("Coverage at edges: {} pixels in {} fixtures, all inside the snap "
+                  "band of the two drivers' subpixel precisions (ambiguous).",
+                  edge_px, edge_fx));
+  out.push_back(
+      fmt::format("Depth ties: {} pixels in {} fixtures where two surfaces lie within "
+                  "the depth tolerance of each other (z-fighting; ambiguous).",
+                  tie_px, tie_fx));
+  out.push_back(hard_px == 0 ? std::string("Hard visibility differences: none.")
+                             : fmt::format("Hard visibility differences: {} pixels in {} fixtures.",
+                                           hard_px, hard_fx));
+  if (depth_worst && depth_worst->depth_max > 0.0)
+    out.push_back(
+        fmt::format("Stored depth differs in {} fixtures, by up to {} steps "
+                    "(`{}`{}).",
+                    depth_fx, num(depth_worst->depth_max), depth_worst->fixture,
+                    at(depth_worst->depth_worst, depth_worst->height)));
+  if (shading_worst && shading_worst->shading_max > 0.0)
+    out.push_back(fmt::format("Colour differs in {} fixtures, by up to {} 8-bit units (`{}`{}).",
+                              shading_fx, num(shading_worst->shading_max), shading_worst->fixture,
+                              at(shading_worst->shading_worst, shading_worst->height)));
+  return out;
+}
+
+}  // namespace
+
+AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
+                              const std::vector<fs::path>& catalogs) {
+  AccuracyData data;
+  std::map<std::string, fs::path> files;
+  std::map<std::tuple<std::string, std::string, std::string>, AccuracyPair> pairs;
+  for (const fs::path& run : runs) {
+    data.sources.push_back(run.string());
+    const fs::path file = run / "report.json";
+    const json doc = readJsonFile(file);
+    const ReportReader r(file);
+    const json& results = r.member(doc, "results", "");
+    if (!results.is_array()) r.fail("results", "must be an array");
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      AccuracyPair p = readPair(r, results[i], fmt::format("results[{}]", i));
+      pairs[{p.expected, p.actual, p.fixture}] = std::move(p);
+    }
+    collectFixtureFiles(run, files);
+  }
+  std::map<std::string, fs::path> catalog;
+  if (!catalogs.empty()) {
+    for (const fs::path& f : findFixtures(catalogs)) {
+      std::ifstream in(f);
+      const json doc = json::parse(in, nullptr, false);
+      if (doc.is_object() && doc.contains("name") && doc["name"].is_string())
+        catalog.emplace(doc["name"].get<std::string>(), f);
+    }
+  }
+  std::map<std::string, std::vector<std::string>> tags;
+  for (auto& [key, p] : pairs) {
+    auto it = tags.find(p.fixture);
+    if (it == tags.end()) {
+      std::optional<std::vector<std::string>> found;
+      if (auto f = files.find(p.fixture); f != files.end()) found = fixtureTags(f->second);
+      if (!found)
+        if (auto c = catalog.find(p.fixture); c != catalog.end()) found = fixtureTags(c->second);
+      it = tags.emplace(p.fixture, found.value_or(std::vector<std::string>{})).first;
+    }
+    p.tags = it->second;
+    data.pairs.push_back(std::move(p));
+  }
+  return data;
+}
+
+std::vector<KnownDifference> readKnownDifferences(const fs::path& file) {
+  const json doc = readJsonFile(file);
+  const ReportReader r(file);
+  const json& list = r.member(doc, "expectations", "");
+  if (!list.is_array()) r.fail("expectations", "must be an array");
+  std::vector<KnownDifference> out;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string path = fmt::format("expectations[{}]", i);
+    out.push_back({r.text(list[i], "fixture", path), r.text(list[i], "backend", path),
+                   r.text(list[i], "class", path), r.text(list[i], "reason", path)});
+  }
+  return out;
+}
+
+std::string accuracyMarkdown(const AccuracyData& data, const std::string& command) {
+  std::string md;
+  auto line = [&md](const std::string& s = "") { md += s + "\n"; };
+
+  std::map<Group, std::vector<const AccuracyPair*>> groups;
+  for (const AccuracyPair& p : data.pairs) groups[{p.expected, p.actual}].push_back(&p);
+  std::vector<Group> against_ref, between_drivers;
+  for (const auto& [g, list] : groups)
+    (isReference(g.first) ? against_ref : between_drivers).push_back(g);
+
+  line("# Accuracy of the OpenGL drivers");
+  line();
+  line(fmt::format("Generated by {}; do not edit by hand.", command));
+  line(fmt::format("Sources: {} comparisons from {} run folder(s).", data.pairs.size(),
+                   data.sources.size()));
+  line();
+  line("Units: visibility in pixels (*hard*: outside the snap band and not a depth tie, so");
+  line("an error; *ambiguous*: either answer is legal); depth in steps of the fixture's depth");
+  line("format; shading as the largest channel error in 8-bit units (x255), mean weighted by");
+  line("compared pixels. Pixels are image coordinates (origin top-left, y down), GL window");
+  line("coordinates in brackets. Thresholds and their derivation: docs/tolerances.md.");
+
+  if (!against_ref.empty()) {
+    line();
+    line("## Drivers against the reference");
+    line();
+    line(
+        "| driver | against | pairs | pass | warn | fail | error | hard px | ambiguous px | "
+        "depth max | depth p99 (worst pair) | shading max | shading mean | lowest PSNR dB |");
+    line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for (const Group& g : against_ref) {
+      Totals t;
+      for (const AccuracyPair* p : groups[g]) t.add(*p);
+      line(fmt::format("| `{}` | `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} |", g.second,
+                       g.first, t.pairs, t.verdicts(), t.hard, t.ambiguous, num(t.depth_max),
+                       num(t.depth_p99), num(t.shading_max), num(t.shadingMean()),
+                       t.psnr_min ? num(*t.psnr_min) : "identical"));
+    }
+
+    line();
+    line("## Per topic");
+    line();
+    line("A fixture counts under each of its tags.");
+    for (const Group& g : against_ref) {
+      std::map<std::string, Totals> per_tag;
+      for (const AccuracyPair* p : groups[g]) {
+        if (p->tags.empty()) per_tag["(untagged)"].add(*p);
+        for (const std::string& t : p->tags) per_tag[t].add(*p);
+      }
+      line();
+      line(fmt::format("### `{}` against `{}`", g.second, g.first));
+      line();
+      line(
+          "| tag | fixtures | pass | warn | fail | error | hard px | ambiguous px | depth max | "
+          "shading max | shading mean |");
+      line("|---|---|---|---|---|---|---|---|---|---|---|");
+      for (const auto& [tag, t] : per_tag)
+        line(fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |", cell(tag), t.pairs,
+                         t.verdicts(), t.hard, t.ambiguous, num(t.depth_max), num(t.shading_max),
+                         num(t.shadingMean())));
+    }
+
+    line();
+    line("## Per fixture");
+    line();
+    std::string head = "| fixture |", rule = "|---|";
+    for (const Group& g : against_ref) {
+      head += fmt::format(" `{}` |", g.second);
+      rule += "---|";
+    }
+    line(head);
+    line(rule);
+    std::set<std::string> fixtures;
+    for (const Group& g : against_ref)
+      for (const AccuracyPair* p : groups[g]) fixtures.insert(p->fixture);
+    for (const std::string& f : fixtures) {
+      std::string row = fmt::format("| `{}` |", f);
+      for (const Group& g : against_ref) {
+        const auto& list = groups[g];
+        auto it = std::find_if(list.begin(), list.end(),
+                               [&](const AccuracyPair* p) { return p->fixture == f; });
+        row += fmt::format(" {} |", it == list.end() ? std::string("-") : verdictCell(**it));
+      }
+      line(row);
+    }
+  }
+
+  for (const Group& g : between_drivers) {
+    const auto& list = groups[g];
+    line();
+    line(fmt::format("## `{}` against `{}`", g.second, g.first));
+    line();
+    std::set<std::pair<int, int>> bits;
+    std::uint64_t identical = 0, edge_only = 0;
+    Totals t;
+    for (const AccuracyPair* p : list) {
+      t.add(*p);
+      bits.insert({p->expected_subpixel_bits, p->actual_subpixel_bits});
+      const bool same_pixels = p->mismatched == 0;
+      const bool same_values = p->depth_max == 0.0 && p->shading_max == 0.0;
+      if (same_pixels && same_values) ++identical;
+      if (!same_pixels && p->hard == 0 && same_values) ++edge_only;
+    }
+    line(
+        fmt::format("{} fixtures: {} identical, {} differing only in ambiguous pixels, {} "
+                    "with other differences. Verdicts: {} pass, {} warn, {} fail, {} error.",
+                    t.pairs, identical, edge_only, t.pairs - identical - edge_only, t.by_status[0],
+                    t.by_status[1], t.by_status[2], t.by_status[3]));
+    for (const auto& [a, b] : bits)
+      if (a > 0 && b > 0)
+        line(fmt::format("Subpixel bits: `{}` {}, `{}` {}.", g.first, a, g.second, b));
+    line(fmt::format(
+        "Visibility: {} hard and {} ambiguous pixels in all; depth up to {} "
+        "steps; shading up to {} (mean {}).",
+        t.hard, t.ambiguous, num(t.depth_max), num(t.shading_max), num(t.shadingMean())));
+    line();
+    line("What differs:");
+    line();
+    for (const std::string& item : differenceSummary(list)) line("- " + item);
+    line();
+    line(
+        "Where they differ, and the pixel to look at first (the worst of each class; ambiguous "
+        "visibility pixels have no worst pixel: the pair's visibility.png shows them):");
+    line();
+    line(
+        "| fixture | verdict | visibility: hard / ambiguous px (by depth tie) | depth: max, "
+        "p99 steps | shading: max, mean |");
+    line("|---|---|---|---|---|");
+    for (const AccuracyPair* p : list) {
+      if (p->mismatched == 0 && p->depth_max == 0.0 && p->shading_max == 0.0) continue;
+      line(fmt::format("| `{}` | {} | {} / {} ({}){} | {}, {}{} | {}, {}{} |", p->fixture,
+                       toString(p->status), p->hard, p->ambiguous, p->ambiguous_by_depth_gap,
+                       at(p->visibility_worst, p->height), num(p->depth_max), num(p->depth_p99),
+                       at(p->depth_worst, p->height), num(p->shading_max), num(p->shading_mean),
+                       at(p->shading_worst, p->height)));
+    }
+    line();
+    line(
+        fmt::format("To look at one: `rastercheck run fixtures/scenes/FIXTURE.json --backends "
+                    "{} --against {} --out /tmp/x`, then open `/tmp/x/report.html` (or "
+                    "`rastercheck compare` the two frame folders).",
+                    g.second, g.first));
+  }
+
+  line();
+  line("## Known differences the conformance suite expects");
+  line();
+  if (data.known.empty()) {
+    line("None: tests/conformance/expectations.json lists no expected failure.");
+  } else {
+    line("| fixture | backend | class | reason |");
+    line("|---|---|---|---|");
+    for (const KnownDifference& k : data.known)
+      line(fmt::format("| `{}` | `{}` | {} | {} |", k.fixture, k.backend, k.cls, cell(k.reason)));
+  }
+  return md;
+}
+
+}  // namespace rc

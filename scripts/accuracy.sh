@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Regenerates docs/accuracy.md: runs the catalog against the three GL backends (each
+# compared with the reference) and softpipe against llvmpipe, then tabulates both runs
+# with `rastercheck accuracy`.
+# Usage: scripts/accuracy.sh [--keep DIR]   (--keep: leave the two run folders in DIR)
+# RASTERCHECK names the binary (default: build/release/app/rastercheck); BACKENDS the
+# comma-separated backends to compare with the reference (default: the three below).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+exe=${RASTERCHECK:-$root/build/release/app/rastercheck}
+backends=${BACKENDS:-gl:egl:llvmpipe,gl:egl:softpipe,gl:osmesa:llvmpipe}
+
+if [[ ${1:-} == --keep ]]; then
+  work=${2:?--keep needs a folder}
+  mkdir -p "$work"
+else
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
+
+# `run` exits 1 when a comparison fails and 3 when a backend cannot run: both are results
+# the document reports. Bad input (2) stops here.
+run() {
+  local code=0
+  "$exe" run "$@" >/dev/null || code=$?
+  if [[ $code -ne 0 && $code -ne 1 && $code -ne 3 ]]; then
+    echo "accuracy.sh: rastercheck run $* exited $code" >&2
+    exit "$code"
+  fi
+}
+
+cd "$root"
+rm -rf "$work/catalog" "$work/drivers"
+run fixtures/scenes --backends "$backends" --out "$work/catalog"
+run fixtures/scenes --backends gl:egl:softpipe --against gl:egl:llvmpipe --out "$work/drivers"
+"$exe" accuracy "$work/catalog" "$work/drivers" \
+  --expectations tests/conformance/expectations.json \
+  --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\` and \`rastercheck run fixtures/scenes --backends gl:egl:softpipe --against gl:egl:llvmpipe\`, then \`rastercheck accuracy\` on both run folders)" \
+  --out docs/accuracy.md
