@@ -87,6 +87,9 @@ layout(location = 5) in vec3 a_face_normal;
 
 uniform mat4 u_view_projection;  // projection * view, composed in double on the CPU
 uniform int u_shading;           // 0 flat, 1 gouraud, 2 phong
+#ifdef RC_FAULT_SHIFT_X
+uniform float u_fault_shift_ndc;  // test-only: 2 * PX / width
+#endif
 
 out vec3 v_world_position;
 out vec3 v_world_normal;
@@ -99,6 +102,9 @@ flat out vec3 v_face_normal;
 
 void main() {
   gl_Position = u_view_projection * vec4(a_world_position, 1.0);
+#ifdef RC_FAULT_SHIFT_X
+  gl_Position.x += u_fault_shift_ndc * gl_Position.w;  // NDC x + 2 PX / width
+#endif
   v_world_position = a_world_position;
   v_world_normal = a_world_normal;
   v_uv = a_uv;
@@ -126,6 +132,9 @@ uniform int u_shading;
 uniform int u_has_texture;
 uniform sampler2D u_texture;
 uniform float u_opacity;
+#ifdef RC_FAULT_DEPTH_BIAS
+uniform float u_fault_depth_bias;  // test-only: STEPS / (2^bits - 1)
+#endif
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_primitive_id;
@@ -144,14 +153,24 @@ void main() {
   }
   o_color = vec4(tex * ambient_diffuse + specular, u_opacity);
   o_primitive_id = v_primitive_id;
+#ifdef RC_FAULT_DEPTH_BIAS
+  gl_FragDepth = gl_FragCoord.z + u_fault_depth_bias;
+#endif
+#ifdef RC_FAULT_COMPILE_ERROR
+  rc_injected_compile_error();
+#endif
 }
 )";
 
 }  // namespace
 
-ProgramSource programSource(int max_lights) {
-  const std::string header = fmt::format(kHeader, max_lights);
-  return {header + kLighting + kVertexMain, header + kLighting + kFragmentMain};
+ProgramSource programSource(int max_lights, const ShaderFaults& faults) {
+  std::string header = fmt::format(kHeader, max_lights);
+  if (faults.depth_bias) header += "#define RC_FAULT_DEPTH_BIAS\n";
+  if (faults.shift_x) header += "#define RC_FAULT_SHIFT_X\n";
+  std::string fragment_header = header;
+  if (faults.compile_error) fragment_header += "#define RC_FAULT_COMPILE_ERROR\n";
+  return {header + kLighting + kVertexMain, fragment_header + kLighting + kFragmentMain};
 }
 
 }  // namespace rc::gl
