@@ -94,7 +94,7 @@ TEST(FrameIo, ExrHasTheContractChannelsAndTypes) {
     EXPECT_EQ(t, name == "id" ? OIIO::TypeDesc::UINT32 : OIIO::TypeDesc::FLOAT) << name;
   }
   // Top row first: pixel (6, 4) is the bottom-right one and holds the max id.
-  std::vector<std::uint32_t> ids(spec.width * spec.height);
+  std::vector<std::uint32_t> ids(static_cast<std::size_t>(spec.width) * spec.height);
   const int idc = spec.channelindex("id");
   ASSERT_TRUE(in->read_image(0, 0, idc, idc + 1, OIIO::TypeDesc::UINT32, ids.data()));
   EXPECT_EQ(ids[4 * 7 + 6], 0xFFFFFFFFu);
@@ -195,9 +195,9 @@ TEST(FrameIo, ReadsOtherChannelEncodings) {
   spec.channelformats = {OIIO::TypeDesc::UINT32, OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::HALF,
                          OIIO::TypeDesc::HALF,   OIIO::TypeDesc::HALF,  OIIO::TypeDesc::HALF};
   // Native pixels: uint32 id, float Z, then four halves (16 bytes).
-  std::vector<unsigned char> native(6 * 16);
+  std::vector<unsigned char> native(std::size_t{6} * 16);
   for (std::uint32_t i = 0; i < 6; ++i) {
-    unsigned char* px = native.data() + i * 16;
+    unsigned char* px = native.data() + std::size_t{i} * 16;
     const std::uint32_t id = i + 1;
     const float z = 0.5f;
     const Imath::half rgba[4] = {Imath::half(1.0f), Imath::half(0.25f), Imath::half(0.125f),
@@ -236,7 +236,7 @@ TEST(FrameIo, PngRoundsLikeLround) {
   for (std::size_t i = 0; i < f.pixelCount(); ++i)
     for (int c = 0; c < 3; ++c) f.color[i * 4 + c] = any(rng);
   // Exact halves (k + 0.5 after the float multiply), the clamps and NaN.
-  for (int k = 0; k < 255; ++k) f.color[k * 4] = (static_cast<float>(k) + 0.5f) / 255.0f;
+  for (std::size_t k = 0; k < 255; ++k) f.color[k * 4] = (static_cast<float>(k) + 0.5f) / 255.0f;
   f.color[1] = std::numeric_limits<float>::quiet_NaN();
   f.color[5] = -std::numeric_limits<float>::infinity();
   f.color[9] = std::numeric_limits<float>::infinity();

@@ -38,6 +38,31 @@ Result run(const std::string& args, const std::string& env = "") {
   return r;
 }
 
+const std::string kFixture =
+    std::string(RC_SOURCE_DIR) + "/fixtures/scenes/coverage/triangle_fan.json";
+const std::string kFixtureName = "coverage/triangle_fan";
+
+// "render FIXTURE --backend SPEC --out OUT"
+std::string renderArgs(const std::string& spec, const fs::path& out) {
+  std::string args = "render ";
+  args += kFixture;
+  args += " --backend ";
+  args += spec;
+  args += " --out ";
+  args += out.string();
+  return args;
+}
+
+// "FIXTURE_NAME: SPEC: what", the start of every backend error of this fixture.
+std::string errorPrefix(const std::string& spec, const std::string& what) {
+  std::string prefix = kFixtureName;
+  prefix += ": ";
+  prefix += spec;
+  prefix += ": ";
+  prefix += what;
+  return prefix;
+}
+
 std::vector<std::string> lines(const std::string& s) {
   std::vector<std::string> out;
   std::istringstream in(s);
@@ -51,10 +76,6 @@ fs::path scratch(const std::string& name) {
   fs::create_directories(p);
   return p;
 }
-
-const std::string kFixture =
-    std::string(RC_SOURCE_DIR) + "/fixtures/scenes/coverage/triangle_fan.json";
-const std::string kFixtureName = "coverage/triangle_fan";
 
 std::vector<std::string> specs() {
   std::vector<std::string> s = {"gl:egl:llvmpipe", "gl:egl:softpipe"};
@@ -72,8 +93,7 @@ bool requireGl() {
 TEST(GlCli, ShaderCompileErrorExitsThreeNamingTheFixture) {
   for (const std::string& spec : specs()) {
     const fs::path out = scratch("shader") / "frame";
-    const Result r = run("render " + kFixture + " --backend " + spec + " --out " + out.string(),
-                         "RASTERCHECK_GL_FAULT=shader_compile_error");
+    const Result r = run(renderArgs(spec, out), "RASTERCHECK_GL_FAULT=shader_compile_error");
     EXPECT_EQ(r.code, 3) << spec << ": " << r.out;
     if (r.out.find("does not compile") == std::string::npos) {  // the driver did not start
       if (requireGl()) ADD_FAILURE() << "RASTERCHECK_REQUIRE_GL=1 but " << spec << ": " << r.out;
@@ -85,8 +105,7 @@ TEST(GlCli, ShaderCompileErrorExitsThreeNamingTheFixture) {
       return l.find("does not compile") != std::string::npos;
     });
     ASSERT_NE(error, all.end()) << spec << ": " << r.out;
-    EXPECT_NE(error->find(kFixtureName + ": " + spec + ": fragment shader does not compile"),
-              std::string::npos)
+    EXPECT_NE(error->find(errorPrefix(spec, "fragment shader does not compile")), std::string::npos)
         << *error;
     EXPECT_NE(error->find("rc_injected_compile_error"), std::string::npos)
         << "the compiler's own log: " << *error;
@@ -103,21 +122,21 @@ TEST(GlCli, UnavailablePlatformExitsThreeNamingTheFixture) {
 #endif
   for (const std::string& spec : unavailable) {
     const fs::path out = scratch("platform") / "frame";
-    const Result r = run("render " + kFixture + " --backend " + spec + " --out " + out.string());
+    const Result r = run(renderArgs(spec, out));
     fs::remove_all(out.parent_path());
     // No GPU is attached to the machines this suite runs on; where one is, it renders.
     if (spec == "gl:egl-device" && r.code == 0) continue;
     EXPECT_EQ(r.code, 3) << spec << ": " << r.out;
     EXPECT_EQ(lines(r.out).size(), 1u) << r.out;
-    EXPECT_NE(r.out.find(kFixtureName + ": " + spec + ": "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(errorPrefix(spec, "")), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out));
   }
 }
 
 TEST(GlCli, UnknownFaultExitsTwoBeforeWriting) {
   const fs::path out = scratch("badfault") / "frame";
-  const Result r = run("render " + kFixture + " --backend gl:egl:llvmpipe --out " + out.string(),
-                       "RASTERCHECK_GL_FAULT=light_scale=2,frobnicate");
+  const Result r =
+      run(renderArgs("gl:egl:llvmpipe", out), "RASTERCHECK_GL_FAULT=light_scale=2,frobnicate");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_EQ(lines(r.out).size(), 1u) << r.out;
   EXPECT_NE(r.out.find("RASTERCHECK_GL_FAULT: 'frobnicate': unknown fault"), std::string::npos)
@@ -129,8 +148,7 @@ TEST(GlCli, UnknownFaultExitsTwoBeforeWriting) {
 TEST(GlCli, InjectedFaultIsRecordedAndWarnedOnce) {
   for (const std::string& spec : specs()) {
     const fs::path dir = scratch("fault");
-    const Result clean =
-        run("render " + kFixture + " --backend " + spec + " --out " + (dir / "clean").string());
+    const Result clean = run(renderArgs(spec, dir / "clean"));
     if (clean.code != 0) {  // the driver did not start
       if (requireGl())
         ADD_FAILURE() << "RASTERCHECK_REQUIRE_GL=1 but " << spec << ": " << clean.out;
@@ -138,8 +156,7 @@ TEST(GlCli, InjectedFaultIsRecordedAndWarnedOnce) {
       continue;
     }
     const Result r =
-        run("render " + kFixture + " --backend " + spec + " --out " + (dir / "faulted").string(),
-            "RASTERCHECK_GL_FAULT=drop_primitive=1");
+        run(renderArgs(spec, dir / "faulted"), "RASTERCHECK_GL_FAULT=drop_primitive=1");
     ASSERT_EQ(r.code, 0) << spec << ": " << r.out;
     const std::vector<std::string> all = lines(r.out);
     EXPECT_EQ(std::count_if(all.begin(), all.end(),
