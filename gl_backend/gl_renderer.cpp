@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -43,6 +44,14 @@ using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// CPU time of the calling thread: the harness's own stages (upload, readback) run on it,
+// and unlike wall time it does not grow when other processes share the cores.
+double threadCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
 const char* glErrorName(GLenum error) {
@@ -794,7 +803,10 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   checkGl(s, "shader compilation");
   const double compile_ms = msSince(start);
 
+  // The FBO: allocated by the driver on the first render of a size and format, reused
+  // after that.
   start = Clock::now();
+  double cpu_start = threadCpuMs();
   const int max_rb = glInteger(gl, GL_MAX_RENDERBUFFER_SIZE);
   GLint max_viewport[2] = {0, 0};
   gl.GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
@@ -805,14 +817,19 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
                     "GL_MAX_VIEWPORT_DIMS {}x{})",
                     scene.width, scene.height, max_rb, max_viewport[0], max_viewport[1]));
   }
+  bindFramebuffer(s, scene);
+  checkGl(s, "framebuffer setup");
+  const double framebuffer_ms = msSince(start);
+  const double framebuffer_cpu_ms = threadCpuMs() - cpu_start;
+
+  start = Clock::now();
+  cpu_start = threadCpuMs();
   const gl::VertexData data = gl::buildVertexData(scene, drawPasses(scene), faults);
   if (data.vertices.size() > static_cast<std::size_t>(INT32_MAX)) {
     throw BackendError(
         fmt::format("{} vertices exceed what one glDrawArrays can address", data.vertices.size()));
   }
   RenderObjects objects(gl);
-  bindFramebuffer(s, scene);
-  checkGl(s, "framebuffer setup");
   uploadVertices(objects, data);
   const std::vector<GLuint> textures =
       uploadTextures(objects, scene, glInteger(gl, GL_MAX_TEXTURE_SIZE));
@@ -820,6 +837,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   if (gl::testing::hooks().gl_error_after_upload) gl.Enable(0xFFFFu);  // not a capability
   checkGl(s, "upload");
   const double upload_ms = msSince(start);
+  const double upload_cpu_ms = threadCpuMs() - cpu_start;
 
   start = Clock::now();
   setFixedState(gl, scene);
@@ -830,10 +848,12 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   const double draw_ms = msSince(start);
 
   start = Clock::now();
+  cpu_start = threadCpuMs();
   Frame frame;
   readBack(s, scene, frame);
   checkGl(s, "readback");
   const double readback_ms = msSince(start);
+  const double readback_cpu_ms = threadCpuMs() - cpu_start;
 
   nlohmann::json& m = frame.meta;
   m["renderer"] = s.renderer;
@@ -846,11 +866,12 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["driver"] = s.driver;
   m["skipped_triangles"] = data.skipped_triangles;
   if (faults.any()) m["fault_injected"] = faults.describe();
-  m["timing_ms"] = {{"context", context_ms},
-                    {"compile", compile_ms},
-                    {"upload", upload_ms},
-                    {"draw", draw_ms},
-                    {"readback", readback_ms}};
+  m["timing_ms"] = {
+      {"context", context_ms}, {"compile", compile_ms}, {"framebuffer", framebuffer_ms},
+      {"upload", upload_ms},   {"draw", draw_ms},       {"readback", readback_ms}};
+  m["timing_cpu_ms"] = {{"framebuffer", framebuffer_cpu_ms},
+                        {"upload", upload_cpu_ms},
+                        {"readback", readback_cpu_ms}};
   return frame;
 }
 

@@ -128,7 +128,22 @@ void BM_FloorMemcpy(benchmark::State& state) {
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bytes));
 }
 
-// Floor 2: handing the same bytes to the kernel as one write() of a new file (page
+// Floor 2: a fresh Frame's buffers of that size, allocated and zero-filled (page faults
+// included): what any readback into a new Frame pays before the first byte is copied.
+void BM_FloorFreshFrame(benchmark::State& state) {
+  const rc::Frame& f = frame(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    rc::Frame fresh;
+    fresh.color.resize(f.color.size());
+    fresh.depth.resize(f.depth.size());
+    fresh.id.resize(f.id.size());
+    fresh.edge_dist.resize(f.edge_dist.size());
+    fresh.depth_gap.resize(f.depth_gap.size());
+    benchmark::DoNotOptimize(fresh.color.data());
+  }
+}
+
+// Floor 3: handing the same bytes to the kernel as one write() of a new file (page
 // cache, no fsync): what writing an uncompressed frame.exr cannot beat.
 void BM_FloorWriteFile(benchmark::State& state) {
   const rc::Frame& f = frame(static_cast<int>(state.range(0)));
@@ -177,6 +192,12 @@ BENCHMARK(BM_ReadFrameDir)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_FloorMemcpy)
+    ->ArgName("channels")
+    ->Arg(6)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_FloorFreshFrame)
     ->ArgName("channels")
     ->Arg(6)
     ->Arg(8)

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <string>
 
@@ -37,48 +38,84 @@ double msSince(std::chrono::steady_clock::time_point start) {
 }
 
 // Sums of the backend's stage timings over the iterations, reported as per-frame means.
+// Wall times, plus the calling thread's CPU time for the harness's own stages (robust
+// when other processes share the cores).
 struct Stages {
-  double context = 0, compile = 0, upload = 0, draw = 0, readback = 0;
+  double context = 0, compile = 0, framebuffer = 0, upload = 0, draw = 0, readback = 0;
+  double framebuffer_cpu = 0, upload_cpu = 0, readback_cpu = 0;
   std::string renderer;
 
   void add(const rc::Frame& f) {
     context += metaMs(f, "context");
     compile += metaMs(f, "compile");
+    framebuffer += metaMs(f, "framebuffer");
     upload += metaMs(f, "upload");
     draw += metaMs(f, "draw");
     readback += metaMs(f, "readback");
+    framebuffer_cpu += f.meta.at("timing_cpu_ms").at("framebuffer").get<double>();
+    upload_cpu += f.meta.at("timing_cpu_ms").at("upload").get<double>();
+    readback_cpu += f.meta.at("timing_cpu_ms").at("readback").get<double>();
     renderer = f.meta.at("gl_renderer").get<std::string>();
   }
   void report(benchmark::State& state) const {
     const auto n = static_cast<double>(state.iterations());
     state.counters["context_ms"] = context / n;
     state.counters["compile_ms"] = compile / n;
+    state.counters["framebuffer_ms"] = framebuffer / n;
     state.counters["upload_ms"] = upload / n;
     state.counters["draw_ms"] = draw / n;
     state.counters["readback_ms"] = readback / n;
+    state.counters["framebuffer_cpu_ms"] = framebuffer_cpu / n;
+    state.counters["upload_cpu_ms"] = upload_cpu / n;
+    state.counters["readback_cpu_ms"] = readback_cpu / n;
   }
 };
 
-// A context from nothing (display, context, function table) after the process's first:
-// Mesa keeps the loaded driver, so this is what a second context costs. The first one,
-// driver loading included, is the "first_context_ms" entry of the run's context.
+// CPU time of the whole process (the PNG writer thread included; the driver's threads
+// are idle while the frame is written).
+double processCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+// A context from nothing: display, context, made current, function table loaded.
+// Returns GL_RENDERER.
+std::string createContext(const rc::GlSpec& spec) {
+  std::unique_ptr<rc::gl::Context> ctx;
+  if (spec.platform == rc::GlSpec::Platform::OSMesa) {
+    ctx = rc::gl::createOsMesaContext();
+  } else if (spec.platform == rc::GlSpec::Platform::EglDevice) {
+    ctx = rc::gl::createEglDeviceContext(spec.device);
+  } else {
+    ctx = rc::gl::createEglSurfacelessContext();
+  }
+  ctx->makeCurrent();
+  rc::gl::Functions gl;
+  gl.load(ctx->loader());
+  const std::string renderer = reinterpret_cast<const char*>(gl.GetString(GL_RENDERER));
+  ctx->release();
+  return renderer;
+}
+
+// Contexts after the process's first (Mesa keeps the driver loaded): what each further
+// context costs. The first one, driver loading included, is "first_context_ms" in the
+// run's context. Runs before any render: destroying an EGL context terminates the
+// display, which a render session would share.
 void BM_ContextCreate(benchmark::State& state) {
   const rc::GlSpec spec = rc::parseGlSpec(g_spec);
-  for (auto _ : state) {
-    std::unique_ptr<rc::gl::Context> ctx;
-    if (spec.platform == rc::GlSpec::Platform::OSMesa) {
-      ctx = rc::gl::createOsMesaContext();
-    } else if (spec.platform == rc::GlSpec::Platform::EglDevice) {
-      ctx = rc::gl::createEglDeviceContext(spec.device);
-    } else {
-      ctx = rc::gl::createEglSurfacelessContext();
-    }
-    ctx->makeCurrent();
-    rc::gl::Functions gl;
-    gl.load(ctx->loader());
-    benchmark::DoNotOptimize(gl.GetString(GL_RENDERER));
-    ctx->release();
-  }
+  for (auto _ : state) benchmark::DoNotOptimize(createContext(spec));
+}
+
+// The process's first render, at 1080p: the session's context, the first shader
+// compilation (llvmpipe JITs its variants in the first draw), the FBO allocation and a
+// readback into memory the process has never touched: what a `rastercheck render`
+// child pays. One iteration by construction.
+void BM_FirstRender1080p(benchmark::State& state) {
+  const rc::Scene scene = rc::bench::sphere1080p(rc::ColorFormat::RGBA32F);
+  Stages stages;
+  for (auto _ : state) stages.add(rc::renderGl(scene, rc::parseGlSpec(g_spec)));
+  stages.report(state);
 }
 
 // One renderGl of the 1080p scene; the counters split it into the backend's stages.
@@ -86,6 +123,7 @@ void BM_Stages1080p(benchmark::State& state) {
   const auto color = static_cast<rc::ColorFormat>(state.range(0));
   const rc::Scene scene = rc::bench::sphere1080p(color);
   const rc::GlSpec spec = rc::parseGlSpec(g_spec);
+  rc::renderGl(scene, spec);  // warm-up: llvmpipe JITs shader variants at the first draw
   Stages stages;
   for (auto _ : state) stages.add(rc::renderGl(scene, spec));
   stages.report(state);
@@ -100,13 +138,16 @@ void BM_HarnessOverhead1080p(benchmark::State& state) {
   const rc::GlSpec spec = rc::parseGlSpec(g_spec);
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("rc_bench_gl_" + std::to_string(::getpid()));
+  rc::renderGl(scene, spec);  // warm-up, as above
   Stages stages;
-  double write = 0;
+  double write = 0, write_cpu = 0;
   for (auto _ : state) {
     const rc::Frame f = rc::renderGl(scene, spec);
     const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = processCpuMs();
     rc::writeFrameDir(f, dir);
     write += msSince(start);
+    write_cpu += processCpuMs() - cpu_start;
     stages.add(f);
   }
   std::filesystem::remove_all(dir);
@@ -115,12 +156,16 @@ void BM_HarnessOverhead1080p(benchmark::State& state) {
   state.counters["write_frame_ms"] = write / n;
   state.counters["backend_overhead_ms"] = (stages.upload + stages.readback) / n;
   state.counters["harness_overhead_ms"] = (stages.upload + stages.readback + write) / n;
+  state.counters["write_frame_cpu_ms"] = write_cpu / n;
+  state.counters["harness_overhead_cpu_ms"] =
+      (stages.upload_cpu + stages.readback_cpu + write_cpu) / n;
 }
 
 // The reference benchmark's scenes through GL: same names and arguments as in
 // bench_reference, so bench/run.sh can match them.
 void renderScene(benchmark::State& state, const rc::Scene& scene) {
   const rc::GlSpec spec = rc::parseGlSpec(g_spec);
+  rc::renderGl(scene, spec);  // warm-up, as above
   Stages stages;
   for (auto _ : state) stages.add(rc::renderGl(scene, spec));
   stages.report(state);
@@ -142,6 +187,11 @@ void BM_Layers(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_ContextCreate)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FirstRender1080p)
+    ->Iterations(1)
+    ->Repetitions(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_Stages1080p)
     ->ArgName("rgba8")
     ->Arg(static_cast<int>(rc::ColorFormat::RGBA32F))
@@ -171,17 +221,19 @@ int main(int argc, char** argv) {
   argc = out;
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  // The first render of the process creates the session (driver loading, context) and
-  // compiles the program: what every `rastercheck render` child pays once.
   try {
-    rc::Scene tiny = rc::bench::sphere1080p(rc::ColorFormat::RGBA32F);
-    tiny.width = 16;
-    tiny.height = 16;
-    const rc::Frame f = rc::renderGl(tiny, rc::parseGlSpec(g_spec));
+    const rc::GlSpec spec = rc::parseGlSpec(g_spec);
+    // The driver is chosen by the first context of the process, as renderGl does.
+    if (!spec.driver.empty()) {
+      setenv("GALLIUM_DRIVER", spec.driver.c_str(), 1);
+      if (spec.platform == rc::GlSpec::Platform::EglSurfaceless)
+        setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const std::string renderer = createContext(spec);
+    benchmark::AddCustomContext("first_context_ms", std::to_string(msSince(start)));
     benchmark::AddCustomContext("gl_spec", g_spec);
-    benchmark::AddCustomContext("gl_renderer", f.meta.at("gl_renderer").get<std::string>());
-    benchmark::AddCustomContext("first_context_ms", std::to_string(metaMs(f, "context")));
-    benchmark::AddCustomContext("first_compile_ms", std::to_string(metaMs(f, "compile")));
+    benchmark::AddCustomContext("gl_renderer", renderer);
   } catch (const rc::InputError& e) {
     std::fprintf(stderr, "bench_gl: %s\n", e.what());
     return 2;
