@@ -11,8 +11,8 @@ constexpr const char* kHeader = R"(#version 330 core
 #define RC_MAX_LIGHTS {}
 )";
 
-// Uniforms and the lighting model, shared by both stages (Gouraud lights per vertex,
-// flat and Phong per fragment).
+// Uniforms and the lighting model, shared by both stages (flat and Gouraud light per
+// vertex, Phong per fragment).
 constexpr const char* kLighting = R"(
 uniform vec3 u_eye;               // camera.eye: v points towards it
 uniform vec3 u_ambient_light;
@@ -97,8 +97,11 @@ out vec2 v_uv;
 out vec3 v_gouraud_ambient_diffuse;
 out vec3 v_gouraud_specular;
 flat out uint v_primitive_id;
-flat out vec3 v_face_centroid;
-flat out vec3 v_face_normal;
+// Flat: every vertex of a triangle carries the same centroid and face normal, so each
+// computes the same colour and the provoking vertex's is used for the whole triangle:
+// lit once per vertex instead of once per fragment.
+flat out vec3 v_flat_ambient_diffuse;
+flat out vec3 v_flat_specular;
 
 void main() {
   gl_Position = u_view_projection * vec4(a_world_position, 1.0);
@@ -109,10 +112,12 @@ void main() {
   v_world_normal = a_world_normal;
   v_uv = a_uv;
   v_primitive_id = a_primitive_id;
-  v_face_centroid = a_face_centroid;
-  v_face_normal = a_face_normal;
   v_gouraud_ambient_diffuse = vec3(0.0);
   v_gouraud_specular = vec3(0.0);
+  v_flat_ambient_diffuse = vec3(0.0);
+  v_flat_specular = vec3(0.0);
+  if (u_shading == 0) shadePoint(a_face_centroid, a_face_normal, v_flat_ambient_diffuse,
+                                 v_flat_specular);
   if (u_shading == 1) shadePoint(a_world_position, a_world_normal, v_gouraud_ambient_diffuse,
                                  v_gouraud_specular);
 }
@@ -125,8 +130,8 @@ in vec2 v_uv;
 in vec3 v_gouraud_ambient_diffuse;
 in vec3 v_gouraud_specular;
 flat in uint v_primitive_id;
-flat in vec3 v_face_centroid;
-flat in vec3 v_face_normal;
+flat in vec3 v_flat_ambient_diffuse;
+flat in vec3 v_flat_specular;
 
 uniform int u_shading;
 uniform int u_has_texture;
@@ -144,7 +149,8 @@ void main() {
   vec3 ambient_diffuse;
   vec3 specular;
   if (u_shading == 0) {
-    shadePoint(v_face_centroid, v_face_normal, ambient_diffuse, specular);
+    ambient_diffuse = v_flat_ambient_diffuse;
+    specular = v_flat_specular;
   } else if (u_shading == 1) {
     ambient_diffuse = v_gouraud_ambient_diffuse;
     specular = v_gouraud_specular;
