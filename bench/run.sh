@@ -139,14 +139,20 @@ if fio:
     print("\n## Frame files at 1920x1080 (wall ms, medians; 6 channels = GL frame, 8 = reference)\n")
     print("| benchmark | 6 channels | 8 channels |")
     print("|---|---|---|")
-    for name, label in [("BM_WriteFrameDir", "writeFrameDir (exr + png + json, swap)"),
+    for name, label in [("BM_WriteFrameDir", "writeFrameDir into a new DIR (exr + png + json)"),
+                        ("BM_WriteFrameDir+replace", "writeFrameDir replacing a DIR (old frame deleted)"),
                         ("BM_ReadFrameDir", "readFrameDir"),
                         ("BM_ExrWrite/compression:0", "frame.exr write (none)"),
                         ("BM_ExrRead/compression:0", "frame.exr read (none)"),
                         ("BM_FloorMemcpy", "floor: memcpy of the same bytes"),
                         ("BM_FloorWriteFile", "floor: one write() of the same bytes")]:
         def get(ch):
-            e = fio.get(f"{name}/channels:{ch}")
+            base, _, variant = name.partition("+")
+            if base == "BM_WriteFrameDir":
+                key = f"{base}/channels:{ch}/replace:{1 if variant else 0}"
+            else:
+                key = f"{name}/channels:{ch}"
+            e = fio.get(key)
             return fmt(ms(e)) if e else "—"
         print(f"| {label} | {get(6)} | {get(8)} |")
     png = fio.get("BM_PngWrite/level:1/filter:8")
