@@ -24,9 +24,12 @@ void Functions::load(ProcLoader loader) {
   GLint count = 0;
   GetIntegerv(GL_NUM_EXTENSIONS, &count);
   bool khr_debug = false;
-  for (GLint i = 0; i < count && !khr_debug; ++i) {
+  pack_invert = false;
+  for (GLint i = 0; i < count; ++i) {
     const auto* ext = reinterpret_cast<const char*>(GetStringi(GL_EXTENSIONS, i));
-    khr_debug = ext != nullptr && std::strcmp(ext, "GL_KHR_debug") == 0;
+    if (ext == nullptr) continue;
+    khr_debug = khr_debug || std::strcmp(ext, "GL_KHR_debug") == 0;
+    pack_invert = pack_invert || std::strcmp(ext, "GL_MESA_pack_invert") == 0;
   }
   DebugMessageCallback =
       khr_debug ? reinterpret_cast<PFNGLDEBUGMESSAGECALLBACKPROC>(loader("glDebugMessageCallback"))

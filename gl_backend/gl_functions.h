@@ -7,6 +7,11 @@
 
 #include "gl_backend/context.h"
 
+// From the GL_MESA_pack_invert specification (not in glcorearb.h).
+#ifndef GL_PACK_INVERT_MESA
+#define GL_PACK_INVERT_MESA 0x8758
+#endif
+
 namespace rc::gl {
 
 // X(type, name): the member `name` holds "gl" #name. Only GL 3.3 core functions, plus
@@ -90,6 +95,8 @@ struct Functions {
   RC_GL_CORE_FUNCTIONS(RC_GL_DECLARE)
 #undef RC_GL_DECLARE
   PFNGLDEBUGMESSAGECALLBACKPROC DebugMessageCallback = nullptr;  // null without KHR_debug
+  // GL_MESA_pack_invert: glReadPixels can return rows top first (GL_PACK_INVERT_MESA).
+  bool pack_invert = false;
 
   // Loads every entry point; throws BackendError naming the first one that is missing.
   // Must be called with the context current (some providers only resolve then).

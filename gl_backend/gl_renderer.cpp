@@ -1,11 +1,15 @@
 // renderGl: the process-wide GL session, the FBO, the draw sequence of drawPasses() and
 // the readback into a Frame (top row first). See gl_backend.h and docs/gl_backend.md.
+#include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -40,6 +44,14 @@ using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// CPU time of the calling thread: the harness's own stages (upload, readback) run on it,
+// and unlike wall time it does not grow when other processes share the cores.
+double threadCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
 const char* glErrorName(GLenum error) {
@@ -107,6 +119,7 @@ struct Program {
   GLint light_intensity = -1, specular_model = -1, attenuation = -1;
   GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
   GLint opacity = -1, has_texture = -1, texture = -1;
+  GLint fault_depth_bias = -1, fault_shift_ndc = -1;  // -1 unless compiled with the fault
 };
 
 // The FBO of the last render, kept for the next one of the same size and formats:
@@ -120,11 +133,9 @@ struct Framebuffer {
   DepthFormat depth = DepthFormat::D24;
 };
 
-// Readback lands here first (warm memory, reused between renders), then is flipped and
-// converted into the Frame in one pass.
+// Readback of the formats that need converting (d16, rgba8) lands here first (warm
+// memory, reused between renders); everything else goes straight into the Frame.
 struct Scratch {
-  std::vector<float> floats;
-  std::vector<std::uint32_t> words;
   std::vector<std::uint16_t> halves;
   std::vector<std::uint8_t> bytes;
 };
@@ -264,8 +275,12 @@ GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& s
                                  stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log));
 }
 
-const Program& programFor(Session& s, int max_lights) {
-  gl::ProgramSource source = gl::programSource(max_lights);
+const Program& programFor(Session& s, int max_lights, const gl::testing::Faults& faults) {
+  gl::ShaderFaults shader_faults;
+  shader_faults.depth_bias = faults.depth_bias_steps != 0;
+  shader_faults.shift_x = faults.shift_x_px != 0.0;
+  shader_faults.compile_error = faults.shader_compile_error;
+  gl::ProgramSource source = gl::programSource(max_lights, shader_faults);
   const gl::testing::Hooks& hooks = gl::testing::hooks();
   if (!hooks.vertex_shader.empty()) source.vertex = hooks.vertex_shader;
   if (!hooks.fragment_shader.empty()) source.fragment = hooks.fragment_shader;
@@ -322,6 +337,8 @@ const Program& programFor(Session& s, int max_lights) {
   p.opacity = loc("u_opacity");
   p.has_texture = loc("u_has_texture");
   p.texture = loc("u_texture");
+  p.fault_depth_bias = loc("u_fault_depth_bias");
+  p.fault_shift_ndc = loc("u_fault_shift_ndc");
   return s.programs.emplace(key, p).first->second;
 }
 
@@ -520,7 +537,8 @@ std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max
 
 glm::vec3 toFloat(const glm::dvec3& v) { return glm::vec3(v); }
 
-void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& scene) {
+void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& scene,
+                      const gl::testing::Faults& faults) {
   const double aspect = static_cast<double>(scene.width) / scene.height;
   const glm::mat4 view_projection(projectionMatrix(scene.camera, aspect) *
                                   viewMatrix(scene.camera));
@@ -541,6 +559,14 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
   const auto count = static_cast<GLsizei>(scene.lights.size());
   gl.Uniform1i(p.light_count, count);
   gl.Uniform1i(p.texture, 0);
+  if (p.fault_shift_ndc >= 0) {
+    gl.Uniform1f(p.fault_shift_ndc, static_cast<GLfloat>(2.0 * faults.shift_x_px / scene.width));
+  }
+  if (p.fault_depth_bias >= 0) {
+    const int bits = depthBits(scene.state.depth_format);  // d32f: one step is 2^-24
+    const double step = bits > 0 ? 1.0 / (std::ldexp(1.0, bits) - 1.0) : std::ldexp(1.0, -24);
+    gl.Uniform1f(p.fault_depth_bias, static_cast<GLfloat>(faults.depth_bias_steps * step));
+  }
   if (count == 0) return;
   std::vector<GLint> directional;
   std::vector<glm::vec3> position, direction, color;
@@ -550,7 +576,7 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
     position.push_back(toFloat(l.position));
     direction.push_back(toFloat(l.direction));
     color.push_back(toFloat(l.color));
-    intensity.push_back(static_cast<GLfloat>(l.intensity));
+    intensity.push_back(static_cast<GLfloat>(l.intensity * faults.light_scale));
   }
   gl.Uniform1iv(p.light_directional, count, directional.data());
   gl.Uniform3fv(p.light_position, count, glm::value_ptr(position[0]));
@@ -626,23 +652,22 @@ void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
   }
 }
 
-// Appends a GL-row-ordered image (row 0 at the bottom) to dst top row first, converting
-// each element. dst was reserved, so this is the only pass over the Frame's memory.
-template <typename Src, typename Dst, typename Convert>
-void appendFlipped(const Src* src, std::vector<Dst>& dst, std::size_t row_elements, int height,
-                   Convert convert) {
-  for (int y = height - 1; y >= 0; --y) {
-    const Src* row = src + static_cast<std::size_t>(y) * row_elements;
-    for (std::size_t i = 0; i < row_elements; ++i) dst.push_back(convert(row[i]));
+// Swaps rows top <-> bottom in place: GL returns the bottom row first.
+void flipRows(std::byte* data, std::size_t row_bytes, int height) {
+  for (int top = 0, bottom = height - 1; top < bottom; ++top, --bottom) {
+    std::swap_ranges(data + static_cast<std::size_t>(top) * row_bytes,
+                     data + static_cast<std::size_t>(top + 1) * row_bytes,
+                     data + static_cast<std::size_t>(bottom) * row_bytes);
   }
 }
 
-template <typename T>
-void appendFlipped(const T* src, std::vector<T>& dst, std::size_t row_elements, int height) {
-  for (int y = height - 1; y >= 0; --y) {
-    const T* row = src + static_cast<std::size_t>(y) * row_elements;
-    dst.insert(dst.end(), row, row + row_elements);
-  }
+// Reads the bound read buffer (or depth) into dst, top row first: with
+// GL_MESA_pack_invert (llvmpipe, softpipe) the driver writes the rows in that order in
+// its one copy; elsewhere the rows are swapped afterwards.
+void readRows(const gl::Functions& gl, bool inverted, int w, int h, GLenum format, GLenum type,
+              void* dst, std::size_t row_bytes) {
+  gl.ReadPixels(0, 0, w, h, format, type, dst);
+  if (!inverted) flipRows(static_cast<std::byte*>(dst), row_bytes, h);
 }
 
 template <typename T>
@@ -651,6 +676,10 @@ T* scratchFor(std::vector<T>& scratch, std::size_t n) {
   return scratch.data();
 }
 
+// Reads colour, depth and ids straight into the Frame's buffers (no intermediate copy
+// except for d16 and rgba8, which need converting). Stored depth q becomes q / (2^b - 1)
+// like the reference; q * (1 / (2^b - 1)) in double rounds to the same float for every
+// q (checked for all 2^24 and 2^16 values) and vectorises.
 void readBack(Session& s, const Scene& scene, Frame& frame) {
   const gl::Functions& gl = s.gl;
   Scratch& scratch = s.scratch;
@@ -660,59 +689,55 @@ void readBack(Session& s, const Scene& scene, Frame& frame) {
   const std::size_t n = row * h;
   frame.width = w;
   frame.height = h;
-  frame.color.clear();
-  frame.color.reserve(n * 4);
-  frame.depth.clear();
-  frame.depth.reserve(n);
-  frame.id.clear();
-  frame.id.reserve(n);
+  frame.color.resize(n * 4);
+  frame.depth.resize(n);
+  frame.id.resize(n);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  const bool inverted = gl.pack_invert && !gl::testing::hooks().ignore_pack_invert;
+  if (inverted) gl.PixelStorei(GL_PACK_INVERT_MESA, GL_TRUE);
+
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   if (scene.state.color_format == ColorFormat::RGBA8) {
     std::uint8_t* bytes = scratchFor(scratch.bytes, n * 4);
-    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bytes);
+    readRows(gl, inverted, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bytes, row * 4);
     static const auto kUnorm8 = [] {
       std::array<float, 256> t{};
       for (int q = 0; q < 256; ++q) t[q] = static_cast<float>(q / 255.0);
       return t;
     }();
-    appendFlipped(bytes, frame.color, row * 4, h, [](std::uint8_t q) { return kUnorm8[q]; });
+    float* dst = frame.color.data();
+    for (std::size_t i = 0; i < n * 4; ++i) dst[i] = kUnorm8[bytes[i]];
   } else {
-    float* floats = scratchFor(scratch.floats, n * 4);
-    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, floats);
-    appendFlipped(floats, frame.color, row * 4, h);
+    readRows(gl, inverted, w, h, GL_RGBA, GL_FLOAT, frame.color.data(), row * 4 * sizeof(float));
   }
 
-  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-  std::uint32_t* ids = scratchFor(scratch.words, n);
-  gl.ReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, ids);
-  appendFlipped(ids, frame.id, row, h);
-
-  // Depth comes back as the stored integer q (exactly), then q / (2^b - 1) like the
-  // reference; GL_UNSIGNED_INT scales a 24-bit value to 32 bits, so q = v >> 8 whether
-  // the driver replicates bits or rounds (see docs/gl_backend.md).
+  // GL_UNSIGNED_INT scales a 24-bit value to 32 bits, so q = v >> 8 whether the driver
+  // replicates bits or rounds (see docs/gl_backend.md "Readback"). The ids' buffer holds
+  // the raw values until the ids are read.
+  float* depth = frame.depth.data();
   switch (scene.state.depth_format) {
     case DepthFormat::D16: {
       std::uint16_t* q = scratchFor(scratch.halves, n);
-      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, q);
-      appendFlipped(q, frame.depth, row, h,
-                    [](std::uint16_t v) { return static_cast<float>(v / 65535.0); });
+      readRows(gl, inverted, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, q, row * 2);
+      constexpr double kScale = 1.0 / 65535.0;
+      for (std::size_t i = 0; i < n; ++i) depth[i] = static_cast<float>(q[i] * kScale);
       break;
     }
     case DepthFormat::D24: {
-      std::uint32_t* q = scratchFor(scratch.words, n);  // the ids were copied out already
-      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, q);
-      appendFlipped(q, frame.depth, row, h,
-                    [](std::uint32_t v) { return static_cast<float>((v >> 8) / 16777215.0); });
+      std::uint32_t* v = frame.id.data();
+      readRows(gl, inverted, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, v, row * 4);
+      constexpr double kScale = 1.0 / 16777215.0;
+      for (std::size_t i = 0; i < n; ++i) depth[i] = static_cast<float>((v[i] >> 8) * kScale);
       break;
     }
-    case DepthFormat::D32F: {
-      float* z = scratchFor(scratch.floats, n);
-      gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, z);
-      appendFlipped(z, frame.depth, row, h);
+    case DepthFormat::D32F:
+      readRows(gl, inverted, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth, row * 4);
       break;
-    }
   }
+
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  readRows(gl, inverted, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, frame.id.data(), row * 4);
+  if (inverted) gl.PixelStorei(GL_PACK_INVERT_MESA, GL_FALSE);
 }
 
 // Lights cost 5 vec4 slots each in the worst packing; the rest of the uniforms fit in 16.
@@ -734,11 +759,31 @@ int lightArraySize(const gl::Functions& gl, std::size_t lights) {
   return std::min(size, max_lights);
 }
 
+// The faults of this render: the in-process hooks, else RASTERCHECK_GL_FAULT. A faulted
+// process says so once on stderr, so nobody mistakes its frames for real ones.
+gl::testing::Faults activeFaults() {
+  gl::testing::Faults faults = gl::testing::hooks().faults;
+  if (!faults.any()) {
+    const char* env = std::getenv(gl::testing::kFaultVariable);
+    if (env != nullptr) faults = gl::testing::parseFaults(env);
+  }
+  static bool warned = false;
+  if (faults.any() && !warned) {
+    warned = true;
+    std::fprintf(
+        stderr,
+        "rastercheck: warning: GL fault injected (%s): test-only, frames are wrong on purpose\n",
+        faults.describe().c_str());
+  }
+  return faults;
+}
+
 Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   if (scene.width <= 0 || scene.height <= 0) {
     throw InputError(
         fmt::format("{}: image size {}x{} is not positive", scene.name, scene.width, scene.height));
   }
+  const gl::testing::Faults faults = activeFaults();  // bad RASTERCHECK_GL_FAULT: exit 2
   auto start = Clock::now();
   Session& s = acquireSession(spec);
   struct Release {
@@ -751,7 +796,17 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   }
   const double context_ms = msSince(start);
 
+  // Compiling is the driver's work and happens once per process and program; it is
+  // timed apart from the upload (the harness's own work).
   start = Clock::now();
+  const Program& program = programFor(s, lightArraySize(gl, scene.lights.size()), faults);
+  checkGl(s, "shader compilation");
+  const double compile_ms = msSince(start);
+
+  // The FBO: allocated by the driver on the first render of a size and format, reused
+  // after that.
+  start = Clock::now();
+  double cpu_start = threadCpuMs();
   const int max_rb = glInteger(gl, GL_MAX_RENDERBUFFER_SIZE);
   GLint max_viewport[2] = {0, 0};
   gl.GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
@@ -762,23 +817,27 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
                     "GL_MAX_VIEWPORT_DIMS {}x{})",
                     scene.width, scene.height, max_rb, max_viewport[0], max_viewport[1]));
   }
-  const Program& program = programFor(s, lightArraySize(gl, scene.lights.size()));
-  checkGl(s, "shader compilation");
-  const gl::VertexData data = gl::buildVertexData(scene, drawPasses(scene));
+  bindFramebuffer(s, scene);
+  checkGl(s, "framebuffer setup");
+  const double framebuffer_ms = msSince(start);
+  const double framebuffer_cpu_ms = threadCpuMs() - cpu_start;
+
+  start = Clock::now();
+  cpu_start = threadCpuMs();
+  const gl::VertexData data = gl::buildVertexData(scene, drawPasses(scene), faults);
   if (data.vertices.size() > static_cast<std::size_t>(INT32_MAX)) {
     throw BackendError(
         fmt::format("{} vertices exceed what one glDrawArrays can address", data.vertices.size()));
   }
   RenderObjects objects(gl);
-  bindFramebuffer(s, scene);
-  checkGl(s, "framebuffer setup");
   uploadVertices(objects, data);
   const std::vector<GLuint> textures =
       uploadTextures(objects, scene, glInteger(gl, GL_MAX_TEXTURE_SIZE));
-  setSceneUniforms(gl, program, scene);
+  setSceneUniforms(gl, program, scene, faults);
   if (gl::testing::hooks().gl_error_after_upload) gl.Enable(0xFFFFu);  // not a capability
   checkGl(s, "upload");
   const double upload_ms = msSince(start);
+  const double upload_cpu_ms = threadCpuMs() - cpu_start;
 
   start = Clock::now();
   setFixedState(gl, scene);
@@ -789,10 +848,12 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   const double draw_ms = msSince(start);
 
   start = Clock::now();
+  cpu_start = threadCpuMs();
   Frame frame;
   readBack(s, scene, frame);
   checkGl(s, "readback");
   const double readback_ms = msSince(start);
+  const double readback_cpu_ms = threadCpuMs() - cpu_start;
 
   nlohmann::json& m = frame.meta;
   m["renderer"] = s.renderer;
@@ -804,8 +865,13 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["platform"] = s.context->platform();
   m["driver"] = s.driver;
   m["skipped_triangles"] = data.skipped_triangles;
+  if (faults.any()) m["fault_injected"] = faults.describe();
   m["timing_ms"] = {
-      {"context", context_ms}, {"upload", upload_ms}, {"draw", draw_ms}, {"readback", readback_ms}};
+      {"context", context_ms}, {"compile", compile_ms}, {"framebuffer", framebuffer_ms},
+      {"upload", upload_ms},   {"draw", draw_ms},       {"readback", readback_ms}};
+  m["timing_cpu_ms"] = {{"framebuffer", framebuffer_cpu_ms},
+                        {"upload", upload_cpu_ms},
+                        {"readback", readback_cpu_ms}};
   return frame;
 }
 

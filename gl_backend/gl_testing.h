@@ -1,17 +1,46 @@
-// Test-only fault injection for the GL backend: lets tests prove that shader logs, GL
-// errors and driver mismatches surface as BackendError. Not thread-safe; production
-// code never sets these.
+// Test-only fault injection for the GL backend. Two ways in:
+//  - in-process tests set hooks() (shader replacements, a GL error, a forced driver,
+//    faults);
+//  - a child `rastercheck render` reads the environment variable RASTERCHECK_GL_FAULT,
+//    a comma-separated list of faults (docs/gl_backend.md "Fault injection"), so the
+//    harness's self-tests can prove that an injected GL-side fault is caught.
+// A faulted render records "fault_injected" in frame.json and warns once on stderr.
+// Not thread-safe; production code never sets these.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace rc::gl::testing {
+
+// The environment variable read by every renderGl call (when hooks().faults is empty).
+inline constexpr const char* kFaultVariable = "RASTERCHECK_GL_FAULT";
+
+struct Faults {
+  std::uint32_t drop_primitive = 0;   // drop_primitive=ID: that triangle is not drawn (0: none)
+  int depth_bias_steps = 0;           // depth_bias=STEPS: stored depth + STEPS format steps
+  double light_scale = 1.0;           // light_scale=F: every light's intensity times F
+  bool no_inverse_transpose = false;  // normals by the model matrix, not its inverse transpose
+  double shift_x_px = 0.0;            // shift_x=PX: geometry moved PX pixels right (window)
+  bool shader_compile_error = false;  // shader_compile_error: the fragment shader breaks
+
+  bool any() const;
+  // The canonical comma-separated form (parseFaults(describe()) gives the same faults).
+  std::string describe() const;
+};
+
+// Parses "drop_primitive=3,light_scale=2". Throws InputError naming the variable and the
+// offending entry for an unknown fault name or a bad value.
+Faults parseFaults(std::string_view text);
 
 struct Hooks {
   std::string vertex_shader;           // non-empty: compiled instead of the real vertex shader
   std::string fragment_shader;         // non-empty: compiled instead of the real fragment shader
   bool gl_error_after_upload = false;  // issue an invalid GL call after the upload stage
   std::string gallium_driver;          // non-empty: GALLIUM_DRIVER is set to this, not the spec's
+  Faults faults;                       // any(): used instead of RASTERCHECK_GL_FAULT
+  bool ignore_pack_invert = false;     // read back as if GL_MESA_pack_invert were missing
 };
 
 // The process-wide hooks (all off by default).

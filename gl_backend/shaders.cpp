@@ -11,8 +11,8 @@ constexpr const char* kHeader = R"(#version 330 core
 #define RC_MAX_LIGHTS {}
 )";
 
-// Uniforms and the lighting model, shared by both stages (Gouraud lights per vertex,
-// flat and Phong per fragment).
+// Uniforms and the lighting model, shared by both stages (flat and Gouraud light per
+// vertex, Phong per fragment).
 constexpr const char* kLighting = R"(
 uniform vec3 u_eye;               // camera.eye: v points towards it
 uniform vec3 u_ambient_light;
@@ -87,6 +87,9 @@ layout(location = 5) in vec3 a_face_normal;
 
 uniform mat4 u_view_projection;  // projection * view, composed in double on the CPU
 uniform int u_shading;           // 0 flat, 1 gouraud, 2 phong
+#ifdef RC_FAULT_SHIFT_X
+uniform float u_fault_shift_ndc;  // test-only: 2 * PX / width
+#endif
 
 out vec3 v_world_position;
 out vec3 v_world_normal;
@@ -94,19 +97,27 @@ out vec2 v_uv;
 out vec3 v_gouraud_ambient_diffuse;
 out vec3 v_gouraud_specular;
 flat out uint v_primitive_id;
-flat out vec3 v_face_centroid;
-flat out vec3 v_face_normal;
+// Flat: every vertex of a triangle carries the same centroid and face normal, so each
+// computes the same colour and the provoking vertex's is used for the whole triangle:
+// lit once per vertex instead of once per fragment.
+flat out vec3 v_flat_ambient_diffuse;
+flat out vec3 v_flat_specular;
 
 void main() {
   gl_Position = u_view_projection * vec4(a_world_position, 1.0);
+#ifdef RC_FAULT_SHIFT_X
+  gl_Position.x += u_fault_shift_ndc * gl_Position.w;  // NDC x + 2 PX / width
+#endif
   v_world_position = a_world_position;
   v_world_normal = a_world_normal;
   v_uv = a_uv;
   v_primitive_id = a_primitive_id;
-  v_face_centroid = a_face_centroid;
-  v_face_normal = a_face_normal;
   v_gouraud_ambient_diffuse = vec3(0.0);
   v_gouraud_specular = vec3(0.0);
+  v_flat_ambient_diffuse = vec3(0.0);
+  v_flat_specular = vec3(0.0);
+  if (u_shading == 0) shadePoint(a_face_centroid, a_face_normal, v_flat_ambient_diffuse,
+                                 v_flat_specular);
   if (u_shading == 1) shadePoint(a_world_position, a_world_normal, v_gouraud_ambient_diffuse,
                                  v_gouraud_specular);
 }
@@ -119,13 +130,16 @@ in vec2 v_uv;
 in vec3 v_gouraud_ambient_diffuse;
 in vec3 v_gouraud_specular;
 flat in uint v_primitive_id;
-flat in vec3 v_face_centroid;
-flat in vec3 v_face_normal;
+flat in vec3 v_flat_ambient_diffuse;
+flat in vec3 v_flat_specular;
 
 uniform int u_shading;
 uniform int u_has_texture;
 uniform sampler2D u_texture;
 uniform float u_opacity;
+#ifdef RC_FAULT_DEPTH_BIAS
+uniform float u_fault_depth_bias;  // test-only: STEPS / (2^bits - 1)
+#endif
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_primitive_id;
@@ -135,7 +149,8 @@ void main() {
   vec3 ambient_diffuse;
   vec3 specular;
   if (u_shading == 0) {
-    shadePoint(v_face_centroid, v_face_normal, ambient_diffuse, specular);
+    ambient_diffuse = v_flat_ambient_diffuse;
+    specular = v_flat_specular;
   } else if (u_shading == 1) {
     ambient_diffuse = v_gouraud_ambient_diffuse;
     specular = v_gouraud_specular;
@@ -144,14 +159,24 @@ void main() {
   }
   o_color = vec4(tex * ambient_diffuse + specular, u_opacity);
   o_primitive_id = v_primitive_id;
+#ifdef RC_FAULT_DEPTH_BIAS
+  gl_FragDepth = gl_FragCoord.z + u_fault_depth_bias;
+#endif
+#ifdef RC_FAULT_COMPILE_ERROR
+  rc_injected_compile_error();
+#endif
 }
 )";
 
 }  // namespace
 
-ProgramSource programSource(int max_lights) {
-  const std::string header = fmt::format(kHeader, max_lights);
-  return {header + kLighting + kVertexMain, header + kLighting + kFragmentMain};
+ProgramSource programSource(int max_lights, const ShaderFaults& faults) {
+  std::string header = fmt::format(kHeader, max_lights);
+  if (faults.depth_bias) header += "#define RC_FAULT_DEPTH_BIAS\n";
+  if (faults.shift_x) header += "#define RC_FAULT_SHIFT_X\n";
+  std::string fragment_header = header;
+  if (faults.compile_error) fragment_header += "#define RC_FAULT_COMPILE_ERROR\n";
+  return {header + kLighting + kVertexMain, fragment_header + kLighting + kFragmentMain};
 }
 
 }  // namespace rc::gl

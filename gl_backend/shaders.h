@@ -27,8 +27,16 @@ struct ProgramSource {
   std::string fragment;
 };
 
+// Test-only faults compiled into the program (gl_testing.h). With none set, the program
+// text is exactly the production one; each set fault adds one #define.
+struct ShaderFaults {
+  bool depth_bias = false;     // gl_FragDepth = gl_FragCoord.z + u_fault_depth_bias
+  bool shift_x = false;        // gl_Position.x += u_fault_shift_ndc * gl_Position.w
+  bool compile_error = false;  // the fragment shader calls a function that does not exist
+};
+
 // The program for scenes with up to max_lights lights (array sizes are compile-time
 // constants in GLSL 330).
-ProgramSource programSource(int max_lights);
+ProgramSource programSource(int max_lights, const ShaderFaults& faults = {});
 
 }  // namespace rc::gl

@@ -53,13 +53,16 @@ void validateObject(const Scene& scene, std::size_t index) {
   }
 }
 
-WorldMesh toWorld(const Object& o, const glm::dmat4& view_projection) {
+WorldMesh toWorld(const Object& o, const glm::dmat4& view_projection, bool model_matrix_normals) {
   WorldMesh w;
   const std::size_t n = o.mesh.positions.size();
   w.positions.resize(n);
   w.normals.resize(n);
   w.finite.resize(n);
-  const glm::dmat3 normal_matrix = normalMatrix(o.model);
+  // The fault no_inverse_transpose: the classic mistake, exact only for rotations and
+  // uniform scales.
+  const glm::dmat3 normal_matrix =
+      model_matrix_normals ? glm::dmat3(o.model) : normalMatrix(o.model);
   for (std::size_t i = 0; i < n; ++i) {
     const glm::dvec4 p = o.model * glm::dvec4(glm::dvec3(o.mesh.positions[i]), 1.0);
     w.positions[i] = glm::dvec3(p);
@@ -78,14 +81,16 @@ void store(float (&dst)[3], const glm::dvec3& v) {
 
 }  // namespace
 
-VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes) {
+VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes,
+                           const testing::Faults& faults) {
   for (std::size_t i = 0; i < scene.objects.size(); ++i) validateObject(scene, i);
   const double aspect = static_cast<double>(scene.width) / scene.height;
   const glm::dmat4 view_projection =
       projectionMatrix(scene.camera, aspect) * viewMatrix(scene.camera);
   std::vector<WorldMesh> world;
   world.reserve(scene.objects.size());
-  for (const Object& o : scene.objects) world.push_back(toWorld(o, view_projection));
+  for (const Object& o : scene.objects)
+    world.push_back(toWorld(o, view_projection, faults.no_inverse_transpose));
 
   VertexData data;
   std::size_t triangles = 0;
@@ -98,6 +103,7 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
     out.depth_write = pass.depth_write;
     out.blend = pass.blend;
     for (const PrimitiveRef& prim : pass.primitives) {
+      if (prim.id == faults.drop_primitive) continue;  // the fault drop_primitive=ID
       const Object& obj = scene.objects[prim.object];
       const WorldMesh& wm = world[prim.object];
       const auto& tri = obj.mesh.triangles[prim.triangle];

@@ -10,6 +10,7 @@
 
 #include "fixtures/scene.h"
 #include "fixtures/scene_logic.h"
+#include "gl_backend/gl_testing.h"
 
 namespace rc::gl {
 
@@ -46,6 +47,8 @@ struct VertexData {
 // Builds the buffer for drawPasses(scene). Triangles with a non-finite world or clip
 // position are left out; their ids stay unused. Throws InputError for indices out of
 // range (material, vertex) or attribute arrays whose size does not match the positions.
-VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes);
+// Of the test-only faults, drop_primitive and no_inverse_transpose act here.
+VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes,
+                           const testing::Faults& faults = {});
 
 }  // namespace rc::gl

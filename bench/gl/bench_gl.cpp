@@ -1,21 +1,23 @@
-// GL backend benchmarks at 1920x1080. Each stage of renderGl is timed inside the backend
-// (frame.meta timing_ms) and reported here as counters; the harness overhead adds the
-// frame files (writeFrameDir) to upload + readback. One driver per process:
-//   RASTERCHECK_GL_SPEC=gl:egl:softpipe ./bench_gl   or   ./bench_gl --gl_spec=gl:egl:softpipe
+// GL backend benchmarks, one driver per process (GALLIUM_DRIVER is read once):
+//   ./bench_gl --gl_spec=gl:egl:softpipe     (or RASTERCHECK_GL_SPEC=...)
+// At 1920x1080: context creation, shader compilation, upload, draw and readback as
+// separate counters (each timed inside renderGl, frame.meta timing_ms), and the harness's
+// own overhead per frame (upload + readback with conversion + writing the frame files).
+// Plus the reference benchmark's scenes, for bench/run.sh's reference/GL ratios.
+// Everything is wall time (UseRealTime): the drivers draw on their own threads.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
-#include <numbers>
 #include <string>
 
-#include <glm/gtc/matrix_transform.hpp>
-
+#include "bench/gl/bench_scenes.h"
+#include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 #include "fixtures/scene.h"
 #include "gl_backend/context.h"
@@ -26,146 +28,187 @@ namespace {
 
 std::string g_spec = "gl:egl:llvmpipe";
 
-// A lit sphere (64 x 32 segments) over a ground grid, perspective, Phong shading: the
-// kind of scene the conformance suite renders, at 1080p.
-rc::Scene benchScene(rc::ColorFormat color) {
-  rc::Scene s;
-  s.name = "bench/sphere_1080p";
-  s.width = 1920;
-  s.height = 1080;
-  s.camera.eye = {0.0, 1.0, 4.0};
-  s.camera.target = {0.0, 0.3, 0.0};
-  s.ambient_light = {0.1, 0.1, 0.1};
-  s.state.color_format = color;
-  rc::Light key;
-  key.position = {2, 3, 3};
-  s.lights.push_back(key);
-  rc::Light fill;
-  fill.type = rc::LightType::Directional;
-  fill.direction = {-1, -1, -0.5};
-  fill.intensity = 0.4;
-  s.lights.push_back(fill);
-  rc::Material m;
-  m.ambient = {0.8, 0.3, 0.2};
-  m.diffuse = {0.8, 0.3, 0.2};
-  m.specular = {0.5, 0.5, 0.5};
-  s.materials.push_back(m);
-
-  rc::Object ball;
-  const int seg = 64, rings = 32;
-  for (int r = 0; r <= rings; ++r) {
-    const double th = std::numbers::pi * r / rings;
-    for (int i = 0; i <= seg; ++i) {
-      const double ph = 2 * std::numbers::pi * i / seg;
-      const glm::vec3 p(static_cast<float>(std::sin(th) * std::cos(ph)),
-                        static_cast<float>(std::cos(th)),
-                        static_cast<float>(-std::sin(th) * std::sin(ph)));
-      ball.mesh.positions.push_back(p);
-      ball.mesh.normals.push_back(p);
-    }
-  }
-  for (int r = 0; r < rings; ++r) {
-    for (int i = 0; i < seg; ++i) {
-      const auto a = static_cast<std::uint32_t>(r * (seg + 1) + i);
-      const auto b = a + static_cast<std::uint32_t>(seg + 1);
-      ball.mesh.triangles.push_back({a, b, a + 1});
-      ball.mesh.triangles.push_back({a + 1, b, b + 1});
-    }
-  }
-  ball.model = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.5, 0));
-  s.objects.push_back(ball);
-
-  rc::Object ground;
-  ground.mesh.positions = {{-5, -0.5f, 5}, {5, -0.5f, 5}, {5, -0.5f, -5}, {-5, -0.5f, -5}};
-  ground.mesh.normals.assign(4, glm::vec3(0, 1, 0));
-  ground.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
-  s.objects.push_back(ground);
-  return s;
-}
-
 double metaMs(const rc::Frame& f, const char* key) {
   return f.meta.at("timing_ms").at(key).get<double>();
 }
 
-// Creating the provider's context from nothing (display, context, function table): what a
-// fresh `rastercheck render` child pays once.
-void BM_ContextCreate(benchmark::State& state) {
-  const rc::GlSpec spec = rc::parseGlSpec(g_spec);
-  for (auto _ : state) {
-    std::unique_ptr<rc::gl::Context> ctx;
-    if (spec.platform == rc::GlSpec::Platform::OSMesa) {
-      ctx = rc::gl::createOsMesaContext();
-    } else if (spec.platform == rc::GlSpec::Platform::EglDevice) {
-      ctx = rc::gl::createEglDeviceContext(spec.device);
-    } else {
-      ctx = rc::gl::createEglSurfacelessContext();
-    }
-    ctx->makeCurrent();
-    rc::gl::Functions gl;
-    gl.load(ctx->loader());
-    benchmark::DoNotOptimize(gl.GetString(GL_RENDERER));
-    ctx->release();
-  }
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
-// One full renderGl at 1080p; the counters split it into the backend's stages.
-void BM_Render1080p(benchmark::State& state) {
-  const auto color = static_cast<rc::ColorFormat>(state.range(0));
-  const rc::Scene scene = benchScene(color);
-  const rc::GlSpec spec = rc::parseGlSpec(g_spec);
-  double upload = 0, draw = 0, readback = 0, context = 0;
+// Sums of the backend's stage timings over the iterations, reported as per-frame means.
+// Wall times, plus the calling thread's CPU time for the harness's own stages (robust
+// when other processes share the cores).
+struct Stages {
+  double context = 0, compile = 0, framebuffer = 0, upload = 0, draw = 0, readback = 0;
+  double framebuffer_cpu = 0, upload_cpu = 0, readback_cpu = 0;
   std::string renderer;
-  for (auto _ : state) {
-    const rc::Frame f = rc::renderGl(scene, spec);
+
+  void add(const rc::Frame& f) {
+    context += metaMs(f, "context");
+    compile += metaMs(f, "compile");
+    framebuffer += metaMs(f, "framebuffer");
     upload += metaMs(f, "upload");
     draw += metaMs(f, "draw");
     readback += metaMs(f, "readback");
-    context += metaMs(f, "context");
+    framebuffer_cpu += f.meta.at("timing_cpu_ms").at("framebuffer").get<double>();
+    upload_cpu += f.meta.at("timing_cpu_ms").at("upload").get<double>();
+    readback_cpu += f.meta.at("timing_cpu_ms").at("readback").get<double>();
     renderer = f.meta.at("gl_renderer").get<std::string>();
   }
-  const auto n = static_cast<double>(state.iterations());
-  state.counters["context_ms"] = context / n;
-  state.counters["upload_ms"] = upload / n;
-  state.counters["draw_ms"] = draw / n;
-  state.counters["readback_ms"] = readback / n;
-  state.SetLabel(renderer + (color == rc::ColorFormat::RGBA8 ? ", rgba8" : ", rgba32f"));
+  void report(benchmark::State& state) const {
+    const auto n = static_cast<double>(state.iterations());
+    state.counters["context_ms"] = context / n;
+    state.counters["compile_ms"] = compile / n;
+    state.counters["framebuffer_ms"] = framebuffer / n;
+    state.counters["upload_ms"] = upload / n;
+    state.counters["draw_ms"] = draw / n;
+    state.counters["readback_ms"] = readback / n;
+    state.counters["framebuffer_cpu_ms"] = framebuffer_cpu / n;
+    state.counters["upload_cpu_ms"] = upload_cpu / n;
+    state.counters["readback_cpu_ms"] = readback_cpu / n;
+  }
+};
+
+// CPU time of the whole process (the PNG writer thread included; the driver's threads
+// are idle while the frame is written).
+double processCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
-// The harness's own cost per frame: upload + readback (with conversion) inside the
-// backend, plus writing the frame directory (frame.exr, color.png, frame.json).
+// A context from nothing: display, context, made current, function table loaded.
+// Returns GL_RENDERER.
+std::string createContext(const rc::GlSpec& spec) {
+  std::unique_ptr<rc::gl::Context> ctx;
+  if (spec.platform == rc::GlSpec::Platform::OSMesa) {
+    ctx = rc::gl::createOsMesaContext();
+  } else if (spec.platform == rc::GlSpec::Platform::EglDevice) {
+    ctx = rc::gl::createEglDeviceContext(spec.device);
+  } else {
+    ctx = rc::gl::createEglSurfacelessContext();
+  }
+  ctx->makeCurrent();
+  rc::gl::Functions gl;
+  gl.load(ctx->loader());
+  const std::string renderer = reinterpret_cast<const char*>(gl.GetString(GL_RENDERER));
+  ctx->release();
+  return renderer;
+}
+
+// Contexts after the process's first (Mesa keeps the driver loaded): what each further
+// context costs. The first one, driver loading included, is "first_context_ms" in the
+// run's context. Runs before any render: destroying an EGL context terminates the
+// display, which a render session would share.
+void BM_ContextCreate(benchmark::State& state) {
+  const rc::GlSpec spec = rc::parseGlSpec(g_spec);
+  for (auto _ : state) benchmark::DoNotOptimize(createContext(spec));
+}
+
+// The process's first render, at 1080p: the session's context, the first shader
+// compilation (llvmpipe JITs its variants in the first draw), the FBO allocation and a
+// readback into memory the process has never touched: what a `rastercheck render`
+// child pays. One iteration by construction.
+void BM_FirstRender1080p(benchmark::State& state) {
+  const rc::Scene scene = rc::bench::sphere1080p(rc::ColorFormat::RGBA32F);
+  Stages stages;
+  for (auto _ : state) stages.add(rc::renderGl(scene, rc::parseGlSpec(g_spec)));
+  stages.report(state);
+}
+
+// One renderGl of the 1080p scene; the counters split it into the backend's stages.
+void BM_Stages1080p(benchmark::State& state) {
+  const auto color = static_cast<rc::ColorFormat>(state.range(0));
+  const rc::Scene scene = rc::bench::sphere1080p(color);
+  const rc::GlSpec spec = rc::parseGlSpec(g_spec);
+  rc::renderGl(scene, spec);  // warm-up: llvmpipe JITs shader variants at the first draw
+  Stages stages;
+  for (auto _ : state) stages.add(rc::renderGl(scene, spec));
+  stages.report(state);
+  state.SetLabel(stages.renderer + (color == rc::ColorFormat::RGBA8 ? ", rgba8" : ", rgba32f"));
+}
+
+// The harness's own cost per 1080p frame: upload and readback (with conversion) inside
+// the backend, plus writing the frame directory (frame.exr, color.png, frame.json) as
+// `rastercheck render` does into a new DIR (as `rastercheck run` does; deleting the
+// previous iteration's 50 MB frame, 10-20 ms of unlinking, happens outside the timing).
 void BM_HarnessOverhead1080p(benchmark::State& state) {
-  const rc::Scene scene = benchScene(rc::ColorFormat::RGBA32F);
+  const rc::Scene scene = rc::bench::sphere1080p(rc::ColorFormat::RGBA32F);
   const rc::GlSpec spec = rc::parseGlSpec(g_spec);
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("rc_bench_gl_" + std::to_string(::getpid()));
-  double upload = 0, readback = 0, write = 0;
+  rc::renderGl(scene, spec);  // warm-up, as above
+  Stages stages;
+  double write = 0, write_cpu = 0;
   for (auto _ : state) {
     const rc::Frame f = rc::renderGl(scene, spec);
     const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = processCpuMs();
     rc::writeFrameDir(f, dir);
-    write +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    upload += metaMs(f, "upload");
-    readback += metaMs(f, "readback");
+    write += msSince(start);
+    write_cpu += processCpuMs() - cpu_start;
+    stages.add(f);
+    state.PauseTiming();
+    std::filesystem::remove_all(dir);
+    state.ResumeTiming();
   }
   std::filesystem::remove_all(dir);
+  stages.report(state);
   const auto n = static_cast<double>(state.iterations());
-  state.counters["upload_ms"] = upload / n;
-  state.counters["readback_ms"] = readback / n;
   state.counters["write_frame_ms"] = write / n;
-  state.counters["backend_overhead_ms"] = (upload + readback) / n;
-  state.counters["harness_overhead_ms"] = (upload + readback + write) / n;
+  state.counters["backend_overhead_ms"] = (stages.upload + stages.readback) / n;
+  state.counters["harness_overhead_ms"] = (stages.upload + stages.readback + write) / n;
+  state.counters["write_frame_cpu_ms"] = write_cpu / n;
+  state.counters["harness_overhead_cpu_ms"] =
+      (stages.upload_cpu + stages.readback_cpu + write_cpu) / n;
+}
+
+// The reference benchmark's scenes through GL: same names and arguments as in
+// bench_reference, so bench/run.sh can match them.
+void renderScene(benchmark::State& state, const rc::Scene& scene) {
+  const rc::GlSpec spec = rc::parseGlSpec(g_spec);
+  rc::renderGl(scene, spec);  // warm-up, as above
+  Stages stages;
+  for (auto _ : state) stages.add(rc::renderGl(scene, spec));
+  stages.report(state);
+  state.SetLabel(stages.renderer);
+}
+
+void BM_SmallTriangles(benchmark::State& state) {
+  static const rc::Scene scene = rc::bench::smallTriangles();
+  renderScene(state, scene);
+}
+
+void BM_Layers(benchmark::State& state) {
+  static const rc::Scene scenes[3] = {rc::bench::layers(rc::Shading::Flat),
+                                      rc::bench::layers(rc::Shading::Gouraud),
+                                      rc::bench::layers(rc::Shading::Phong)};
+  renderScene(state, scenes[state.range(0)]);
 }
 
 }  // namespace
 
-BENCHMARK(BM_ContextCreate)->Unit(benchmark::kMillisecond)->Iterations(5);
-BENCHMARK(BM_Render1080p)
+BENCHMARK(BM_ContextCreate)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FirstRender1080p)
+    ->Iterations(1)
+    ->Repetitions(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Stages1080p)
+    ->ArgName("rgba8")
     ->Arg(static_cast<int>(rc::ColorFormat::RGBA32F))
     ->Arg(static_cast<int>(rc::ColorFormat::RGBA8))
     ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0);
-BENCHMARK(BM_HarnessOverhead1080p)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+    ->UseRealTime();
+BENCHMARK(BM_HarnessOverhead1080p)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SmallTriangles)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Layers)
+    ->ArgName("shading")
+    ->DenseRange(0, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 int main(int argc, char** argv) {
   if (const char* env = std::getenv("RASTERCHECK_GL_SPEC"); env != nullptr && *env != '\0')
@@ -180,21 +223,28 @@ int main(int argc, char** argv) {
     }
   }
   argc = out;
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   try {
     const rc::GlSpec spec = rc::parseGlSpec(g_spec);
-    // The driver is chosen by the first context of the process (as renderGl does).
+    // The driver is chosen by the first context of the process, as renderGl does.
     if (!spec.driver.empty()) {
       setenv("GALLIUM_DRIVER", spec.driver.c_str(), 1);
       if (spec.platform == rc::GlSpec::Platform::EglSurfaceless)
         setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
     }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s\n", e.what());
+    const auto start = std::chrono::steady_clock::now();
+    const std::string renderer = createContext(spec);
+    benchmark::AddCustomContext("first_context_ms", std::to_string(msSince(start)));
+    benchmark::AddCustomContext("gl_spec", g_spec);
+    benchmark::AddCustomContext("gl_renderer", renderer);
+  } catch (const rc::InputError& e) {
+    std::fprintf(stderr, "bench_gl: %s\n", e.what());
     return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_gl: %s\n", e.what());
+    return 3;
   }
-  benchmark::AddCustomContext("gl_spec", g_spec);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

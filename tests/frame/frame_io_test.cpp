@@ -1,10 +1,17 @@
 // Frame directories: exact round trip of every channel (ids as real uint32, not float),
-// the EXR's channel names and types as DESIGN.md fixes them, and all-or-nothing writes.
+// the EXR's channel names and types as DESIGN.md fixes them, byte-identical files, and
+// all-or-nothing writes (also when a rename fails midway).
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <random>
+#include <string>
 
+#include <Imath/half.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -87,7 +94,7 @@ TEST(FrameIo, ExrHasTheContractChannelsAndTypes) {
     EXPECT_EQ(t, name == "id" ? OIIO::TypeDesc::UINT32 : OIIO::TypeDesc::FLOAT) << name;
   }
   // Top row first: pixel (6, 4) is the bottom-right one and holds the max id.
-  std::vector<std::uint32_t> ids(spec.width * spec.height);
+  std::vector<std::uint32_t> ids(static_cast<std::size_t>(spec.width) * spec.height);
   const int idc = spec.channelindex("id");
   ASSERT_TRUE(in->read_image(0, 0, idc, idc + 1, OIIO::TypeDesc::UINT32, ids.data()));
   EXPECT_EQ(ids[4 * 7 + 6], 0xFFFFFFFFu);
@@ -112,4 +119,208 @@ TEST(FrameIo, ReadingSomethingElseIsAnInputError) {
   fs::create_directories(dir);
   EXPECT_THROW(rc::readFrameDir(dir), rc::InputError);  // no frame.exr
   fs::remove_all(dir);
+}
+
+namespace {
+
+std::string fileBytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Every entry of the directory that holds `dir` whose name starts with "." + dir's name:
+// the temporary siblings writeFrameDir uses.
+std::vector<std::string> tempSiblings(const fs::path& dir) {
+  std::vector<std::string> out;
+  const std::string prefix = "." + dir.filename().string();
+  for (const auto& e : fs::directory_iterator(dir.parent_path())) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind(prefix, 0) == 0) out.push_back(name);
+  }
+  return out;
+}
+
+rc::Frame otherFrame() {
+  rc::Frame f = makeFrame(false);
+  for (float& c : f.color) c = 0.75f;
+  for (std::uint32_t& i : f.id) i = 7;
+  f.meta = {{"backend", "new"}};
+  return f;
+}
+
+}  // namespace
+
+TEST(FrameIo, FilesAreByteIdenticalAndCarryNoTimeStamp) {
+  const fs::path a = tempDir("det_a"), b = tempDir("det_b");
+  rc::writeFrameDir(makeFrame(true), a);
+  rc::writeFrameDir(makeFrame(true), b);
+  for (const char* name : {"frame.exr", "color.png", "frame.json"})
+    EXPECT_EQ(fileBytes(a / name), fileBytes(b / name)) << name;
+  // Writes within one second would agree even with a time stamp: check the header too.
+  auto in = OIIO::ImageInput::open((a / "frame.exr").string());
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().get_string_attribute("DateTime"), "");
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+TEST(FrameIo, EveryLosslessCompressionRoundTrips) {
+  const rc::Frame in = makeFrame(true);
+  const fs::path dir = tempDir("comp");
+  fs::create_directories(dir);
+  for (const char* compression : {"none", "rle", "zips", "zip", "zip:1", "piz"}) {
+    rc::FrameEncoding enc;
+    enc.exr_compression = compression;
+    rc::writeFrameExr(in, dir / "f.exr", enc);
+    const rc::Frame out = rc::readFrameExr(dir / "f.exr");
+    EXPECT_TRUE(std::isnan(out.color[0])) << compression;
+    EXPECT_TRUE(std::equal(in.color.begin() + 1, in.color.end(), out.color.begin() + 1))
+        << compression;
+    EXPECT_EQ(out.depth, in.depth) << compression;
+    EXPECT_EQ(out.id, in.id) << compression;
+    EXPECT_EQ(out.edge_dist, in.edge_dist) << compression;
+    EXPECT_EQ(out.depth_gap, in.depth_gap) << compression;
+  }
+  fs::remove_all(dir);
+}
+
+// A file from another tool (half-float colour, channels in another order) takes the
+// converting path and still reads.
+TEST(FrameIo, ReadsOtherChannelEncodings) {
+  const fs::path dir = tempDir("half");
+  fs::create_directories(dir);
+  const fs::path file = dir / "frame.exr";
+  OIIO::ImageSpec spec(3, 2, 6, OIIO::TypeDesc::HALF);
+  spec.channelnames = {"id", "Z", "A", "B", "G", "R"};
+  spec.channelformats = {OIIO::TypeDesc::UINT32, OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::HALF,
+                         OIIO::TypeDesc::HALF,   OIIO::TypeDesc::HALF,  OIIO::TypeDesc::HALF};
+  // Native pixels: uint32 id, float Z, then four halves (16 bytes).
+  std::vector<unsigned char> native(std::size_t{6} * 16);
+  for (std::uint32_t i = 0; i < 6; ++i) {
+    unsigned char* px = native.data() + std::size_t{i} * 16;
+    const std::uint32_t id = i + 1;
+    const float z = 0.5f;
+    const Imath::half rgba[4] = {Imath::half(1.0f), Imath::half(0.25f), Imath::half(0.125f),
+                                 Imath::half(2.0f)};  // A B G R
+    std::memcpy(px, &id, 4);
+    std::memcpy(px + 4, &z, 4);
+    std::memcpy(px + 8, rgba, 8);
+  }
+  {
+    auto out = OIIO::ImageOutput::create(file.string());
+    ASSERT_TRUE(out && out->open(file.string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UNKNOWN, native.data()));
+    ASSERT_TRUE(out->close());
+  }
+  const rc::Frame f = rc::readFrameExr(file);
+  ASSERT_EQ(f.pixelCount(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(f.id[i], i + 1);
+    EXPECT_EQ(f.depth[i], 0.5f);
+    EXPECT_EQ(f.color[i * 4 + 0], 2.0f);
+    EXPECT_EQ(f.color[i * 4 + 1], 0.125f);
+    EXPECT_EQ(f.color[i * 4 + 2], 0.25f);
+    EXPECT_EQ(f.color[i * 4 + 3], 1.0f);
+  }
+  fs::remove_all(dir);
+}
+
+// color.png: clamp to [0,1] (NaN as 0), scale by 255, round halves away from zero; the
+// oracle is std::lround on the same float product.
+TEST(FrameIo, PngRoundsLikeLround) {
+  rc::Frame f;
+  const float clear[4] = {0.f, 0.f, 0.f, 1.f};
+  f.allocate(256, 64, clear, 1.0f, false);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> any(-0.25f, 1.25f);
+  for (std::size_t i = 0; i < f.pixelCount(); ++i)
+    for (int c = 0; c < 3; ++c) f.color[i * 4 + c] = any(rng);
+  // Exact halves (k + 0.5 after the float multiply), the clamps and NaN.
+  for (std::size_t k = 0; k < 255; ++k) f.color[k * 4] = (static_cast<float>(k) + 0.5f) / 255.0f;
+  f.color[1] = std::numeric_limits<float>::quiet_NaN();
+  f.color[5] = -std::numeric_limits<float>::infinity();
+  f.color[9] = std::numeric_limits<float>::infinity();
+  const fs::path dir = tempDir("png");
+  fs::create_directories(dir);
+  rc::writeColorPng(f, dir / "c.png");
+  auto in = OIIO::ImageInput::open((dir / "c.png").string());
+  ASSERT_TRUE(in);
+  ASSERT_EQ(in->spec().nchannels, 3);
+  std::vector<std::uint8_t> px(f.pixelCount() * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, px.data()));
+  int halves_up = 0;
+  for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      float v = f.color[i * 4 + c];
+      v = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
+      const long want = std::lround(v * 255.0f);
+      ASSERT_EQ(px[i * 3 + c], want)
+          << "pixel " << i << " channel " << c << " value " << f.color[i * 4 + c];
+      if (i < 255 && c == 0 && v * 255.0f == static_cast<float>(i) + 0.5f) ++halves_up;
+    }
+  }
+  EXPECT_GT(halves_up, 100) << "the exact-half cases should mostly survive the float divide";
+  fs::remove_all(dir);
+}
+
+TEST(FrameIo, ReplacesAFrameDirectoryWhole) {
+  const fs::path dir = tempDir("swap");
+  rc::writeFrameDir(makeFrame(true), dir);
+  rc::writeFrameDir(otherFrame(), dir);
+  const rc::Frame out = rc::readFrameDir(dir);
+  EXPECT_EQ(out.meta, otherFrame().meta);
+  EXPECT_EQ(out.id, otherFrame().id);
+  EXPECT_FALSE(out.hasUncertainty());
+  EXPECT_TRUE(tempSiblings(dir).empty());
+  fs::remove_all(dir);
+}
+
+TEST(FrameIo, KeepsTheUsersOtherFiles) {
+  const fs::path dir = tempDir("keep");
+  rc::writeFrameDir(makeFrame(false), dir);
+  std::ofstream(dir / "notes.txt") << "mine\n";
+  rc::writeFrameDir(otherFrame(), dir);
+  EXPECT_EQ(rc::readFrameDir(dir).meta, otherFrame().meta);
+  EXPECT_EQ(fileBytes(dir / "notes.txt"), "mine\n");
+  EXPECT_TRUE(tempSiblings(dir).empty());
+  fs::remove_all(dir);
+}
+
+// Whichever rename fails, DIR keeps the complete old frame (byte for byte) and the
+// user's other files, and no temporary directory is left.
+TEST(FrameIo, FailedReplacementLeavesTheOldFrame) {
+  for (bool with_other_file : {false, true}) {
+    for (int budget = 0; budget < 6; ++budget) {
+      const fs::path dir = tempDir("midway");
+      rc::writeFrameDir(makeFrame(true), dir);
+      if (with_other_file) std::ofstream(dir / "notes.txt") << "mine\n";
+      std::vector<std::string> before;
+      for (const char* name : {"frame.exr", "color.png", "frame.json"})
+        before.push_back(fileBytes(dir / name));
+      rc::testing::frame_dir_renames_before_failure = budget;
+      bool threw = false;
+      try {
+        rc::writeFrameDir(otherFrame(), dir);
+      } catch (const rc::InputError& e) {
+        threw = true;
+        EXPECT_NE(std::string(e.what()).find("injected rename failure"), std::string::npos);
+      }
+      rc::testing::frame_dir_renames_before_failure = -1;
+      const std::string where =
+          (with_other_file ? "per-file, " : "swap, ") + std::to_string(budget) + " renames allowed";
+      EXPECT_TRUE(tempSiblings(dir).empty()) << where;
+      if (!threw) {  // enough renames for the whole replacement
+        EXPECT_EQ(rc::readFrameDir(dir).meta, otherFrame().meta) << where;
+        fs::remove_all(dir);
+        continue;
+      }
+      int i = 0;
+      for (const char* name : {"frame.exr", "color.png", "frame.json"})
+        EXPECT_EQ(fileBytes(dir / name), before[i++]) << where << ": " << name;
+      if (with_other_file) {
+        EXPECT_EQ(fileBytes(dir / "notes.txt"), "mine\n") << where;
+      }
+      fs::remove_all(dir);
+    }
+  }
 }

@@ -172,6 +172,22 @@ const AgreementCase kCases[] = {
        s.state.color_format = ColorFormat::RGBA8;
      }},
     {"d32f", [](Scene& s) { s.state.depth_format = DepthFormat::D32F; }},
+    {"textured_gouraud",
+     [](Scene& s) {
+       s.state.shading = Shading::Gouraud;
+       for (Material& m : s.materials) m.texture = checker(16);
+     }},
+    {"textured_flat_linear_clamp",
+     [](Scene& s) {
+       s.state.shading = Shading::Flat;
+       s.state.texture_filter = TextureFilter::Linear;
+       s.state.texture_wrap = TextureWrap::Clamp;
+       for (Material& m : s.materials) m.texture = checker(8);
+     }},
+    {"cull_back_ccw",
+     [](Scene& s) {
+       s.state.cull = Cull::Back;  // default front face ccw: the sphere's outside, the ground
+     }},
     {"cull_back_cw",
      [](Scene& s) {
        s.state.cull = Cull::Back;

@@ -156,6 +156,42 @@ struct HookGuard {
   ~HookGuard() { gl::testing::hooks() = gl::testing::Hooks{}; }
 };
 
+// Both readback paths (rows inverted by GL_MESA_pack_invert, or swapped afterwards) give
+// the same frame for every colour and depth format, at an odd height (middle row).
+TEST_F(GlBackend, ReadbackWithAndWithoutPackInvertAgree) {
+  for (ColorFormat color : {ColorFormat::RGBA32F, ColorFormat::RGBA8}) {
+    for (DepthFormat depth : {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F}) {
+      Scene s = orthoScene(24, 17);
+      s.state.color_format = color;
+      s.state.depth_format = depth;
+      s.ambient_light = {0.1, 0.2, 0.3};
+      Material m;
+      m.ambient = {1, 0.5, 0.25};
+      s.materials.push_back(m);
+      Object o = quad(-0.9, -0.8, 0.7, 0.9, 0.1, 0);
+      o.mesh.positions[2].z = -0.4f;
+      o.mesh.positions[0].y = -0.2f;  // not symmetric top to bottom
+      s.objects.push_back(o);
+      const Frame a = render(s);
+      Frame b;
+      {
+        HookGuard guard;
+        gl::testing::hooks().ignore_pack_invert = true;
+        b = render(s);
+      }
+      const std::string what = std::string(toString(color)) + "/" + toString(depth);
+      EXPECT_EQ(a.color, b.color) << what;
+      EXPECT_EQ(a.depth, b.depth) << what;
+      EXPECT_EQ(a.id, b.id) << what;
+      bool symmetric = true;
+      for (int y = 0; y < 17; ++y)
+        for (int x = 0; x < 24; ++x)
+          symmetric = symmetric && a.id[a.index(x, y)] == a.id[a.index(x, 16 - y)];
+      EXPECT_FALSE(symmetric) << "a flipped frame must look different";
+    }
+  }
+}
+
 TEST_F(GlBackend, ShaderCompileErrorSurfacesTheLog) {
   HookGuard guard;
   gl::testing::hooks().fragment_shader =

@@ -1,0 +1,89 @@
+// Parsing and printing the test-only fault list of RASTERCHECK_GL_FAULT: see gl_testing.h.
+#include <charconv>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "fixtures/errors.h"
+#include "gl_backend/gl_testing.h"
+
+namespace rc::gl::testing {
+namespace {
+
+constexpr const char* kValidFaults =
+    "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
+    "shader_compile_error";
+
+[[noreturn]] void badFault(std::string_view entry, std::string_view why) {
+  throw InputError(
+      fmt::format("{}: '{}': {} (valid: {})", kFaultVariable, entry, why, kValidFaults));
+}
+
+template <typename T>
+T number(std::string_view entry, std::string_view value) {
+  T out{};
+  const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), out);
+  if (value.empty() || ec != std::errc() || end != value.data() + value.size())
+    badFault(entry, "not a number");
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!std::isfinite(out)) badFault(entry, "not a finite number");
+  }
+  return out;
+}
+
+}  // namespace
+
+bool Faults::any() const {
+  return drop_primitive != 0 || depth_bias_steps != 0 || light_scale != 1.0 ||
+         no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error;
+}
+
+std::string Faults::describe() const {
+  std::vector<std::string> parts;
+  if (drop_primitive != 0) parts.push_back(fmt::format("drop_primitive={}", drop_primitive));
+  if (depth_bias_steps != 0) parts.push_back(fmt::format("depth_bias={}", depth_bias_steps));
+  if (light_scale != 1.0) parts.push_back(fmt::format("light_scale={}", light_scale));
+  if (no_inverse_transpose) parts.emplace_back("no_inverse_transpose");
+  if (shift_x_px != 0.0) parts.push_back(fmt::format("shift_x={}", shift_x_px));
+  if (shader_compile_error) parts.emplace_back("shader_compile_error");
+  return fmt::format("{}", fmt::join(parts, ","));
+}
+
+Faults parseFaults(std::string_view text) {
+  Faults f;
+  while (!text.empty()) {
+    const std::size_t comma = text.find(',');
+    const std::string_view entry = text.substr(0, comma);
+    text = comma == std::string_view::npos ? std::string_view{} : text.substr(comma + 1);
+    if (entry.empty()) continue;
+    const std::size_t eq = entry.find('=');
+    const std::string_view name = entry.substr(0, eq);
+    const bool has_value = eq != std::string_view::npos;
+    const std::string_view value = has_value ? entry.substr(eq + 1) : std::string_view{};
+    const bool flag = name == "no_inverse_transpose" || name == "shader_compile_error";
+    const bool valued = name == "drop_primitive" || name == "depth_bias" || name == "light_scale" ||
+                        name == "shift_x";
+    if (!flag && !valued) badFault(entry, "unknown fault");
+    if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
+    if (name == "drop_primitive") {
+      f.drop_primitive = number<std::uint32_t>(entry, value);
+      if (f.drop_primitive == 0) badFault(entry, "primitive ids start at 1");
+    } else if (name == "depth_bias") {
+      f.depth_bias_steps = number<int>(entry, value);
+    } else if (name == "light_scale") {
+      f.light_scale = number<double>(entry, value);
+    } else if (name == "shift_x") {
+      f.shift_x_px = number<double>(entry, value);
+    } else if (name == "no_inverse_transpose") {
+      f.no_inverse_transpose = true;
+    } else {
+      f.shader_compile_error = true;
+    }
+  }
+  return f;
+}
+
+}  // namespace rc::gl::testing
