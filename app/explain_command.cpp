@@ -214,6 +214,29 @@ std::string passKind(const Scene& scene, const DrawPass& pass, bool force_painte
 
 // ---- the backends -------------------------------------------------------------------
 
+// Stable names for the JSON (toString(PixelClass) is for people).
+const char* classKey(PixelClass c) {
+  switch (c) {
+    case PixelClass::Background:
+      return "background";
+    case PixelClass::Match:
+      return "match";
+    case PixelClass::MissingAmbiguous:
+      return "missing_ambiguous";
+    case PixelClass::MissingHard:
+      return "missing_hard";
+    case PixelClass::ExtraAmbiguous:
+      return "extra_ambiguous";
+    case PixelClass::ExtraHard:
+      return "extra_hard";
+    case PixelClass::WrongAmbiguous:
+      return "wrong_primitive_ambiguous";
+    case PixelClass::WrongHard:
+      return "wrong_primitive_hard";
+  }
+  return "?";
+}
+
 Json backendJson(const BackendSpec& spec, const Frame& reference, const Frame& frame,
                  const Scene& scene, const ToleranceOverrides& cli, std::size_t i) {
   Json j = {{"backend", spec.text}};
@@ -230,7 +253,7 @@ Json backendJson(const BackendSpec& spec, const Frame& reference, const Frame& f
   const PairResult r = compareFrames(reference, frame, reference, tol, &maps);
   const PixelClass cls = maps.pixel_class[i];
   Json c = {
-      {"visibility", toString(cls)},
+      {"visibility", classKey(cls)},
       {"ambiguous", cls == PixelClass::MissingAmbiguous || cls == PixelClass::ExtraAmbiguous ||
                         cls == PixelClass::WrongAmbiguous},
       {"band_px", num(r.visibility.band_px)}};
@@ -501,8 +524,9 @@ int explainCommand(const ExplainArgs& args) {
           {"against_source", depth_source},
           {"write", depth_write}}}};
     j["shading"] = shadingJson(ctx, f);
-    // As frame.exr holds it (the colour buffer is float; rgba8 values are q / 255).
-    const glm::dvec4 after = glm::dvec4(glm::vec4(f.color_written));
+    // The buffer as the reference reads it back to blend (rgba8: exactly q / 255) and, in
+    // color_after, as frame.exr holds it (a float per channel).
+    const glm::dvec4 after = f.color_written;
     if (f.depth_pass && pass.blend) {
       const glm::dvec4 src = f.shading.color;
       j["blend"] = {
@@ -514,7 +538,7 @@ int explainCommand(const ExplainArgs& args) {
       j["blend"] = nullptr;
     }
     j["written"] = f.depth_pass;
-    j["color_after"] = vec(after);
+    j["color_after"] = vec(glm::dvec4(glm::vec4(after)));
     if (f.depth_pass) {
       buffer = after;
       final_fragment = k + 1;
