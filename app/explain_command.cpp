@@ -402,8 +402,12 @@ std::string story(const Json& doc) {
   s += fin["fragment"].is_null()
            ? " (the clear values)\n"
            : fmt::format(" (written by fragment {})\n", fmtNum(fin["fragment"]));
+  const double edge = doc["edge_dist"].is_number() ? doc["edge_dist"].get<double>() : 1.0;
   s += fmt::format("uncertainty: edge_dist {} px{}, depth_gap {}\n", fmtNum(doc["edge_dist"]),
-                   doc["edge_dist"].get<double>() >= 1.0 ? " (capped: no edge within a pixel)" : "",
+                   edge >= 1.0   ? " (capped: no edge within a pixel)"
+                   : edge == 0.0 ? " (the centre lies on an edge: the tie-break rule decides)"
+                   : edge < 0.1  ? " (an edge passes close: snapping may move it across)"
+                                 : "",
                    doc["depth_gap"].is_null() ? std::string("none (fewer than two fragments)")
                                               : fmtNum(doc["depth_gap"]) + " steps");
   if (!doc["backends"].empty()) s += "backends:\n";

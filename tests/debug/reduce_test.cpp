@@ -27,7 +27,7 @@ Scene reduceAndCheck(const std::string& fixture, const std::string& expected,
   EXPECT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.err.find("reduce ["), std::string::npos) << "no progress shown: " << r.err;
   EXPECT_NE(r.out.find("still fails: FAIL"), std::string::npos) << r.out;
-  const Scene min = loadScene(out);
+  Scene min = loadScene(out);
   EXPECT_LE(triangleCount(min), max_triangles);
   EXPECT_GE(triangleCount(min), 1u);
   EXPECT_NE(min.description.find("Reduced by rastercheck reduce from " + fixture),
