@@ -58,7 +58,11 @@ std::string childFailure(const Job& job) {
 Frame renderInChild(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {
   std::vector<Job> jobs{renderJob(scene_file, spec, out_dir)};
   runJobs(jobs, 1, [](std::size_t) {});
-  if (jobs[0].exit_code != 0) throw BackendError(spec + ": " + childFailure(jobs[0]));
+  if (jobs[0].exit_code != 0) {
+    const std::string why = childFailure(jobs[0]);
+    // The child's own message usually names the spec already.
+    throw BackendError(why.find(spec) != std::string::npos ? why : spec + ": " + why);
+  }
   return readFrameDir(out_dir);
 }
 
