@@ -164,21 +164,60 @@ EdgeSide sideOf(int nx, int ny) {
 
 }  // namespace
 
+namespace {
+
+int cross2(glm::ivec2 a, glm::ivec2 b, glm::ivec2 c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+// Adds one triangle (vertices = pixel indices; their centres are the window positions) and
+// the centres strictly inside its edges: lattice points P + k * (d / g), 0 < k < g.
+std::uint32_t addCentredTriangle(TieBreakProbe& probe, const std::string& name,
+                                 const glm::ivec2 (&v)[3]) {
+  const bool ccw = cross2(v[0], v[1], v[2]) > 0;
+  const auto id = static_cast<std::uint32_t>(probe.scene.objects.size()) + 1;
+  std::vector<glm::vec3> positions;
+  for (const glm::ivec2& p : v)
+    positions.emplace_back(static_cast<float>(p.x) + 0.5f, static_cast<float>(p.y) + 0.5f, -2.0f);
+  addObject(probe.scene, name, positions, {{0, 1, 2}});
+  for (int e = 0; e < 3; ++e) {
+    const glm::ivec2 p = v[e];
+    const glm::ivec2 d = v[(e + 1) % 3] - p;
+    const int g = std::gcd(std::abs(d.x), std::abs(d.y));
+    // The interior is to the left of the edge direction when counter-clockwise.
+    const int nx = ccw ? -d.y : d.y;
+    const int ny = ccw ? d.x : -d.x;
+    for (int k = 1; k < g; ++k) {
+      const glm::ivec2 c = p + k * (d / g);
+      probe.centres.push_back({c.x, probe.scene.height - 1 - c.y, id, sideOf(nx, ny)});
+    }
+  }
+  return id;
+}
+
+}  // namespace
+
 TieBreakProbe tieBreakProbe() {
-  constexpr int kSize = 32;
   constexpr int kCell = 8;
   TieBreakProbe probe;
   probe.scene = probeScene("tie_break",
-                           "Variant probe: right triangles with every vertex on a pixel centre, "
-                           "edges through centres in every orientation and winding",
-                           kSize, kSize);
+                           "Variant probe: triangles with every vertex on a pixel centre, edges "
+                           "through centres in every orientation and winding, alone and shared",
+                           8 * kCell, 4 * kCell);
+  int cell = 0;
+  auto origin = [&] {
+    const glm::ivec2 o((cell % 8) * kCell + 1, (cell / 8) * kCell + 1);
+    ++cell;
+    return o;
+  };
+  // Isolated right triangles: four corner orientations x both windings x two sizes.
   enum Corner { BL, BR, TL, TR };
-  int index = 0;
   for (int leg : {5, 6}) {
     for (Corner corner : {BL, BR, TL, TR}) {
       for (bool ccw : {true, false}) {
-        const int x = (index % 4) * kCell + 1;
-        const int y = (index / 4) * kCell + 1;
+        const glm::ivec2 o = origin();
+        const int x = o.x;
+        const int y = o.y;
         // The right angle's pixel first, then its two neighbours along the legs.
         glm::ivec2 v[3];
         switch (corner) {
@@ -195,31 +234,54 @@ TieBreakProbe tieBreakProbe() {
             v[0] = {x + leg, y + leg}, v[1] = {x, y + leg}, v[2] = {x + leg, y};
             break;
         }
-        const auto cross = [](glm::ivec2 a, glm::ivec2 b, glm::ivec2 c) {
-          return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-        };
-        if ((cross(v[0], v[1], v[2]) > 0) != ccw) std::swap(v[1], v[2]);
-        const std::uint32_t id = static_cast<std::uint32_t>(probe.scene.objects.size()) + 1;
-        std::vector<glm::vec3> positions;
-        for (const glm::ivec2& p : v)
-          positions.emplace_back(static_cast<float>(p.x) + 0.5f, static_cast<float>(p.y) + 0.5f,
-                                 -2.0f);
-        addObject(probe.scene, fmt::format("{}{}_{}", "ABCD"[corner], leg, ccw ? "ccw" : "cw"),
-                  positions, {{0, 1, 2}});
-        // Centres strictly inside each edge: lattice points P + k * (d / g), 0 < k < g.
-        for (int e = 0; e < 3; ++e) {
-          const glm::ivec2 p = v[e];
-          const glm::ivec2 d = v[(e + 1) % 3] - p;
-          const int g = std::gcd(std::abs(d.x), std::abs(d.y));
-          // The interior is to the left of the edge direction when counter-clockwise.
-          const int nx = ccw ? -d.y : d.y;
-          const int ny = ccw ? d.x : -d.x;
-          for (int k = 1; k < g; ++k) {
-            const glm::ivec2 c = p + k * (d / g);
-            probe.centres.push_back({c.x, kSize - 1 - c.y, id, sideOf(nx, ny)});
-          }
-        }
-        ++index;
+        if ((cross2(v[0], v[1], v[2]) > 0) != ccw) std::swap(v[1], v[2]);
+        addCentredTriangle(probe, fmt::format("{}{}_{}", "ABCD"[corner], leg, ccw ? "ccw" : "cw"),
+                           v);
+      }
+    }
+  }
+  // Pairs sharing an edge through centres (diagonal both ways, vertical, horizontal), in
+  // both windings: each centre on the shared edge must go to exactly one of the two.
+  for (bool ccw : {true, false}) {
+    for (int shape = 0; shape < 4; ++shape) {
+      const glm::ivec2 o = origin();
+      glm::ivec2 a[3];
+      glm::ivec2 b[3];
+      glm::ivec2 s0;
+      glm::ivec2 s1;
+      switch (shape) {
+        case 0:  // square split along "/"
+          s0 = o, s1 = o + glm::ivec2(5, 5);
+          a[0] = s0, a[1] = o + glm::ivec2(5, 0), a[2] = s1;
+          b[0] = s0, b[1] = s1, b[2] = o + glm::ivec2(0, 5);
+          break;
+        case 1:  // square split along "\"
+          s0 = o + glm::ivec2(5, 0), s1 = o + glm::ivec2(0, 5);
+          a[0] = o, a[1] = s0, a[2] = s1;
+          b[0] = s0, b[1] = o + glm::ivec2(5, 5), b[2] = s1;
+          break;
+        case 2:  // a vertical shared edge
+          s0 = o + glm::ivec2(3, 0), s1 = o + glm::ivec2(3, 6);
+          a[0] = s0, a[1] = s1, a[2] = o + glm::ivec2(0, 3);
+          b[0] = s0, b[1] = o + glm::ivec2(6, 3), b[2] = s1;
+          break;
+        default:  // a horizontal shared edge
+          s0 = o + glm::ivec2(0, 3), s1 = o + glm::ivec2(6, 3);
+          a[0] = s0, a[1] = s1, a[2] = o + glm::ivec2(3, 6);
+          b[0] = s0, b[1] = o + glm::ivec2(3, 0), b[2] = s1;
+          break;
+      }
+      for (glm::ivec2* t : {a, b})
+        if ((cross2(t[0], t[1], t[2]) > 0) != ccw) std::swap(t[1], t[2]);
+      const std::uint32_t ia =
+          addCentredTriangle(probe, fmt::format("pair{}a_{}", shape, ccw ? "ccw" : "cw"), a);
+      const std::uint32_t ib =
+          addCentredTriangle(probe, fmt::format("pair{}b_{}", shape, ccw ? "ccw" : "cw"), b);
+      const glm::ivec2 d = s1 - s0;
+      const int g = std::gcd(std::abs(d.x), std::abs(d.y));
+      for (int k = 1; k < g; ++k) {
+        const glm::ivec2 c = s0 + k * (d / g);
+        probe.shared.push_back({c.x, probe.scene.height - 1 - c.y, ia, ib});
       }
     }
   }
@@ -235,6 +297,11 @@ TieBreakResult analyseTieBreak(const TieBreakProbe& probe, const Frame& driver) 
     s.included += included ? 1 : 0;
     ++s.total;
     if (included != referenceIncludes(c.side)) ++r.disagreements;
+  }
+  for (const SharedCentre& c : probe.shared) {
+    const std::uint32_t id = driver.id[driver.index(c.x, c.y)];
+    ++r.shared_centres;
+    if (id != c.a && id != c.b) ++r.shared_gaps;
   }
   std::vector<std::string> included;
   std::vector<std::string> mixed;
@@ -395,6 +462,7 @@ nlohmann::json toJson(const TieBreakResult& r) {
           {"consistent", r.consistent},
           {"disagreements", r.disagreements},
           {"sides", sides},
+          {"shared_edges", {{"centres", r.shared_centres}, {"gaps", r.shared_gaps}}},
           {"summary", describeTieBreak(r)}};
 }
 
@@ -444,6 +512,10 @@ std::string describeTieBreak(const TieBreakResult& r) {
   if (r.sides.empty()) return "not probed";
   std::string s = fmt::format("a centre exactly on an edge is covered on {} edges{}", r.rule,
                               r.consistent ? "" : " (inconsistently)");
+  s += r.shared_gaps == 0
+           ? fmt::format(", shared edges covered once ({} centres)", r.shared_centres)
+           : fmt::format(", {} of {} centres on shared edges left uncovered", r.shared_gaps,
+                         r.shared_centres);
   return s + (r.matches_reference
                   ? ": the reference's rule"
                   : fmt::format(": differs from the reference's left+bottom rule at {} of the "

@@ -71,14 +71,25 @@ struct EdgeCentre {
   EdgeSide side = EdgeSide::Left;
 };
 
-struct TieBreakProbe {
-  Scene scene;
-  std::vector<EdgeCentre> centres;  // from the geometry, exactly (integer arithmetic)
+// A pixel centre on an edge shared by two probe triangles (a and b): a rule that covers
+// shared edges exactly once gives it to one of them, never to neither.
+struct SharedCentre {
+  int x = 0;  // image coordinates
+  int y = 0;
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
 };
 
-// 16 isolated right triangles with every vertex on a pixel centre: the four corner
-// orientations x both windings x two sizes, so that vertical, horizontal and 45-degree
-// edges with every inward normal pass exactly through pixel centres.
+struct TieBreakProbe {
+  Scene scene;
+  std::vector<EdgeCentre> centres;   // from the geometry, exactly (integer arithmetic)
+  std::vector<SharedCentre> shared;  // the subset on shared edges, by pair
+};
+
+// Triangles with every vertex on a pixel centre, so that vertical, horizontal and
+// 45-degree edges with every inward normal pass exactly through pixel centres: 16 isolated
+// right triangles (four corner orientations x both windings x two sizes) and 8 pairs that
+// share an edge (diagonal both ways, vertical, horizontal; both windings). 64x32 px.
 TieBreakProbe tieBreakProbe();
 
 struct TieBreakResult {
@@ -88,6 +99,8 @@ struct TieBreakResult {
   };
   std::map<EdgeSide, Side> sides;
   int disagreements = 0;   // centres where the driver differs from referenceIncludes()
+  int shared_centres = 0;  // centres on shared edges
+  int shared_gaps = 0;     // of those, covered by neither triangle of the pair
   bool consistent = true;  // every side is all-included or all-excluded
   std::string rule;        // e.g. "left+bottom", from the four axis-aligned sides
   bool matches_reference = false;

@@ -154,6 +154,7 @@ void checkVariants(const json& report) {
   EXPECT_GT(llvm["subpixel"]["mismatches"]["7"].get<int>(), 0);
   EXPECT_GT(llvm["subpixel"]["mismatches"]["9"].get<int>(), 0);
   EXPECT_EQ(llvm["tie_break"]["rule"], "left+bottom");
+  EXPECT_EQ(llvm["tie_break"]["shared_edges"]["gaps"], 0);
   EXPECT_TRUE(llvm["tie_break"]["matches_reference"].get<bool>());
   EXPECT_EQ(llvm["depth_rounding"]["rule"], "nearest");
   EXPECT_TRUE(llvm["depth_rounding"]["matches_reference"].get<bool>());
@@ -168,6 +169,7 @@ void checkVariants(const json& report) {
   EXPECT_GT(soft["subpixel"]["mismatches"]["4"].get<int>(), 100);
   EXPECT_GE(soft["subpixel"]["best"].get<int>(), 11);
   EXPECT_EQ(soft["tie_break"]["rule"], "right+bottom");
+  EXPECT_EQ(soft["tie_break"]["shared_edges"]["gaps"], 0);
   EXPECT_FALSE(soft["tie_break"]["matches_reference"].get<bool>());
   EXPECT_EQ(soft["depth_rounding"]["rule"], "truncate");
   EXPECT_FALSE(soft["depth_rounding"]["matches_reference"].get<bool>());

@@ -121,6 +121,9 @@ TEST(Variants, ReferenceFollowsItsOwnTieBreakRule) {
   EXPECT_TRUE(r.consistent);
   EXPECT_EQ(r.disagreements, 0);
   EXPECT_EQ(r.sides.size(), static_cast<std::size_t>(kEdgeSideCount));  // every orientation
+  EXPECT_GE(probe.shared.size(), 30u);
+  EXPECT_EQ(r.shared_centres, static_cast<int>(probe.shared.size()));
+  EXPECT_EQ(r.shared_gaps, 0);
   for (const auto& [side, s] : r.sides) {
     EXPECT_GT(s.total, 0) << toString(side);
     EXPECT_EQ(s.included, referenceIncludes(side) ? s.total : 0) << toString(side);
@@ -133,14 +136,22 @@ TEST(Variants, TieBreakTellsARightEdgeRuleApart) {
   const TieBreakProbe probe = tieBreakProbe();
   Frame f = renderAt(probe.scene, 8);
   int moved = 0;
+  auto isLeft = [](EdgeSide s) {
+    return s == EdgeSide::Left || s == EdgeSide::BottomLeft || s == EdgeSide::TopLeft;
+  };
+  auto isRight = [](EdgeSide s) {
+    return s == EdgeSide::Right || s == EdgeSide::BottomRight || s == EdgeSide::TopRight;
+  };
+  // Take first, then give: on a shared edge the right-edge triangle must end up with it.
   for (const EdgeCentre& c : probe.centres) {
-    std::uint32_t& id = f.id[f.index(c.x, c.y)];
-    if (c.side == EdgeSide::Left || c.side == EdgeSide::BottomLeft || c.side == EdgeSide::TopLeft) {
-      id = 0;
+    if (isLeft(c.side)) {
+      f.id[f.index(c.x, c.y)] = 0;
       ++moved;
-    } else if (c.side == EdgeSide::Right || c.side == EdgeSide::BottomRight ||
-               c.side == EdgeSide::TopRight) {
-      id = c.primitive;
+    }
+  }
+  for (const EdgeCentre& c : probe.centres) {
+    if (isRight(c.side)) {
+      f.id[f.index(c.x, c.y)] = c.primitive;
       ++moved;
     }
   }
@@ -149,6 +160,14 @@ TEST(Variants, TieBreakTellsARightEdgeRuleApart) {
   EXPECT_FALSE(r.matches_reference);
   EXPECT_EQ(r.disagreements, moved);
   EXPECT_TRUE(r.consistent);
+  EXPECT_EQ(r.shared_gaps, 0);  // still one owner per shared centre
+  // A rule that covers neither side of a shared edge leaves gaps.
+  Frame gaps = renderAt(probe.scene, 8);
+  for (const SharedCentre& c : probe.shared) gaps.id[gaps.index(c.x, c.y)] = 0;
+  const TieBreakResult holes = analyseTieBreak(probe, gaps);
+  EXPECT_EQ(holes.shared_gaps, static_cast<int>(probe.shared.size()));
+  EXPECT_NE(describeTieBreak(holes).find("left uncovered"), std::string::npos)
+      << describeTieBreak(holes);
   // Half of the left centres only: inconsistent.
   Frame g = renderAt(probe.scene, 8);
   bool flip = false;
