@@ -98,8 +98,7 @@ int runCli(int argc, char** argv) {
   reduce_cmd
       ->add_option("--timeout", reduce.timeout_seconds,
                    "Stop after this many seconds and write the smallest failing scene so far")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->capture_default_str();
   reduce_cmd->add_option("--tolerance,-t", reduce.tolerance, "As for compare; repeatable");
 
   try {
