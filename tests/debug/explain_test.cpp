@@ -82,7 +82,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{catalog("shading/sphere_phong_low.json")},
                       Case{catalog("lighting/coloured_lights.json")},
                       Case{catalog("lighting/attenuation_inverse_square.json")},
-                      Case{catalog("texture/checker_plane_grazing.json")},
+                      Case{testData("textured_gouraud_rgba8.json")},
                       Case{catalog("transparency/alpha_quads.json")},
                       Case{testData("textured_blend_phong.json")},
                       Case{catalog("visibility/painter_three_quads.json")},
