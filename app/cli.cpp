@@ -63,6 +63,43 @@ int runCli(int argc, char** argv) {
   run_cmd->add_option("--out,-o", run.out, "Report folder")->required();
   run_cmd->add_option("--tolerance,-t", run.tolerance, "As for compare; repeatable");
   run_cmd->add_option("--jobs,-j", run.jobs, "Renders at a time (default: one per core)");
+  run_cmd->add_flag("!--no-variants", run.variants,
+                    "Skip the variant probes (subpixel precision, tie-break, depth rounding) "
+                    "of each GL backend");
+
+  ExplainArgs explain;
+  CLI::App* explain_cmd = app.add_subcommand(
+      "explain", "Tell the reference's history of one pixel and what each backend has there");
+  explain_cmd->add_option("scene", explain.scene, "Fixture file (JSON)")->required();
+  explain_cmd->add_option("--pixel,-p", explain.pixel, "X,Y in image coordinates (origin top-left)")
+      ->required();
+  explain_cmd->add_option("--backends,-b", explain.backends, "Backend SPECs to compare there")
+      ->delimiter(',');
+  explain_cmd
+      ->add_option("--reference", explain.reference,
+                   "Reference SPEC whose history is told (ref, ref:painter, ref:subpixel=N)")
+      ->capture_default_str();
+  explain_cmd->add_option("--tolerance,-t", explain.tolerance, "As for compare; repeatable");
+  explain_cmd->add_flag("--json", explain.json, "Print JSON (documented in docs/explain.md)");
+
+  ReduceArgs reduce;
+  CLI::App* reduce_cmd = app.add_subcommand(
+      "reduce", "Delta-debug a failing fixture down to a minimal one that still fails");
+  reduce_cmd->add_option("scene", reduce.scene, "Fixture file (JSON)")->required();
+  reduce_cmd->add_option("--expected", reduce.expected, "Expected backend SPEC")->required();
+  reduce_cmd->add_option("--actual", reduce.actual, "Actual backend SPEC")->required();
+  reduce_cmd->add_option("--out,-o", reduce.out, "Where to write the minimal fixture (JSON)")
+      ->required();
+  reduce_cmd
+      ->add_option("--class", reduce.failure_class,
+                   "Class that must keep failing (default: the one that fails first of "
+                   "visibility, depth, shading)")
+      ->check(CLI::IsMember({"visibility", "depth", "shading"}));
+  reduce_cmd
+      ->add_option("--timeout", reduce.timeout_seconds,
+                   "Stop after this many seconds and write the smallest failing scene so far")
+      ->capture_default_str();
+  reduce_cmd->add_option("--tolerance,-t", reduce.tolerance, "As for compare; repeatable");
 
   AccuracyArgs accuracy;
   CLI::App* accuracy_cmd = app.add_subcommand(
@@ -89,6 +126,8 @@ int runCli(int argc, char** argv) {
     if (*compare_cmd) return compareCommand(compare);
     if (*run_cmd) return runCommand(run);
     if (*accuracy_cmd) return accuracyCommand(accuracy);
+    if (*explain_cmd) return explainCommand(explain);
+    if (*reduce_cmd) return reduceCommand(reduce);
   } catch (const InputError& e) {
     std::cerr << "rastercheck: error: " << e.what() << '\n';
     return kExitInput;

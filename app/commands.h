@@ -46,7 +46,8 @@ struct RunArgs {
   std::string against = "ref";
   std::filesystem::path out;
   std::vector<std::string> tolerance;
-  int jobs = 0;  // 0: one per core
+  int jobs = 0;          // 0: one per core
+  bool variants = true;  // probe each GL backend's variants (app/variants.h)
 };
 int runCommand(const RunArgs& args);
 
@@ -58,5 +59,26 @@ struct AccuracyArgs {
   std::string command;                          // how the document says it was made
 };
 int accuracyCommand(const AccuracyArgs& args);
+
+struct ExplainArgs {
+  std::filesystem::path scene;
+  std::string pixel;                  // "X,Y" in image coordinates (origin top-left)
+  std::vector<std::string> backends;  // compared with the reference at that pixel
+  std::string reference = "ref";      // the reference SPEC whose pixel history is told
+  std::vector<std::string> tolerance;
+  bool json = false;
+};
+int explainCommand(const ExplainArgs& args);
+
+struct ReduceArgs {
+  std::filesystem::path scene;
+  std::string expected;
+  std::string actual;
+  std::filesystem::path out;
+  std::string failure_class;  // visibility|depth|shading; empty: the first that fails
+  double timeout_seconds = 300.0;
+  std::vector<std::string> tolerance;
+};
+int reduceCommand(const ReduceArgs& args);
 
 }  // namespace rc

@@ -19,6 +19,7 @@
 #include "app/paths.h"
 #include "app/report_support.h"
 #include "app/subprocess.h"
+#include "app/variants.h"
 #include "app/version.h"
 #include "compare/report.h"
 #include "fixtures/catalog.h"
@@ -144,6 +145,9 @@ int runCommand(const RunArgs& args) {
   Report report;
   report.tool_version = kVersion;
   report.command = "run";
+  // Which legal variant each GL backend follows, probed once per backend for the run.
+  if (args.variants)
+    report.variants = detectVariants(render_specs, args.out / "variants", parallel);
   for (std::size_t f = 0; f < fixtures.size(); ++f) {
     const Job& against_job = jobs[job_of[{f, against.text}]];
     const Job& ref_job = jobs[job_of[{f, std::string("ref")}]];

@@ -122,6 +122,7 @@ img.broken{outline:3px solid #c62828}
 .numbers table td:first-child{color:#555}
 #matrix td a{color:inherit;text-decoration:none}
 #matrix td.cellstatus{text-align:center}
+#variants td{white-space:normal;max-width:420px;vertical-align:top}
 .hidden{display:none}
 )CSS";
 
@@ -348,22 +349,36 @@ std::string pairSection(const PairResult& r, std::size_t k, const fs::path& repo
 }
 
 std::string matrix(const Report& report) {
+  // One column per backend compared; labelled "actual vs expected" when the pairs do not
+  // all share one expected side (driver-vs-driver runs next to reference runs).
+  bool one_expected = true;
+  for (const PairResult& r : report.results)
+    one_expected = one_expected && r.expected == report.results.front().expected;
+  auto column = [&](const PairResult& r) {
+    return one_expected ? r.actual : r.actual + " vs " + r.expected;
+  };
   std::vector<std::string> backends;
   std::vector<std::string> fixtures;
   std::map<std::pair<std::string, std::string>, std::pair<Status, std::size_t>> cells;
   for (std::size_t k = 0; k < report.results.size(); ++k) {
     const PairResult& r = report.results[k];
-    if (std::find(backends.begin(), backends.end(), r.actual) == backends.end())
-      backends.push_back(r.actual);
+    if (std::find(backends.begin(), backends.end(), column(r)) == backends.end())
+      backends.push_back(column(r));
     if (std::find(fixtures.begin(), fixtures.end(), r.fixture) == fixtures.end())
       fixtures.push_back(r.fixture);
-    auto key = std::make_pair(r.fixture, r.actual);
+    auto key = std::make_pair(r.fixture, column(r));
     auto it = cells.find(key);
     if (it == cells.end() || static_cast<int>(r.status) > static_cast<int>(it->second.first))
       cells[key] = {r.status, k};
   }
-  if (backends.size() < 2) return "";
-  std::string out = "<h2>Fixture &times; backend</h2><table id=\"matrix\"><tr><th>fixture</th>";
+  // A run renders at least two backends (the compared one and --against), so it always
+  // gets the matrix; a single `compare` does not.
+  if (backends.empty() || (backends.size() < 2 && report.command != "run")) return "";
+  std::string out = "<h2>Fixture &times; backend</h2>";
+  if (one_expected)
+    out += fmt::format("<div class=\"meta\">every backend compared against {}</div>",
+                       esc(report.results.front().expected));
+  out += "<table id=\"matrix\"><tr><th>fixture</th>";
   for (const std::string& b : backends) out += fmt::format("<th>{}</th>", esc(b));
   out += "</tr>";
   for (const std::string& f : fixtures) {
@@ -378,6 +393,48 @@ std::string matrix(const Report& report) {
                          it->second.second, badge(it->second.first));
     }
     out += "</tr>";
+  }
+  return out + "</table>";
+}
+
+// The legal variants each GL backend follows (report.variants, see docs/debugging.md).
+std::string variantsTable(const Report& report) {
+  if (!report.variants.is_object() || report.variants.empty()) return "";
+  auto text = [](const nlohmann::json& v, const char* key) -> std::string {
+    if (!v.contains(key)) return "";
+    const nlohmann::json& x = v[key];
+    if (x.is_object() && x.contains("summary") && x["summary"].is_string())
+      return x["summary"].get<std::string>();
+    return x.is_string() ? x.get<std::string>() : x.dump();
+  };
+  // A legal variant is not a failure: the marks say "same as the reference" or not.
+  auto mark = [](const nlohmann::json& v, const char* key, const char* flag, const char* yes,
+                 const char* no) {
+    const bool ok = v.contains(key) && v[key].is_object() && v[key].value(flag, false);
+    return fmt::format("<span class=\"badge {}\">{}</span>", ok ? "pass" : "warn", ok ? yes : no);
+  };
+  std::string out =
+      "<h2>Backend variants</h2><table id=\"variants\"><tr><th>backend</th><th>renderer</th>"
+      "<th>GL_SUBPIXEL_BITS</th><th>subpixel precision</th><th>tie-break</th>"
+      "<th>depth rounding</th></tr>";
+  for (const auto& [spec, v] : report.variants.items()) {
+    out += fmt::format("<tr><td>{}</td>", esc(spec));
+    if (v.contains("error")) {
+      out += fmt::format("<td colspan=\"5\">{} {}</td></tr>", badge(Status::Error),
+                         esc(text(v, "error")));
+      continue;
+    }
+    out += fmt::format("<td>{}</td><td class=\"n\">{}</td>", esc(text(v, "renderer")),
+                       esc(text(v, "subpixel_bits")));
+    out += fmt::format("<td>{} {}</td>",
+                       mark(v, "subpixel", "confirmed", "confirmed", "not confirmed"),
+                       esc(text(v, "subpixel")));
+    out += fmt::format("<td>{} {}</td>",
+                       mark(v, "tie_break", "matches_reference", "as ref", "differs"),
+                       esc(text(v, "tie_break")));
+    out += fmt::format("<td>{} {}</td></tr>",
+                       mark(v, "depth_rounding", "matches_reference", "as ref", "differs"),
+                       esc(text(v, "depth_rounding")));
   }
   return out + "</table>";
 }
@@ -404,6 +461,7 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       "<div>exit code<b>{}</b></div></div>",
       sum.total(), sum.pass, sum.warn, sum.fail, sum.error, exitCodeFor(report));
   out += matrix(report);
+  out += variantsTable(report);
 
   out +=
       "<h2>Pairs</h2><div class=\"controls\"><input id=\"filter\" type=\"search\" "

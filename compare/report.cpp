@@ -223,6 +223,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
               {"total", s.total()}}},
             {"exit_code", exitCodeFor(report)}};
   if (!report.command.empty()) j["command"] = report.command;
+  if (!report.variants.empty()) j["variants"] = report.variants;
   return j;
 }
 

@@ -29,6 +29,8 @@ struct Report {
   std::string tool_version;
   std::string command;  // the command line that produced it, when known
   std::vector<PairResult> results;
+  // Per GL backend, the legal variants it follows (app/variants.h; empty: not probed).
+  nlohmann::json variants = nlohmann::json::object();
 
   ReportSummary summary() const;
 };

@@ -1,0 +1,83 @@
+// See debug_support.h.
+#include "app/debug_support.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "app/paths.h"
+#include "compare/compare.h"
+#include "fixtures/errors.h"
+#include "fixtures/frame_io.h"
+
+namespace rc {
+namespace fs = std::filesystem;
+
+ScratchDir::ScratchDir(std::string_view prefix) {
+  std::string pattern =
+      (fs::temp_directory_path() / fmt::format("rastercheck-{}-XXXXXX", prefix)).string();
+  std::vector<char> buf(pattern.begin(), pattern.end());
+  buf.push_back('\0');
+  if (::mkdtemp(buf.data()) == nullptr)
+    throw InputError(fmt::format("cannot create a scratch folder {}", pattern));
+  path_ = buf.data();
+}
+
+ScratchDir::~ScratchDir() {
+  if (const char* keep = std::getenv("RASTERCHECK_KEEP_SCRATCH"); keep && *keep) return;
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+Job renderJob(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {
+  fs::path log = out_dir;
+  log += ".log";
+  return Job{{selfExecutable().string(), "render", scene_file.string(), "--backend", spec, "--out",
+              out_dir.string()},
+             log};
+}
+
+std::string childFailure(const Job& job) {
+  std::ifstream in(job.log);
+  std::string line;
+  std::string last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  for (const char* prefix :
+       {"rastercheck: backend error: ", "rastercheck: error: ", "rastercheck: internal error: "}) {
+    if (last.rfind(prefix, 0) == 0) last = last.substr(std::string(prefix).size());
+  }
+  if (!job.signal_name.empty())
+    return fmt::format("crashed ({}){}", job.signal_name, last.empty() ? "" : ": " + last);
+  return last.empty() ? fmt::format("exited with code {}", job.exit_code) : last;
+}
+
+Frame renderInChild(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {
+  std::vector<Job> jobs{renderJob(scene_file, spec, out_dir)};
+  runJobs(jobs, 1, [](std::size_t) {});
+  if (jobs[0].exit_code != 0) {
+    const std::string why = childFailure(jobs[0]);
+    // The child's own message usually names the spec already.
+    throw BackendError(why.find(spec) != std::string::npos ? why : spec + ": " + why);
+  }
+  return readFrameDir(out_dir);
+}
+
+Frame renderBackend(const BackendSpec& backend, const Scene& scene, const fs::path& scene_file,
+                    const fs::path& out_dir) {
+  if (backend.kind == BackendSpec::Kind::Reference) return renderWith(backend, scene);
+  return renderInChild(scene_file, backend.text, out_dir);
+}
+
+Tolerances pairTolerances(const Frame& expected, const Frame& actual, const Scene& scene,
+                          const ToleranceOverrides& cli) {
+  Tolerances tol = tolerancesForFrames(expected, actual);
+  applyOverrides(tol, scene.tolerance);
+  applyOverrides(tol, cli);
+  return tol;
+}
+
+}  // namespace rc

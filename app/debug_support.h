@@ -1,0 +1,56 @@
+// What `explain`, `reduce` and the variant probes share: scratch folders, rendering a
+// fixture file with a backend in a child process (`rastercheck render`, as `run` does,
+// so a driver crash costs one render and each child picks its own GL driver), and the
+// tolerances `compare` would use for a pair.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "app/backends.h"
+#include "app/subprocess.h"
+#include "compare/tolerances.h"
+#include "fixtures/frame.h"
+#include "fixtures/scene.h"
+
+namespace rc {
+
+// A fresh folder under the system temporary directory, removed with its contents when
+// the object goes (unless RASTERCHECK_KEEP_SCRATCH is set, for debugging the tool).
+class ScratchDir {
+ public:
+  explicit ScratchDir(std::string_view prefix);
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// The job that renders `scene_file` with `spec` into `out_dir` (log beside it).
+Job renderJob(const std::filesystem::path& scene_file, const std::string& spec,
+              const std::filesystem::path& out_dir);
+
+// Why a finished job failed, in one line: the child's last error line without our
+// prefixes, or how it died.
+std::string childFailure(const Job& job);
+
+// Renders in a child process and reads the frame back. Throws BackendError (one line,
+// naming the spec) when the child fails.
+Frame renderInChild(const std::filesystem::path& scene_file, const std::string& spec,
+                    const std::filesystem::path& out_dir);
+
+// Renders `scene` with `backend`: the reference in this process, GL in a child process
+// that reads `scene_file` (which must hold the same scene). Throws BackendError.
+Frame renderBackend(const BackendSpec& backend, const Scene& scene,
+                    const std::filesystem::path& scene_file, const std::filesystem::path& out_dir);
+
+// The tolerances `compare` uses for this pair: the formats' defaults, then the scene's
+// "tolerance", then the command line.
+Tolerances pairTolerances(const Frame& expected, const Frame& actual, const Scene& scene,
+                          const ToleranceOverrides& cli);
+
+}  // namespace rc

@@ -1,0 +1,165 @@
+// Variant detection: which of the legal rasterization variants a GL driver follows.
+// Three small probe scenes with analytically known answers, and pure functions that read
+// a driver's frames of them (plus reference frames where the answer is "which reference
+// option reproduces it"). Rendering the probes is the caller's job (app/variants.cpp);
+// nothing here renders, spawns or touches files. docs/debugging.md explains the probes.
+//
+// Every probe uses an orthographic camera whose bounds are the image (world x, y =
+// GL window x, y) and dyadic coordinates, so that GL's float32 vertex pipeline and the
+// reference's double one reach exactly the same window coordinates and depths.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "fixtures/frame.h"
+#include "fixtures/scene.h"
+
+namespace rc::variants {
+
+// ---- (a) subpixel precision ---------------------------------------------------------------
+
+// 64 isolated right triangles whose near-vertical and near-horizontal edges run along
+// rows and columns of pixel centres, each vertex offset from a centre by a random
+// +-u * 2^-k px (k in 1..12, an odd multiple of 2^-16 so that no offset is a rounding tie
+// at 14 bits or fewer). Snapping to N bits zeroes the offsets below 2^-(N+1), which moves
+// whole rows of centres onto or across the edge: the coverage differs clearly between N
+// and N+1. At 12 bits no offset vanishes, so no centre lies exactly on an edge and the
+// tie-break rule does not enter: a rasterizer without snapping matches ref:subpixel=12.
+Scene subpixelProbe(std::uint32_t seed = 1);
+
+// Candidate precisions the reference can reproduce (`ref:subpixel=N`).
+inline constexpr int kMinCandidateBits = 0;
+inline constexpr int kMaxCandidateBits = 12;
+
+struct SubpixelResult {
+  int queried = -1;                         // GL_SUBPIXEL_BITS from frame.json (-1: absent)
+  std::map<int, std::uint64_t> mismatches;  // N -> pixels whose id differs from ref:subpixel=N
+  int best = -1;                            // N with the fewest mismatches (smallest N on ties)
+  std::uint64_t best_mismatches = 0;
+  bool exact = false;      // some N reproduces the driver's coverage exactly
+  bool confirmed = false;  // the queried N does
+};
+
+// `driver` is the driver's frame of subpixelProbe(); `reference` maps each candidate N to
+// the reference's frame of the same scene rendered with ref:subpixel=N. Throws
+// InputError when sizes differ.
+SubpixelResult analyseSubpixel(const Frame& driver, const std::map<int, Frame>& reference);
+
+// ---- (b) tie-break on edges through pixel centres ------------------------------------------
+
+// An edge's side of its triangle, named by its inward normal (nx, ny) in GL window
+// coordinates (y up): nx > 0 is a left edge, ny > 0 a bottom edge; diagonals get both.
+enum class EdgeSide { Left, Right, Bottom, Top, BottomLeft, BottomRight, TopLeft, TopRight };
+inline constexpr int kEdgeSideCount = 8;
+const char* toString(EdgeSide side);
+
+// The reference's documented rule (reference/rasterizer.h): a centre exactly on an edge
+// is covered iff nx > 0, or nx == 0 and ny > 0 (left edges, and bottom edges in GL window
+// coordinates).
+bool referenceIncludes(EdgeSide side);
+
+// One pixel centre that lies exactly on one edge of one probe triangle (not a vertex).
+struct EdgeCentre {
+  int x = 0;  // image coordinates
+  int y = 0;
+  std::uint32_t primitive = 0;
+  EdgeSide side = EdgeSide::Left;
+};
+
+// A pixel centre on an edge shared by two probe triangles (a and b): a rule that covers
+// shared edges exactly once gives it to one of them, never to neither.
+struct SharedCentre {
+  int x = 0;  // image coordinates
+  int y = 0;
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+};
+
+struct TieBreakProbe {
+  Scene scene;
+  std::vector<EdgeCentre> centres;   // from the geometry, exactly (integer arithmetic)
+  std::vector<SharedCentre> shared;  // the subset on shared edges, by pair
+};
+
+// Triangles with every vertex on a pixel centre, so that vertical, horizontal and
+// 45-degree edges with every inward normal pass exactly through pixel centres: 16 isolated
+// right triangles (four corner orientations x both windings x two sizes) and 8 pairs that
+// share an edge (diagonal both ways, vertical, horizontal; both windings). 64x32 px.
+TieBreakProbe tieBreakProbe();
+
+struct TieBreakResult {
+  struct Side {
+    int included = 0;
+    int total = 0;
+  };
+  std::map<EdgeSide, Side> sides;
+  int disagreements = 0;   // centres where the driver differs from referenceIncludes()
+  int shared_centres = 0;  // centres on shared edges
+  int shared_gaps = 0;     // of those, covered by neither triangle of the pair
+  bool consistent = true;  // every side is all-included or all-excluded
+  std::string rule;        // e.g. "left+bottom", from the four axis-aligned sides
+  bool matches_reference = false;
+};
+
+TieBreakResult analyseTieBreak(const TieBreakProbe& probe, const Frame& driver);
+
+// ---- (c) depth rounding ----------------------------------------------------------------
+
+// One probe square: its pixels (image coordinates, inclusive-exclusive) and window depth.
+struct DepthSample {
+  int x0 = 0;
+  int y0 = 0;
+  int x1 = 0;
+  int y1 = 0;
+  std::uint32_t primitive = 0;  // the first of its two triangles
+  double window_z = 0.0;        // exact (dyadic), so z * (2^24 - 1) is known exactly
+};
+
+struct DepthProbe {
+  Scene scene;  // d24
+  std::vector<DepthSample> samples;
+};
+
+// 64 screen-parallel squares at window depths z = (2j + 1) / 128, j = 0..63. Each z is
+// exact in float32 all the way through GL's vertex pipeline, and z * (2^24 - 1) =
+// (2j + 1) * 2^17 - z: the fraction of a step is 1 - z, from 127/128 down to 1/128, so
+// round-to-nearest and truncation differ on half of them and round-up on the other half.
+DepthProbe depthProbe();
+
+// Candidate conversions of a window depth z to a d24 value q.
+enum class DepthRounding { Nearest, Truncate, NearestFloat32, TruncateFloat32 };
+inline constexpr int kDepthRoundingCount = 4;
+const char* toString(DepthRounding rule);
+std::uint32_t convertDepth(double z, DepthRounding rule);
+
+struct DepthRoundingResult {
+  int samples = 0;
+  std::map<DepthRounding, int> agree;  // samples each candidate predicts exactly
+  std::string rule;                    // the first candidate that predicts every sample, or
+                                       // "none"
+  bool matches_reference = false;      // Nearest predicts every sample
+  bool readback_exact = true;          // every Z is exactly float(q / (2^24 - 1)) for a q
+  bool uniform = true;                 // every pixel of a square holds the same q
+  int uncovered = 0;                   // probe pixels the driver did not draw
+};
+
+DepthRoundingResult analyseDepthRounding(const DepthProbe& probe, const Frame& driver);
+
+// ---- report.json ------------------------------------------------------------------------
+
+nlohmann::json toJson(const SubpixelResult& r);
+nlohmann::json toJson(const TieBreakResult& r);
+nlohmann::json toJson(const DepthRoundingResult& r);
+
+// One line per variant for people, e.g. "subpixel: 8 bits (GL_SUBPIXEL_BITS 8, confirmed:
+// ref:subpixel=8 reproduces the probe exactly)".
+std::string describeSubpixel(const SubpixelResult& r);
+std::string describeTieBreak(const TieBreakResult& r);
+std::string describeDepthRounding(const DepthRoundingResult& r);
+
+}  // namespace rc::variants
