@@ -140,7 +140,9 @@ TEST(MutationManifest, MatchesTheFolders) {
         << m.name << ": " << m.cls;
     EXPECT_TRUE(fs::exists(m.original)) << m.name << ": " << m.original;
     EXPECT_NE(m.mutant.empty(), m.gl_fault.empty()) << m.name << ": mutant or gl_fault";
-    if (!m.mutant.empty()) EXPECT_TRUE(fs::exists(m.mutant)) << m.name << ": " << m.mutant;
+    if (!m.mutant.empty()) {
+      EXPECT_TRUE(fs::exists(m.mutant)) << m.name << ": " << m.mutant;
+    }
     used.insert(m.original.parent_path().filename().string());
   }
   std::set<std::string> folders;
