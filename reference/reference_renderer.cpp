@@ -380,10 +380,16 @@ void Renderer::shadeSpan(const TriangleContext& t, const FragmentInterpolator& i
     const double cx = px + 0.5;
     const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
     const double z = clampDepth(interp.depth(cx, cy));
-    if (track_gaps) gaps_.add(index, z);
     const std::uint32_t key = depthKey(z, depth_format);
     const std::uint32_t against = depth[index];
     const bool pass = always || key < against;
+    if (track_gaps) {
+      if (pass) {
+        gaps_.passed(index, z, !always, depth_write);
+      } else {
+        gaps_.failed(index, z);
+      }
+    }
 
     if constexpr (kTrace) {
       FragmentTrace f;

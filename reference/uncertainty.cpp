@@ -9,9 +9,9 @@
 namespace rc::ref {
 
 float DepthGapTracker::gapSteps(std::size_t index, DepthFormat format) const {
-  const Slot& s = slots_[index];
-  if (!std::isfinite(s.second)) return std::numeric_limits<float>::infinity();
-  return static_cast<float>((s.second - s.first) * depthStepsPerUnit(format));
+  const double gap = slots_[index].gap;
+  if (!std::isfinite(gap)) return std::numeric_limits<float>::infinity();
+  return static_cast<float>(gap * depthStepsPerUnit(format));
 }
 
 double polygonArea2(const WindowVertex* polygon, int count) {

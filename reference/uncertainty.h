@@ -6,12 +6,23 @@
 //     fan diagonals), after culling, plus culled or zero-area ones whose cull decision a
 //     snap of another implementation could flip (cullCouldFlip()). Computed in a band
 //     around each edge, so the cost follows the perimeter, not the area.
-//   depth_gap: per pixel, the two smallest window depths among ALL fragments that covered
-//     it (any primitive, passing the depth test or not); gap = z2 - z1 in steps of the
-//     depth format (d16/d24: * (2^b - 1); d32f: / 2^-24), +inf with fewer than two.
+//   depth_gap: per pixel, how close the depth comparisons that decided the final id came
+//     to flipping. A comparison is one fragment f tested (LESS) against the depth stored
+//     by an earlier fragment s; it DECIDED the final id when flipping its outcome alone
+//     would change the final id. depth_gap = min |z_f - z_s| over those comparisons, in
+//     steps of the depth format (d16/d24: * (2^b - 1); d32f: * 2^24), z the clamped,
+//     unquantized window depth of each fragment; +inf when no comparison decided it.
+//     DepthGapTracker computes it in draw order, exactly (see there for why it is exact).
+//     Not counted: tests against the clear depth (they decide primitive vs background,
+//     which the comparator never excuses by depth), and passes without a depth test
+//     (painter's, depth_test false: ALWAYS), where the shared far-to-near sort or the file
+//     order, identical in both renderers, decides the winner: no depth error can change it,
+//     so a pixel drawn last by such a pass is +inf. In a single z-buffer pass this is the
+//     gap between the winner and the nearest other fragment (DESIGN.md's wording).
 // It does not decide coverage or visibility.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <vector>
@@ -22,25 +33,54 @@
 
 namespace rc::ref {
 
+// Per-pixel state of the depth_gap rule above, fed every fragment in draw order with the
+// outcome of its depth test. Why the streaming rule is exact:
+//  - a fragment that passes becomes the final id so far, and no EARLIER comparison decides
+//    the final id any more: with depth writes (a z-buffer pass) the new fragment is nearer
+//    than everything stored before it, so it passes whatever an earlier flip would have
+//    stored; without writes (the alpha pass, tested against the opaque depth) it is drawn
+//    later than every earlier fragment and wins regardless of their outcomes. Its own
+//    comparison does decide (failing, it would leave the previous id): gap = |z_f - z_s|;
+//  - a fragment that fails is compared with the stored depth; passing instead, it would
+//    become the final id unless a later fragment passes (which resets the gap anyway):
+//    gap = min(gap, |z_f - z_s|);
+//  - a fragment drawn without a test (ALWAYS) becomes the final id whatever the depths:
+//    gap = +inf;
+//  - comparisons against the clear depth are not counted (s is "clear").
+// Flipping an opaque-pass comparison under a transparent winner can only change the final
+// id through a transparent fragment whose depth lies between the two opaque candidates;
+// that fragment's own comparison is then closer and is counted, so the minimum is the same.
 class DepthGapTracker {
  public:
   void reset(std::size_t pixels) { slots_.assign(pixels, Slot{}); }
-  void add(std::size_t index, double z) {
+
+  // Fragment at clamped window depth z passed the test (tested: LESS; else ALWAYS) and,
+  // when `writes`, stored its depth.
+  void passed(std::size_t index, double z, bool tested, bool writes) {
     Slot& s = slots_[index];
-    if (z < s.first) {
-      s.second = s.first;
-      s.first = z;
-    } else if (z < s.second) {
-      s.second = z;
+    s.gap = tested && s.stored_by_fragment ? std::fabs(z - s.stored_z) : kInf;
+    if (writes) {
+      s.stored_z = z;
+      s.stored_by_fragment = true;
     }
   }
-  // (z2 - z1) in steps of the format; +inf when fewer than two fragments.
+  // Fragment at clamped window depth z failed the LESS test.
+  void failed(std::size_t index, double z) {
+    Slot& s = slots_[index];
+    if (!s.stored_by_fragment) return;
+    const double d = std::fabs(z - s.stored_z);
+    if (d < s.gap) s.gap = d;
+  }
+
+  // The gap in steps of the format; +inf when no comparison decided the final id.
   float gapSteps(std::size_t index, DepthFormat format) const;
 
  private:
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
   struct Slot {
-    double first = std::numeric_limits<double>::infinity();
-    double second = std::numeric_limits<double>::infinity();
+    double stored_z = 0.0;  // depth stored by the last writing fragment...
+    double gap = kInf;
+    bool stored_by_fragment = false;  // ...or the clear depth when false
   };
   std::vector<Slot> slots_;
 };
