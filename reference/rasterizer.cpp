@@ -36,9 +36,7 @@ double guardLimitPx(int subpixel_bits) {
 }
 
 FixedVertex snapVertex(double window_x, double window_y, int subpixel_bits) {
-  const double scale = std::ldexp(1.0, subpixel_bits);
-  return FixedVertex{static_cast<std::int64_t>(roundHalfEven((window_x - 0.5) * scale)),
-                     static_cast<std::int64_t>(roundHalfEven((window_y - 0.5) * scale))};
+  return snapVertexScaled(window_x, window_y, std::ldexp(1.0, subpixel_bits));
 }
 
 std::int64_t snappedArea2(const FixedVertex& v0, const FixedVertex& v1, const FixedVertex& v2) {

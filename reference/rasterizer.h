@@ -12,6 +12,8 @@
 
 #include <cstdint>
 
+#include "reference/rounding.h"
+
 namespace rc::ref {
 
 inline constexpr int kMaxSubpixelBits = 12;
@@ -39,6 +41,12 @@ struct FixedVertex {
   std::int64_t y = 0;
 };
 FixedVertex snapVertex(double window_x, double window_y, int subpixel_bits);
+// The same with scale = 2^subpixel_bits computed once by the caller (the product by a
+// power of two is exact, so the results are identical).
+inline FixedVertex snapVertexScaled(double window_x, double window_y, double scale) {
+  return FixedVertex{static_cast<std::int64_t>(roundHalfEven((window_x - 0.5) * scale)),
+                     static_cast<std::int64_t>(roundHalfEven((window_y - 0.5) * scale))};
+}
 
 // Twice the signed area of a snapped triangle, in units^2 (> 0: counter-clockwise in GL
 // window coordinates). Exact.

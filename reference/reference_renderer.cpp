@@ -81,6 +81,7 @@ struct TriangleContext {
   const PrimitiveRef* prim = nullptr;
   const DrawPass* pass = nullptr;
   const Material* material = nullptr;
+  const PreparedShading* shading = nullptr;
   const Texture* texture = nullptr;
   const TransformedVertex* v[3] = {nullptr, nullptr, nullptr};
   const LitColor* gouraud[3] = {nullptr, nullptr, nullptr};  // per original vertex
@@ -90,6 +91,30 @@ struct TriangleContext {
   bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
 };
+
+// The depth key of a fragment at clamped window depth z01 (fragment_ops.h depthKey, with
+// the format fixed at compile time for the span loops).
+template <DepthFormat kFormat>
+inline std::uint32_t depthKeyOf(double z01) {
+  if constexpr (kFormat == DepthFormat::D16) {
+    return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 65535.0));
+  } else if constexpr (kFormat == DepthFormat::D24) {
+    return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 16777215.0));
+  } else {
+    return std::bit_cast<std::uint32_t>(static_cast<float>(z01));
+  }
+}
+
+// Per-pixel working buffers that are not part of the Frame (depth keys, depth_gap state:
+// 20 bytes a pixel), kept per thread between renders so that rendering many frames does
+// not page-fault fresh memory each time; buffers over kMaxKeptScratchPixels are released
+// after the frame. Contents never carry over: every render refills them.
+struct Scratch {
+  std::vector<std::uint32_t> depth;
+  DepthGapTracker gaps;
+};
+thread_local Scratch t_scratch;
+constexpr std::size_t kMaxKeptScratchPixels = std::size_t{1} << 22;
 
 class Renderer {
  public:
@@ -106,9 +131,15 @@ class Renderer {
         uncertainty_(options.uncertainty && trace == nullptr),
         depth_format_(scene.state.depth_format),
         color_format_(scene.state.color_format),
+        snap_scale_(std::ldexp(1.0, options.subpixel_bits)),
         camera_(cameraTransform(scene)),
         lighting_(sceneLighting(scene)),
-        volume_(clipVolume(scene.width, scene.height, guardLimitPx(options.subpixel_bits))) {}
+        volume_(clipVolume(scene.width, scene.height, guardLimitPx(options.subpixel_bits))),
+        depth_(t_scratch.depth),
+        gaps_(t_scratch.gaps) {
+    shading_.reserve(scene.materials.size());
+    for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
+  }
 
   Frame run();
 
@@ -116,9 +147,17 @@ class Renderer {
   void transformVertices();
   void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
   void prepareTriangle(TriangleContext& t) const;
-  template <Shading kShading, bool kTrace>
-  void shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py, int x_begin,
-                 int x_end);
+  void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
+                const FragmentInterpolator& interp);
+  template <DepthFormat kFormat, bool kGaps, class Shade>
+  void fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                 const FragmentInterpolator& interp, Shade&& shade);
+  template <DepthFormat kFormat>
+  void shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
+                      const FragmentInterpolator& interp);
+  template <Shading kShading>
+  void traceSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                  const FragmentInterpolator& interp);
   template <Shading kShading>
   glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b,
                            ShadingTerms* terms) const;
@@ -135,31 +174,34 @@ class Renderer {
   const bool uncertainty_;
   const DepthFormat depth_format_;
   const ColorFormat color_format_;
+  const double snap_scale_;  // 2^subpixel_bits
   const CameraTransform camera_;
   const Lighting lighting_;
   const ClipVolume volume_;
+  std::vector<PreparedShading> shading_;  // per material
 
   std::vector<std::vector<TransformedVertex>> vertices_;  // per object
   std::vector<std::vector<LitColor>> gouraud_;            // per object, Gouraud only
-  Frame frame_;                       // colour, id, edge_dist over the clip rectangle
-  std::vector<std::uint32_t> depth_;  // depth keys (fragment_ops.h)
-  DepthGapTracker gaps_;
+  Frame frame_;                        // colour, id, edge_dist over the clip rectangle
+  std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
+  DepthGapTracker& gaps_;              // scratch
 };
 
 void Renderer::transformVertices() {
   vertices_.resize(scene_.objects.size());
-  if (scene_.state.shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
+  const Shading shading = scene_.state.shading;
+  if (shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
   for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
     const Object& obj = scene_.objects[o];
     if (obj.mesh.triangles.empty()) continue;
-    transformObject(obj, camera_, vertices_[o]);
-    if (scene_.state.shading != Shading::Gouraud) continue;
+    // Flat shading lights the face normal: vertex normals would go unused (unless traced).
+    transformObject(obj, camera_, vertices_[o], shading != Shading::Flat || trace_ != nullptr);
+    if (shading != Shading::Gouraud) continue;
     // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
-    const Material& material = scene_.materials[obj.material];
+    const PreparedShading& prepared = shading_[obj.material];
     gouraud_[o].resize(vertices_[o].size());
     for (std::size_t i = 0; i < vertices_[o].size(); ++i)
-      gouraud_[o][i] =
-          shadePoint(lighting_, material, vertices_[o][i].world, vertices_[o][i].normal);
+      gouraud_[o][i] = shadePrepared(prepared, vertices_[o][i].world, vertices_[o][i].normal);
   }
 }
 
@@ -185,8 +227,9 @@ Frame Renderer::run() {
     const double steps = depthStepsPerUnit(depth_format_);
     for (std::size_t i = 0; i < n; ++i) frame_.depth[i] = static_cast<float>(depth_[i] / steps);
   }
-  if (uncertainty_)
-    for (std::size_t i = 0; i < n; ++i) frame_.depth_gap[i] = gaps_.gapSteps(i, depth_format_);
+  if (uncertainty_) gaps_.writeSteps(depth_format_, frame_.depth_gap.data());
+  if (depth_.capacity() > kMaxKeptScratchPixels) depth_ = {};
+  if (gaps_.capacity() > kMaxKeptScratchPixels) gaps_.release();
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   frame_.meta = {{"renderer", "rastercheck reference"},
@@ -200,6 +243,7 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   const Object& obj = scene_.objects[t.prim->object];
   const auto& tri = obj.mesh.triangles[t.prim->triangle];
   t.material = &scene_.materials[obj.material];
+  t.shading = &shading_[obj.material];
   t.texture = t.material->texture.get();
   for (int k = 0; k < 3; ++k) {
     t.v[k] = &vertices_[t.prim->object][tri[k]];
@@ -212,12 +256,20 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   const glm::dvec3& p2 = t.v[2]->world;
   t.centroid = (p0 + p1 + p2) / 3.0;
   t.face_normal = safeNormalize(glm::cross(p1 - p0, p2 - p0));
-  t.flat = shadePoint(lighting_, *t.material, t.centroid, t.face_normal);
+  t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
   t.constant = t.texture == nullptr && !t.pass->blend;
   if (t.constant) {
     const glm::dvec4 c = finalColor(t.flat, glm::dvec3(1.0), t.material->opacity);
     for (int k = 0; k < 4; ++k) t.constant_stored[k] = storeColor(c[k], color_format_);
   }
+}
+
+// Outside the clip volume's plane set, as clipTriangle() decides it (clipper.h): a
+// triangle whose three vertices are inside every plane is drawn without clipping.
+inline bool insideAllPlanes(const glm::dvec4& c, const ClipVolume& v) {
+  return c.z + c.w >= 0.0 && c.w - c.z >= 0.0 && v.guard_x * c.w + c.x >= 0.0 &&
+         v.guard_x * c.w - c.x >= 0.0 && v.guard_y * c.w + c.y >= 0.0 &&
+         v.guard_y * c.w - c.y >= 0.0;
 }
 
 void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
@@ -230,14 +282,23 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   if (!isFinite(c0) || !isFinite(c1) || !isFinite(c2)) return;  // NaN/Inf geometry: dropped
 
   ClipPolygon poly;
-  if (!clipTriangle(c0, c1, c2, volume_, poly)) return;
+  if (insideAllPlanes(c0, volume_) && insideAllPlanes(c1, volume_) &&
+      insideAllPlanes(c2, volume_)) {
+    // What clipTriangle() returns for such a triangle, without its bookkeeping.
+    poly.v[0] = {c0, {1.0, 0.0, 0.0}};
+    poly.v[1] = {c1, {0.0, 1.0, 0.0}};
+    poly.v[2] = {c2, {0.0, 0.0, 1.0}};
+    poly.count = 3;
+  } else if (!clipTriangle(c0, c1, c2, volume_, poly)) {
+    return;
+  }
   WindowVertex wv[kMaxClipVertices];
   FixedVertex fv[kMaxClipVertices];
   for (int i = 0; i < poly.count; ++i) {
     if (!(poly.v[i].clip.w > 0.0)) return;  // only a degenerate camera gets here
     wv[i] = toWindow(poly.v[i], scene_.width, scene_.height);
     if (!std::isfinite(wv[i].x) || !std::isfinite(wv[i].y) || !std::isfinite(wv[i].z)) return;
-    fv[i] = snapVertex(wv[i].x, wv[i].y, options_.subpixel_bits);
+    fv[i] = snapVertexScaled(wv[i].x, wv[i].y, snap_scale_);
   }
 
   const bool ccw_is_front = scene_.state.front_face == FrontFace::CCW;
@@ -265,30 +326,28 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
     if (area2 == 0 || culled(area2 > 0)) continue;
     TriangleCoverage coverage;
     if (!coverage.setup(fv[0], fv[i], fv[i + 1], options_.subpixel_bits, clip_)) continue;
-    FragmentInterpolator interp;
-    interp.setup(wv[0], wv[i], wv[i + 1]);
     if (!prepared) {
       prepareTriangle(t);
       prepared = true;
     }
-    auto run = [&](auto span) {
-      coverage.forEachSpan([&](int py, int x0, int x1) { (this->*span)(t, interp, py, x0, x1); });
-    };
-    const bool tracing = trace_ != nullptr;
-    switch (scene_.state.shading) {
-      case Shading::Flat:
-        tracing ? run(&Renderer::shadeSpan<Shading::Flat, true>)
-                : run(&Renderer::shadeSpan<Shading::Flat, false>);
-        break;
-      case Shading::Gouraud:
-        tracing ? run(&Renderer::shadeSpan<Shading::Gouraud, true>)
-                : run(&Renderer::shadeSpan<Shading::Gouraud, false>);
-        break;
-      case Shading::Phong:
-        tracing ? run(&Renderer::shadeSpan<Shading::Phong, true>)
-                : run(&Renderer::shadeSpan<Shading::Phong, false>);
-        break;
+    FragmentInterpolator interp;
+    // A triangle of one stored colour needs no barycentrics (unless traced).
+    interp.setup(wv[0], wv[i], wv[i + 1], !t.constant || trace_ != nullptr);
+    if (trace_ != nullptr) {
+      switch (scene_.state.shading) {
+        case Shading::Flat:
+          traceSpans<Shading::Flat>(t, coverage, interp);
+          break;
+        case Shading::Gouraud:
+          traceSpans<Shading::Gouraud>(t, coverage, interp);
+          break;
+        case Shading::Phong:
+          traceSpans<Shading::Phong>(t, coverage, interp);
+          break;
+      }
+      continue;
     }
+    shadeFan(t, coverage, interp);
   }
 }
 
@@ -313,7 +372,7 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
     const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
     const glm::dvec3 n =
         safeNormalize(b.x * t.v[0]->normal + b.y * t.v[1]->normal + b.z * t.v[2]->normal);
-    lit = shadePoint(lighting_, *t.material, p, n, terms);
+    lit = shadePrepared(*t.shading, p, n, terms);
   }
   const glm::dvec4 color = finalColor(lit, tex, t.material->opacity);
   if (terms) {
@@ -329,12 +388,11 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
 void Renderer::traceTerms(const TriangleContext& t, const glm::dvec3& b,
                           ShadingTerms& terms) const {
   if (scene_.state.shading == Shading::Flat) {
-    shadePoint(lighting_, *t.material, t.centroid, t.face_normal, &terms);
+    shadePrepared(*t.shading, t.centroid, t.face_normal, &terms);
     return;
   }
   ShadingTerms vt[3];
-  for (int k = 0; k < 3; ++k)
-    shadePoint(lighting_, *t.material, t.v[k]->world, t.v[k]->normal, &vt[k]);
+  for (int k = 0; k < 3; ++k) shadePrepared(*t.shading, t.v[k]->world, t.v[k]->normal, &vt[k]);
   terms.ambient = b.x * vt[0].ambient + b.y * vt[1].ambient + b.z * vt[2].ambient;
   terms.lights.assign(vt[0].lights.size(), LightTerms{});
   for (std::size_t i = 0; i < terms.lights.size(); ++i) {
@@ -361,71 +419,191 @@ inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool 
   for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
 }
 
-template <Shading kShading, bool kTrace>
-void Renderer::shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py,
-                         int x_begin, int x_end) {
-  const double cy = py + 0.5;  // pixel centres
-  const std::size_t row =
-      static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+// The fragment loop: for every covered pixel centre, depth (from the unsnapped plane,
+// clamped, quantized), the depth test, the uncertainty bookkeeping, then depth, id and
+// colour writes. `shade(index, row, dx)` writes the colour of a fragment that passed.
+// Everything constant along a row is computed once per row (FragmentInterpolator::Row).
+template <DepthFormat kFormat, bool kGaps, class Shade>
+void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                         const FragmentInterpolator& interp, Shade&& shade) {
   const bool always = t.pass->depth_func == DepthFunc::Always;
   const bool depth_write = t.pass->depth_write;
-  const bool blend = t.pass->blend;
-  const bool track_gaps = uncertainty_;
-  const DepthFormat depth_format = depth_format_;
-  std::uint32_t* const depth = depth_.data();  // locals: the stores below cannot alias them
-  std::uint32_t* const ids = frame_.id.data();
-  float* const colors = frame_.color.data();
   const std::uint32_t id = t.prim->id;
-  for (int px = x_begin; px < x_end; ++px) {
-    const double cx = px + 0.5;
-    const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
-    const double z = clampDepth(interp.depth(cx, cy));
-    const std::uint32_t key = depthKey(z, depth_format);
-    const std::uint32_t against = depth[index];
-    const bool pass = always || key < against;
-    if (track_gaps) {
-      if (pass) {
-        gaps_.passed(index, z, !always, depth_write);
-      } else {
-        gaps_.failed(index, z);
+  std::uint32_t* const depth = depth_.data();
+  std::uint32_t* const ids = frame_.id.data();
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    const FragmentInterpolator::Row row = interp.row(py + 0.5);  // pixel centres
+    const std::size_t row_index =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    for (int px = x_begin; px < x_end; ++px) {
+      const double dx = interp.dx(px + 0.5);
+      const std::size_t index = row_index + static_cast<std::size_t>(px - clip_.x0);
+      const double z = clampDepth(interp.depthAt(row, dx));
+      const std::uint32_t key = depthKeyOf<kFormat>(z);
+      const bool pass = always || key < depth[index];
+      if constexpr (kGaps) {
+        if (pass) {
+          gaps_.passed(index, z, !always, depth_write);
+        } else {
+          gaps_.failed(index, z);
+        }
       }
+      if (!pass) continue;
+      if (depth_write) depth[index] = key;
+      ids[index] = id;
+      shade(index, row, dx);
     }
+  });
+}
 
-    if constexpr (kTrace) {
+template <DepthFormat kFormat>
+void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
+                              const FragmentInterpolator& interp) {
+  auto fill = [&](auto&& shade) {
+    if (uncertainty_) {
+      fillSpans<kFormat, true>(t, coverage, interp, shade);
+    } else {
+      fillSpans<kFormat, false>(t, coverage, interp, shade);
+    }
+  };
+  float* const colors = frame_.color.data();
+  const bool blend = t.pass->blend;
+  if (t.constant) {  // one stored colour for the whole triangle
+    const float c0 = t.constant_stored[0];
+    const float c1 = t.constant_stored[1];
+    const float c2 = t.constant_stored[2];
+    const float c3 = t.constant_stored[3];
+    fill([=](std::size_t index, const FragmentInterpolator::Row&, double) {
+      float* c = colors + 4 * index;
+      c[0] = c0;
+      c[1] = c1;
+      c[2] = c2;
+      c[3] = c3;
+    });
+    return;
+  }
+  // Untextured, unblended Gouraud and Phong: fragmentColor() and writeColor() written out
+  // with the triangle's constants in locals (the same expressions: an untextured colour is
+  // (ambient + diffuse) * 1 + specular, and x * 1 == x exactly).
+  if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat) {
+    const bool rgba8 = color_format_ == ColorFormat::RGBA8;
+    const float alpha = storeColor(t.material->opacity, color_format_);
+    auto store = [=](std::size_t index, const glm::dvec3& c) {
+      float* out = colors + 4 * index;
+      if (rgba8) {
+        out[0] = storeColor(c.x, ColorFormat::RGBA8);
+        out[1] = storeColor(c.y, ColorFormat::RGBA8);
+        out[2] = storeColor(c.z, ColorFormat::RGBA8);
+      } else {
+        out[0] = static_cast<float>(c.x);
+        out[1] = static_cast<float>(c.y);
+        out[2] = static_cast<float>(c.z);
+      }
+      out[3] = alpha;
+    };
+    if (scene_.state.shading == Shading::Gouraud) {
+      const LitColor g0 = *t.gouraud[0];
+      const LitColor g1 = *t.gouraud[1];
+      const LitColor g2 = *t.gouraud[2];
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        const glm::dvec3 b = interp.barycentricAt(row, dx);
+        const glm::dvec3 ad =
+            b.x * g0.ambient_diffuse + b.y * g1.ambient_diffuse + b.z * g2.ambient_diffuse;
+        const glm::dvec3 sp = b.x * g0.specular + b.y * g1.specular + b.z * g2.specular;
+        store(index, ad + sp);
+      });
+    } else {
+      const glm::dvec3 w0 = t.v[0]->world;
+      const glm::dvec3 w1 = t.v[1]->world;
+      const glm::dvec3 w2 = t.v[2]->world;
+      const glm::dvec3 n0 = t.v[0]->normal;
+      const glm::dvec3 n1 = t.v[1]->normal;
+      const glm::dvec3 n2 = t.v[2]->normal;
+      const PreparedShading& shading = *t.shading;
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        const glm::dvec3 b = interp.barycentricAt(row, dx);
+        const glm::dvec3 p = b.x * w0 + b.y * w1 + b.z * w2;
+        const glm::dvec3 n = safeNormalize(b.x * n0 + b.y * n1 + b.z * n2);
+        const LitColor lit = shadePrepared(shading, p, n);
+        store(index, lit.ambient_diffuse + lit.specular);
+      });
+    }
+    return;
+  }
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        writeColor(index, fragmentColor<Shading::Flat>(t, interp.barycentricAt(row, dx), nullptr),
+                   blend);
+      });
+      break;
+    case Shading::Gouraud:
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        writeColor(index,
+                   fragmentColor<Shading::Gouraud>(t, interp.barycentricAt(row, dx), nullptr),
+                   blend);
+      });
+      break;
+    case Shading::Phong:
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        writeColor(index, fragmentColor<Shading::Phong>(t, interp.barycentricAt(row, dx), nullptr),
+                   blend);
+      });
+      break;
+  }
+}
+
+void Renderer::shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
+                        const FragmentInterpolator& interp) {
+  switch (depth_format_) {
+    case DepthFormat::D16:
+      shadeFanFormat<DepthFormat::D16>(t, coverage, interp);
+      break;
+    case DepthFormat::D24:
+      shadeFanFormat<DepthFormat::D24>(t, coverage, interp);
+      break;
+    case DepthFormat::D32F:
+      shadeFanFormat<DepthFormat::D32F>(t, coverage, interp);
+      break;
+  }
+}
+
+// The fragment loop of tracePixel(): the same depth, test and writes as fillSpans() (the
+// same expressions; FragmentInterpolator's per-pixel forms equal its row forms), with a
+// FragmentTrace per fragment. The uncertainty channels are not computed when tracing.
+template <Shading kShading>
+void Renderer::traceSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                          const FragmentInterpolator& interp) {
+  const bool always = t.pass->depth_func == DepthFunc::Always;
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    const double cy = py + 0.5;
+    const std::size_t row =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    for (int px = x_begin; px < x_end; ++px) {
+      const double cx = px + 0.5;
+      const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
+      const double z = clampDepth(interp.depth(cx, cy));
+      const std::uint32_t key = depthKey(z, depth_format_);
+      const std::uint32_t against = depth_[index];
+      const bool pass = always || key < against;
       FragmentTrace f;
-      f.primitive = id;
+      f.primitive = t.prim->id;
       f.object = t.prim->object;
       f.barycentric = interp.barycentric(cx, cy);
       f.window_z = z;
-      f.stored_z = storedDepth(key, depth_format);
+      f.stored_z = storedDepth(key, depth_format_);
       f.depth_pass = pass;
-      f.depth_against = storedDepth(against, depth_format);
+      f.depth_against = storedDepth(against, depth_format_);
       const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading);
       if (pass) {
-        if (depth_write) depth[index] = key;
-        ids[index] = id;
-        writeColor(index, color, blend);
+        if (t.pass->depth_write) depth_[index] = key;
+        frame_.id[index] = t.prim->id;
+        writeColor(index, color, t.pass->blend);
       }
       f.color_written = storedColor(index);
       trace_->push_back(std::move(f));
-      continue;
     }
-
-    if (!pass) continue;
-    if (depth_write) depth[index] = key;
-    ids[index] = id;
-    if constexpr (kShading == Shading::Flat) {
-      if (t.constant) {  // one stored colour for the whole triangle
-        float* c = colors + 4 * index;
-        c[0] = t.constant_stored[0];
-        c[1] = t.constant_stored[1];
-        c[2] = t.constant_stored[2];
-        c[3] = t.constant_stored[3];
-        continue;
-      }
-    }
-    writeColor(index, fragmentColor<kShading>(t, interp.barycentric(cx, cy), nullptr), blend);
-  }
+  });
 }
 
 }  // namespace

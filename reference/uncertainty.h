@@ -58,29 +58,32 @@ class DepthGapTracker {
   // when `writes`, stored its depth.
   void passed(std::size_t index, double z, bool tested, bool writes) {
     Slot& s = slots_[index];
-    s.gap = tested && s.stored_by_fragment ? std::fabs(z - s.stored_z) : kInf;
-    if (writes) {
-      s.stored_z = z;
-      s.stored_by_fragment = true;
-    }
+    s.gap = tested ? std::fabs(z - s.stored_z) : kInf;  // +inf against the clear depth
+    if (writes) s.stored_z = z;
   }
   // Fragment at clamped window depth z failed the LESS test.
   void failed(std::size_t index, double z) {
     Slot& s = slots_[index];
-    if (!s.stored_by_fragment) return;
-    const double d = std::fabs(z - s.stored_z);
+    const double d = std::fabs(z - s.stored_z);  // +inf against the clear depth: ignored
     if (d < s.gap) s.gap = d;
   }
 
   // The gap in steps of the format; +inf when no comparison decided the final id.
   float gapSteps(std::size_t index, DepthFormat format) const;
+  // gapSteps() of every pixel, into out[0 .. pixels).
+  void writeSteps(DepthFormat format, float* out) const;
+
+  // The storage, for reuse between frames (reset() refills it).
+  std::size_t capacity() const { return slots_.capacity(); }
+  void release() { slots_ = {}; }
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   struct Slot {
-    double stored_z = 0.0;  // depth stored by the last writing fragment...
+    // Window depth of the fragment that stored the pixel's depth; +inf while it holds
+    // the clear depth (|z - inf| = inf, so comparisons with it never count).
+    double stored_z = kInf;
     double gap = kInf;
-    bool stored_by_fragment = false;  // ...or the clear depth when false
   };
   std::vector<Slot> slots_;
 };
