@@ -18,7 +18,7 @@ void FragmentInterpolator::setup(const WindowVertex& v0, const WindowVertex& v1,
 
   // The plane through (0, 0, f0), (e1, f1), (e2, f2) in (dx, dy, f).
   auto plane = [&](double f0, double f1, double f2) {
-    Affine a;
+    Affine a{0.0, 0.0, 0.0};
     if (degenerate) {
       a.at_ref = (f0 + f1 + f2) / 3.0;
       return a;

@@ -61,15 +61,15 @@ class FragmentInterpolator {
   glm::dvec3 barycentric(double x, double y) const { return barycentricAt(row(y), dx(x)); }
 
  private:
-  struct Affine {
-    double at_ref = 0.0;
-    double ddx = 0.0;
-    double ddy = 0.0;
+  struct Affine {  // plain data: setup() sets the planes it is asked for
+    double at_ref;
+    double ddx;
+    double ddy;
     double rowPart(double dy) const { return at_ref + ddy * dy; }
   };
 
-  double x0_ = 0.0;
-  double y0_ = 0.0;
+  double x0_;
+  double y0_;
   Affine z_;
   Affine inv_w_;   // sum(l_i / w_i)
   Affine num_[3];  // sum(l_i / w_i * bary_i[k])

@@ -146,10 +146,12 @@ class Renderer {
  private:
   void transformVertices();
   void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
+  void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
+                   int count);
   void prepareTriangle(TriangleContext& t) const;
   void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
                 const FragmentInterpolator& interp);
-  template <DepthFormat kFormat, bool kGaps, class Shade>
+  template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
   void fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
                  const FragmentInterpolator& interp, Shade&& shade);
   template <DepthFormat kFormat>
@@ -264,14 +266,6 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   }
 }
 
-// Outside the clip volume's plane set, as clipTriangle() decides it (clipper.h): a
-// triangle whose three vertices are inside every plane is drawn without clipping.
-inline bool insideAllPlanes(const glm::dvec4& c, const ClipVolume& v) {
-  return c.z + c.w >= 0.0 && c.w - c.z >= 0.0 && v.guard_x * c.w + c.x >= 0.0 &&
-         v.guard_x * c.w - c.x >= 0.0 && v.guard_y * c.w + c.y >= 0.0 &&
-         v.guard_y * c.w - c.y >= 0.0;
-}
-
 void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   const Object& obj = scene_.objects[prim.object];
   const auto& tri = obj.mesh.triangles[prim.triangle];
@@ -281,22 +275,33 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   const glm::dvec4& c2 = verts[tri[2]].clip;
   if (!isFinite(c0) || !isFinite(c1) || !isFinite(c2)) return;  // NaN/Inf geometry: dropped
 
-  ClipPolygon poly;
-  if (insideAllPlanes(c0, volume_) && insideAllPlanes(c1, volume_) &&
-      insideAllPlanes(c2, volume_)) {
-    // What clipTriangle() returns for such a triangle, without its bookkeeping.
-    poly.v[0] = {c0, {1.0, 0.0, 0.0}};
-    poly.v[1] = {c1, {0.0, 1.0, 0.0}};
-    poly.v[2] = {c2, {0.0, 0.0, 1.0}};
-    poly.count = 3;
-  } else if (!clipTriangle(c0, c1, c2, volume_, poly)) {
-    return;
+  switch (classifyTriangle(c0, c1, c2, volume_)) {
+    case ClipClass::Rejected:
+      return;
+    case ClipClass::Inside: {  // what clipTriangle() would return, without its bookkeeping
+      const ClipVertex whole[3] = {
+          {c0, {1.0, 0.0, 0.0}}, {c1, {0.0, 1.0, 0.0}}, {c2, {0.0, 0.0, 1.0}}};
+      drawPolygon(prim, pass, whole, 3);
+      return;
+    }
+    case ClipClass::Cut: {
+      ClipPolygon poly;
+      if (clipTriangle(c0, c1, c2, volume_, poly))
+        drawPolygon(prim, pass, poly.v.data(), poly.count);
+      return;
+    }
   }
+}
+
+// Draws the (clipped) polygon of one original triangle: window coordinates, snapping,
+// culling, the uncertainty channels, then each fan triangle's coverage and fragments.
+void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
+                           int count) {
   WindowVertex wv[kMaxClipVertices];
   FixedVertex fv[kMaxClipVertices];
-  for (int i = 0; i < poly.count; ++i) {
-    if (!(poly.v[i].clip.w > 0.0)) return;  // only a degenerate camera gets here
-    wv[i] = toWindow(poly.v[i], scene_.width, scene_.height);
+  for (int i = 0; i < count; ++i) {
+    if (!(poly[i].clip.w > 0.0)) return;  // only a degenerate camera gets here
+    wv[i] = toWindow(poly[i], scene_.width, scene_.height);
     if (!std::isfinite(wv[i].x) || !std::isfinite(wv[i].y) || !std::isfinite(wv[i].z)) return;
     fv[i] = snapVertexScaled(wv[i].x, wv[i].y, snap_scale_);
   }
@@ -309,10 +314,10 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   };
 
   if (uncertainty_) {
-    const double area2 = polygonArea2(wv, poly.count);
+    const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
-    if (rasterized || cullCouldFlip(wv, poly.count))
-      addEdgeDistances(wv, poly.count, clip_, fb_width_, fb_height_, frame_.edge_dist.data());
+    if (rasterized || cullCouldFlip(wv, count))
+      addEdgeDistances(wv, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data());
   }
 
   TriangleContext t;
@@ -321,7 +326,7 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   bool prepared = false;
   // The clipped polygon is drawn as a fan; each piece is culled by its own snapped area
   // (as GL implementations set up each post-clip triangle).
-  for (int i = 1; i + 1 < poly.count; ++i) {
+  for (int i = 1; i + 1 < count; ++i) {
     const std::int64_t area2 = snappedArea2(fv[0], fv[i], fv[i + 1]);
     if (area2 == 0 || culled(area2 > 0)) continue;
     TriangleCoverage coverage;
@@ -423,7 +428,7 @@ inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool 
 // clamped, quantized), the depth test, the uncertainty bookkeeping, then depth, id and
 // colour writes. `shade(index, row, dx)` writes the colour of a fragment that passed.
 // Everything constant along a row is computed once per row (FragmentInterpolator::Row).
-template <DepthFormat kFormat, bool kGaps, class Shade>
+template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
 void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
                          const FragmentInterpolator& interp, Shade&& shade) {
   const bool always = t.pass->depth_func == DepthFunc::Always;
@@ -432,7 +437,8 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
   std::uint32_t* const depth = depth_.data();
   std::uint32_t* const ids = frame_.id.data();
   coverage.forEachSpan([&](int py, int x_begin, int x_end) {
-    const FragmentInterpolator::Row row = interp.row(py + 0.5);  // pixel centres
+    const double cy = py + 0.5;  // pixel centres
+    const FragmentInterpolator::Row row = kBarycentrics ? interp.row(cy) : interp.depthRow(cy);
     const std::size_t row_index =
         static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
     for (int px = x_begin; px < x_end; ++px) {
@@ -461,9 +467,9 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
                               const FragmentInterpolator& interp) {
   auto fill = [&](auto&& shade) {
     if (uncertainty_) {
-      fillSpans<kFormat, true>(t, coverage, interp, shade);
+      fillSpans<kFormat, true, true>(t, coverage, interp, shade);
     } else {
-      fillSpans<kFormat, false>(t, coverage, interp, shade);
+      fillSpans<kFormat, false, true>(t, coverage, interp, shade);
     }
   };
   float* const colors = frame_.color.data();
@@ -473,13 +479,18 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
     const float c1 = t.constant_stored[1];
     const float c2 = t.constant_stored[2];
     const float c3 = t.constant_stored[3];
-    fill([=](std::size_t index, const FragmentInterpolator::Row&, double) {
+    auto shade = [=](std::size_t index, const FragmentInterpolator::Row&, double) {
       float* c = colors + 4 * index;
       c[0] = c0;
       c[1] = c1;
       c[2] = c2;
       c[3] = c3;
-    });
+    };
+    if (uncertainty_) {  // only the depth plane was set up
+      fillSpans<kFormat, true, false>(t, coverage, interp, shade);
+    } else {
+      fillSpans<kFormat, false, false>(t, coverage, interp, shade);
+    }
     return;
   }
   // Untextured, unblended Gouraud and Phong: fragmentColor() and writeColor() written out

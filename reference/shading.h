@@ -82,6 +82,11 @@ inline double specularPower(double base, double shininess, int exponent) {
   if (!(base > 0.0)) return 0.0;
   if (exponent < 0) return std::pow(base, shininess);
   auto e = static_cast<unsigned>(exponent);
+  if ((e & (e - 1)) == 0) {  // 2^k: the loop below multiplies 1 by base^(2^k), exactly it
+    double result = base;
+    for (e >>= 1u; e != 0; e >>= 1u) result *= result;
+    return result;
+  }
   double result = 1.0;
   double square = base;
   while (e != 0) {
@@ -122,8 +127,9 @@ PreparedShading prepareShading(const Lighting& lighting, const Material& materia
 
 // Lights world point p with unit (or zero) normal n (DESIGN.md "Shading"; the formulas
 // are at the top of this file). When terms is non-null it also records every term.
-inline LitColor shadePrepared(const PreparedShading& s, const glm::dvec3& p, const glm::dvec3& n,
-                              ShadingTerms* terms = nullptr) {
+[[gnu::always_inline]] inline LitColor shadePrepared(const PreparedShading& s, const glm::dvec3& p,
+                                                     const glm::dvec3& n,
+                                                     ShadingTerms* terms = nullptr) {
   LitColor out;
   out.ambient_diffuse = s.ambient;
   if (terms) {

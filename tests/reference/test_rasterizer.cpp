@@ -89,6 +89,16 @@ TEST(Coverage, SpanMethodsAgreeWithPerPixelTestAndOracle) {
     }
     bool ok = false;
     const TriangleCoverage c = setupCoverage(t, bits, clip, ok);
+    // forEachSpan() (incremental for narrow triangles, by division for wide ones), per row.
+    std::vector<std::pair<int, int>> spans(static_cast<std::size_t>(clip.y1), {0, 0});
+    if (ok) {
+      int last_row = -1;
+      c.forEachSpan([&](int py, int x0, int x1) {
+        ASSERT_GT(py, last_row);  // bottom to top, each row once
+        last_row = py;
+        spans[static_cast<std::size_t>(py)] = {x0, x1};
+      });
+    }
     for (int py = clip.y0; py < clip.y1; ++py) {
       int d0 = 0, d1 = 0, s0 = 0, s1 = 0;
       const bool by_div = ok && c.rowSpanByDivision(py, d0, d1);
@@ -97,6 +107,12 @@ TEST(Coverage, SpanMethodsAgreeWithPerPixelTestAndOracle) {
       if (by_div) {
         ASSERT_EQ(d0, s0) << "iter " << iter;
         ASSERT_EQ(d1, s1) << "iter " << iter;
+      }
+      const auto [f0, f1] = spans[static_cast<std::size_t>(py)];
+      ASSERT_EQ(by_div, f1 > f0) << "iter " << iter << " row " << py;
+      if (by_div) {
+        ASSERT_EQ(d0, f0) << "iter " << iter;
+        ASSERT_EQ(d1, f1) << "iter " << iter;
       }
       for (int px = clip.x0; px < clip.x1; ++px) {
         const bool expected = oracleCovers(t, px, py, bits);
