@@ -105,16 +105,20 @@ inline std::uint32_t depthKeyOf(double z01) {
   }
 }
 
-// Per-pixel working buffers that are not part of the Frame (depth keys, depth_gap state:
-// 20 bytes a pixel), kept per thread between renders so that rendering many frames does
-// not page-fault fresh memory each time; buffers over kMaxKeptScratchPixels are released
-// after the frame. Contents never carry over: every render refills them.
+// Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
+// a pixel; transformed vertices: 96 bytes each, Gouraud colours: 48), kept per thread
+// between renders so that rendering many frames does not page-fault fresh memory each
+// time; buffers over the kMaxKept* sizes are released after the frame. Contents never
+// carry over: every render refills what it reads.
 struct Scratch {
   std::vector<std::uint32_t> depth;
   DepthGapTracker gaps;
+  std::vector<std::vector<TransformedVertex>> vertices;  // per object
+  std::vector<std::vector<LitColor>> gouraud;            // per object, Gouraud only
 };
 thread_local Scratch t_scratch;
 constexpr std::size_t kMaxKeptScratchPixels = std::size_t{1} << 22;
+constexpr std::size_t kMaxKeptScratchVertices = std::size_t{1} << 20;
 
 class Renderer {
  public:
@@ -135,6 +139,8 @@ class Renderer {
         camera_(cameraTransform(scene)),
         lighting_(sceneLighting(scene)),
         volume_(clipVolume(scene.width, scene.height, guardLimitPx(options.subpixel_bits))),
+        vertices_(t_scratch.vertices),
+        gouraud_(t_scratch.gouraud),
         depth_(t_scratch.depth),
         gaps_(t_scratch.gaps) {
     shading_.reserve(scene.materials.size());
@@ -182,8 +188,8 @@ class Renderer {
   const ClipVolume volume_;
   std::vector<PreparedShading> shading_;  // per material
 
-  std::vector<std::vector<TransformedVertex>> vertices_;  // per object
-  std::vector<std::vector<LitColor>> gouraud_;            // per object, Gouraud only
+  std::vector<std::vector<TransformedVertex>>& vertices_;  // per object, scratch
+  std::vector<std::vector<LitColor>>& gouraud_;            // per object, Gouraud only, scratch
   Frame frame_;                        // colour, id, edge_dist over the clip rectangle
   std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
   DepthGapTracker& gaps_;              // scratch
@@ -191,6 +197,7 @@ class Renderer {
 
 void Renderer::transformVertices() {
   vertices_.resize(scene_.objects.size());
+  for (auto& v : vertices_) v.clear();
   const Shading shading = scene_.state.shading;
   if (shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
   for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
@@ -215,7 +222,7 @@ Frame Renderer::run() {
   frame_.allocate(fb_width_, fb_height_, clear_rgba,
                   static_cast<float>(storedDepth(clear_key, depth_format_)), uncertainty_);
   depth_.assign(frame_.pixelCount(), clear_key);
-  if (uncertainty_) gaps_.reset(frame_.pixelCount());
+  if (uncertainty_) gaps_.reset(frame_.pixelCount(), depth_format_, frame_.depth_gap.data());
 
   transformVertices();
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter))
@@ -229,9 +236,14 @@ Frame Renderer::run() {
     const double steps = depthStepsPerUnit(depth_format_);
     for (std::size_t i = 0; i < n; ++i) frame_.depth[i] = static_cast<float>(depth_[i] / steps);
   }
-  if (uncertainty_) gaps_.writeSteps(depth_format_, frame_.depth_gap.data());
   if (depth_.capacity() > kMaxKeptScratchPixels) depth_ = {};
   if (gaps_.capacity() > kMaxKeptScratchPixels) gaps_.release();
+  std::size_t kept_vertices = 0;
+  for (const auto& v : vertices_) kept_vertices += v.capacity();
+  if (kept_vertices > kMaxKeptScratchVertices) {
+    vertices_ = {};
+    gouraud_ = {};
+  }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   frame_.meta = {{"renderer", "rastercheck reference"},
@@ -249,7 +261,7 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   t.texture = t.material->texture.get();
   for (int k = 0; k < 3; ++k) {
     t.v[k] = &vertices_[t.prim->object][tri[k]];
-    if (!gouraud_.empty()) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];
+    if (scene_.state.shading == Shading::Gouraud) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];
   }
   if (scene_.state.shading != Shading::Flat) return;
   // Flat: lit once, at the original triangle's centroid, with its face normal.

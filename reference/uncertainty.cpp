@@ -9,21 +9,6 @@
 
 namespace rc::ref {
 
-float DepthGapTracker::gapSteps(std::size_t index, DepthFormat format) const {
-  const double gap = slots_[index].gap;
-  if (!std::isfinite(gap)) return std::numeric_limits<float>::infinity();
-  return static_cast<float>(gap * depthStepsPerUnit(format));
-}
-
-void DepthGapTracker::writeSteps(DepthFormat format, float* out) const {
-  const double steps = depthStepsPerUnit(format);
-  for (std::size_t i = 0; i < slots_.size(); ++i) {
-    const double gap = slots_[i].gap;
-    out[i] = std::isfinite(gap) ? static_cast<float>(gap * steps)
-                                : std::numeric_limits<float>::infinity();
-  }
-}
-
 double polygonArea2(const WindowVertex* polygon, int count) {
   double area2 = 0.0;
   for (int i = 1; i + 1 < count; ++i) {

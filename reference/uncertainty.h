@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "fixtures/scene.h"
+#include "reference/fragment_ops.h"
 #include "reference/rasterizer.h"
 #include "reference/viewport.h"
 
@@ -50,42 +51,48 @@ namespace rc::ref {
 // Flipping an opaque-pass comparison under a transparent winner can only change the final
 // id through a transparent fragment whose depth lies between the two opaque candidates;
 // that fragment's own comparison is then closer and is counted, so the minimum is the same.
+//
+// Storage: the window depth of the fragment that stored each pixel's depth (a double: the
+// gap must be exact), and the running gap already in steps, as the float the frame keeps:
+// x -> float(x * steps) never decreases, so the minimum of the converted gaps is the
+// converted minimum.
 class DepthGapTracker {
  public:
-  void reset(std::size_t pixels) { slots_.assign(pixels, Slot{}); }
+  // Starts a frame: `gap_steps` (pixels floats, the frame's depth_gap channel) must hold
+  // +inf; it receives the result as fragments arrive.
+  void reset(std::size_t pixels, DepthFormat format, float* gap_steps) {
+    stored_z_.assign(pixels, kInf);
+    steps_ = depthStepsPerUnit(format);
+    gap_ = gap_steps;
+  }
 
   // Fragment at clamped window depth z passed the test (tested: LESS; else ALWAYS) and,
   // when `writes`, stored its depth.
   void passed(std::size_t index, double z, bool tested, bool writes) {
-    Slot& s = slots_[index];
-    s.gap = tested ? std::fabs(z - s.stored_z) : kInf;  // +inf against the clear depth
-    if (writes) s.stored_z = z;
+    // +inf against the clear depth (|z - inf| = inf) and without a test.
+    gap_[index] = tested ? toSteps(std::fabs(z - stored_z_[index])) : kInfF;
+    if (writes) stored_z_[index] = z;
   }
   // Fragment at clamped window depth z failed the LESS test.
   void failed(std::size_t index, double z) {
-    Slot& s = slots_[index];
-    const double d = std::fabs(z - s.stored_z);  // +inf against the clear depth: ignored
-    if (d < s.gap) s.gap = d;
+    const float g = toSteps(std::fabs(z - stored_z_[index]));  // +inf against the clear depth
+    if (g < gap_[index]) gap_[index] = g;
   }
 
-  // The gap in steps of the format; +inf when no comparison decided the final id.
-  float gapSteps(std::size_t index, DepthFormat format) const;
-  // gapSteps() of every pixel, into out[0 .. pixels).
-  void writeSteps(DepthFormat format, float* out) const;
-
   // The storage, for reuse between frames (reset() refills it).
-  std::size_t capacity() const { return slots_.capacity(); }
-  void release() { slots_ = {}; }
+  std::size_t capacity() const { return stored_z_.capacity(); }
+  void release() { stored_z_ = {}; }
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
-  struct Slot {
-    // Window depth of the fragment that stored the pixel's depth; +inf while it holds
-    // the clear depth (|z - inf| = inf, so comparisons with it never count).
-    double stored_z = kInf;
-    double gap = kInf;
-  };
-  std::vector<Slot> slots_;
+  static constexpr float kInfF = std::numeric_limits<float>::infinity();
+  float toSteps(double gap) const { return static_cast<float>(gap * steps_); }
+
+  // Window depth of the fragment that stored the pixel's depth; +inf while it holds the
+  // clear depth (comparisons with it never count).
+  std::vector<double> stored_z_;
+  double steps_ = 1.0;
+  float* gap_ = nullptr;
 };
 
 // Twice the signed area (> 0 counter-clockwise) and the perimeter of a window polygon.

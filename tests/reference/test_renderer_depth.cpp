@@ -244,8 +244,9 @@ TEST(DepthGap, TrackerEqualsTheBruteForceDefinitionOnRandomPixels) {
       const double z = 0.25 + 0.001 * rnd(16) + (rnd(2) ? 1e-6 * rnd(8) : 0.0);
       frags.push_back({z, !always, i < opaque});
     }
+    float got = std::numeric_limits<float>::infinity();  // the frame's depth_gap pixel
     ref::DepthGapTracker tracker;
-    tracker.reset(1);
+    tracker.reset(1, format, &got);
     std::uint32_t stored = ref::depthKey(1.0, format);
     for (const TestFragment& f : frags) {
       const std::uint32_t key = ref::depthKey(f.z, format);
@@ -257,7 +258,6 @@ TEST(DepthGap, TrackerEqualsTheBruteForceDefinitionOnRandomPixels) {
       }
     }
     const double want = bruteForceGap(frags, format);
-    const float got = tracker.gapSteps(0, format);
     const float expected = std::isinf(want)
                                ? std::numeric_limits<float>::infinity()
                                : static_cast<float>(want * ref::depthStepsPerUnit(format));
