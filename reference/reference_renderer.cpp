@@ -193,6 +193,8 @@ class Renderer {
   Frame frame_;                        // colour, id, edge_dist over the clip rectangle
   std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
   DepthGapTracker& gaps_;              // scratch
+  std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
+  std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
 };
 
 void Renderer::transformVertices() {
@@ -249,6 +251,8 @@ Frame Renderer::run() {
   frame_.meta = {{"renderer", "rastercheck reference"},
                  {"subpixel_bits", options_.subpixel_bits},
                  {"painter_forced", options_.force_painter},
+                 {"triangles_rasterized", triangles_drawn_},
+                 {"fragments", fragments_},
                  {"timing_ms", {{"render", ms}}}};
   return std::move(frame_);
 }
@@ -448,7 +452,9 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
   const std::uint32_t id = t.prim->id;
   std::uint32_t* const depth = depth_.data();
   std::uint32_t* const ids = frame_.id.data();
+  ++triangles_drawn_;
   coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    fragments_ += static_cast<std::uint64_t>(x_end - x_begin);
     const double cy = py + 0.5;  // pixel centres
     const FragmentInterpolator::Row row = kBarycentrics ? interp.row(cy) : interp.depthRow(cy);
     const std::size_t row_index =

@@ -62,7 +62,7 @@ struct LitColor {
 
 // normalize(v) with zero (or a non-finite length) staying zero. One division, not three
 // (within an ulp of v / |v|).
-inline glm::dvec3 safeNormalize(const glm::dvec3& v) {
+[[gnu::always_inline]] inline glm::dvec3 safeNormalize(const glm::dvec3& v) {
   const double len = std::sqrt(glm::dot(v, v));
   if (!(len > 0.0) || !std::isfinite(len)) return glm::dvec3(0.0);
   return v * (1.0 / len);
