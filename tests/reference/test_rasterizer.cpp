@@ -250,7 +250,7 @@ TEST(Coverage, JitteredGridCoversEveryPixelExactlyOnce) {
         if (variant == 2) p = glm::round(p * 256.0) / 256.0;  // on subpixel boundaries
         grid.push_back(p);
       }
-    std::vector<int> hits(48 * 40, 0);
+    std::vector<int> hits(std::size_t{48} * 40, 0);
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const glm::dvec2 a = grid[j * (n + 1) + i], b = grid[j * (n + 1) + i + 1];
@@ -274,7 +274,7 @@ TEST(Coverage, FanAroundAPixelCentreCoversEveryPixelExactlyOnce) {
   const glm::dvec2 centre(15.5, 16.5);
   const int spokes = 37;
   const double pi = std::acos(-1.0);
-  std::vector<int> hits(32 * 32, 0);
+  std::vector<int> hits(std::size_t{32} * 32, 0);
   for (int k = 0; k < spokes; ++k) {
     const double a0 = 2 * pi * k / spokes, a1 = 2 * pi * (k + 1) / spokes;
     const glm::dvec2 p0 = centre + 40.0 * glm::dvec2(std::cos(a0), std::sin(a0));
