@@ -31,16 +31,6 @@ unsigned outcode(const glm::dvec4& c, const ClipVolume& vol) {
   return code;
 }
 
-// Outside the trivial-reject band (bits are only ever AND-ed across the three vertices).
-unsigned rejectCode(const glm::dvec4& c, const ClipVolume& vol) {
-  unsigned code = 0;
-  if (c.x > vol.reject_x * c.w) code |= 1u;
-  if (c.x < -vol.reject_x * c.w) code |= 2u;
-  if (c.y > vol.reject_y * c.w) code |= 4u;
-  if (c.y < -vol.reject_y * c.w) code |= 8u;
-  return code;
-}
-
 ClipVertex lerpFromInside(const ClipVertex& in, double d_in, const ClipVertex& out, double d_out) {
   const double t = d_in / (d_in - d_out);
   return ClipVertex{in.clip + t * (out.clip - in.clip), in.bary + t * (out.bary - in.bary)};
@@ -60,11 +50,10 @@ ClipVolume clipVolume(int width, int height, double limit_px) {
 bool clipTriangle(const glm::dvec4& c0, const glm::dvec4& c1, const glm::dvec4& c2,
                   const ClipVolume& volume, ClipPolygon& out) {
   out.count = 0;
-  if (rejectCode(c0, volume) & rejectCode(c1, volume) & rejectCode(c2, volume)) return false;
+  if (classifyTriangle(c0, c1, c2, volume) == ClipClass::Rejected) return false;
   const unsigned o0 = outcode(c0, volume);
   const unsigned o1 = outcode(c1, volume);
   const unsigned o2 = outcode(c2, volume);
-  if (o0 & o1 & o2) return false;
 
   out.v[0] = {c0, {1.0, 0.0, 0.0}};
   out.v[1] = {c1, {0.0, 1.0, 0.0}};

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 
 #include <glm/glm.hpp>
 
@@ -44,6 +45,44 @@ struct ClipPolygon {
   std::array<ClipVertex, kMaxClipVertices> v{};
   int count = 0;
 };
+
+// What clipping will do with a triangle: drop it (entirely beyond the trivial-reject band,
+// or entirely outside one plane), keep it whole (every vertex inside every plane), or cut
+// it. The renderer draws `Inside` triangles without building a ClipPolygon; clipTriangle()
+// makes the same decisions. Vertices must be finite.
+enum class ClipClass { Rejected, Inside, Cut };
+inline ClipClass classifyTriangle(const glm::dvec4& c0, const glm::dvec4& c1, const glm::dvec4& c2,
+                                  const ClipVolume& v) {
+  // Beyond +x / -x / +y / -y of the reject band, per vertex (bits AND-ed over the three).
+  auto reject = [&](const glm::dvec4& c) {
+    return (c.x > v.reject_x * c.w ? 1u : 0u) | (c.x < -v.reject_x * c.w ? 2u : 0u) |
+           (c.y > v.reject_y * c.w ? 4u : 0u) | (c.y < -v.reject_y * c.w ? 8u : 0u);
+  };
+  // Inside every plane. For finite values d = a + b >= 0 exactly when a >= -b (a rounded
+  // sum is zero only when the exact one is), so the six plane tests of clipper.cpp
+  // (z + w, w - z, g w + x, g w - x, ...) >= 0 are |z| <= w, |x| <= g w, |y| <= g w.
+  auto inside = [&](const glm::dvec4& c) {
+    return std::fabs(c.z) <= c.w && std::fabs(c.x) <= v.guard_x * c.w &&
+           std::fabs(c.y) <= v.guard_y * c.w;
+  };
+  if (inside(c0) && inside(c1) && inside(c2)) {  // the common case: only the band can drop it
+    // reject() of the three vertices AND-ed, side by side (-(r w) == (-r) w exactly).
+    const double x0 = v.reject_x * c0.w, x1 = v.reject_x * c1.w, x2 = v.reject_x * c2.w;
+    const double y0 = v.reject_y * c0.w, y1 = v.reject_y * c1.w, y2 = v.reject_y * c2.w;
+    const bool beyond =
+        (c0.x > x0 && c1.x > x1 && c2.x > x2) || (c0.x < -x0 && c1.x < -x1 && c2.x < -x2) ||
+        (c0.y > y0 && c1.y > y1 && c2.y > y2) || (c0.y < -y0 && c1.y < -y1 && c2.y < -y2);
+    return beyond ? ClipClass::Rejected : ClipClass::Inside;
+  }
+  if (reject(c0) & reject(c1) & reject(c2)) return ClipClass::Rejected;
+  // Outside each plane (distance < 0; see clipper.cpp's plane list), per vertex.
+  auto outside = [&](const glm::dvec4& c) {
+    return (c.z + c.w >= 0.0 ? 0u : 1u) | (c.w - c.z >= 0.0 ? 0u : 2u) |
+           (v.guard_x * c.w + c.x >= 0.0 ? 0u : 4u) | (v.guard_x * c.w - c.x >= 0.0 ? 0u : 8u) |
+           (v.guard_y * c.w + c.y >= 0.0 ? 0u : 16u) | (v.guard_y * c.w - c.y >= 0.0 ? 0u : 32u);
+  };
+  return (outside(c0) & outside(c1) & outside(c2)) ? ClipClass::Rejected : ClipClass::Cut;
+}
 
 // Clips the triangle (clip-space positions of the original vertices 0, 1, 2). Returns
 // false (and count 0) when nothing of it is inside. Intersections are always computed

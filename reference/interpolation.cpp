@@ -6,7 +6,7 @@
 namespace rc::ref {
 
 void FragmentInterpolator::setup(const WindowVertex& v0, const WindowVertex& v1,
-                                 const WindowVertex& v2) {
+                                 const WindowVertex& v2, bool barycentrics) {
   x0_ = v0.x;
   y0_ = v0.y;
   const double e1x = v1.x - v0.x;
@@ -18,7 +18,7 @@ void FragmentInterpolator::setup(const WindowVertex& v0, const WindowVertex& v1,
 
   // The plane through (0, 0, f0), (e1, f1), (e2, f2) in (dx, dy, f).
   auto plane = [&](double f0, double f1, double f2) {
-    Affine a;
+    Affine a{0.0, 0.0, 0.0};
     if (degenerate) {
       a.at_ref = (f0 + f1 + f2) / 3.0;
       return a;
@@ -32,6 +32,7 @@ void FragmentInterpolator::setup(const WindowVertex& v0, const WindowVertex& v1,
   };
 
   z_ = plane(v0.z, v1.z, v2.z);
+  if (!barycentrics) return;
   inv_w_ = plane(v0.inv_w, v1.inv_w, v2.inv_w);
   for (int k = 0; k < 3; ++k) {
     num_[k] = plane(v0.inv_w * v0.bary[k], v1.inv_w * v1.bary[k], v2.inv_w * v2.bary[k]);

@@ -21,31 +21,55 @@ class FragmentInterpolator {
  public:
   // A zero (or non-finite) unsnapped area has no gradients: every fragment then gets the
   // vertices' mean values (only reachable when snapping gave a sliver non-zero area).
-  void setup(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2);
+  // Without `barycentrics` only the depth plane is set up (a triangle of one colour).
+  void setup(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+             bool barycentrics = true);
 
-  // Window z at window point (x, y), not clamped.
-  double depth(double x, double y) const { return z_(x - x0_, y - y0_); }
-
-  // Perspective-correct barycentrics of the original triangle at (x, y).
-  glm::dvec3 barycentric(double x, double y) const {
-    const double dx = x - x0_;
+  // Every plane is evaluated as (f(vertex 0) + df/dy * dy) + df/dx * dx, always in this
+  // order, so that the span loops, which compute the parenthesis once per row (Row), and
+  // the per-pixel forms below give bit-identical values at every optimisation level.
+  struct Row {
+    double z = 0.0;
+    double inv_w = 0.0;
+    double num[3] = {0.0, 0.0, 0.0};
+  };
+  Row row(double y) const {
     const double dy = y - y0_;
-    const double inv = 1.0 / inv_w_(dx, dy);
-    return glm::dvec3(num_[0](dx, dy) * inv, num_[1](dx, dy) * inv, num_[2](dx, dy) * inv);
+    Row r;
+    r.z = z_.rowPart(dy);
+    r.inv_w = inv_w_.rowPart(dy);
+    for (int k = 0; k < 3; ++k) r.num[k] = num_[k].rowPart(dy);
+    return r;
+  }
+  Row depthRow(double y) const {  // only Row::z
+    Row r;
+    r.z = z_.rowPart(y - y0_);
+    return r;
+  }
+  double dx(double x) const { return x - x0_; }
+  double depthAt(const Row& r, double dx) const { return r.z + z_.ddx * dx; }
+  glm::dvec3 barycentricAt(const Row& r, double dx) const {
+    const double inv = 1.0 / (r.inv_w + inv_w_.ddx * dx);
+    return glm::dvec3((r.num[0] + num_[0].ddx * dx) * inv, (r.num[1] + num_[1].ddx * dx) * inv,
+                      (r.num[2] + num_[2].ddx * dx) * inv);
   }
 
+  // Window z at window point (x, y), not clamped.
+  double depth(double x, double y) const { return depthAt(depthRow(y), dx(x)); }
+
+  // Perspective-correct barycentrics of the original triangle at (x, y).
+  glm::dvec3 barycentric(double x, double y) const { return barycentricAt(row(y), dx(x)); }
+
  private:
-  // f(dx, dy) = f(vertex 0) + dy * df/dy + dx * df/dx, always in this order, so every
-  // caller (render, trace, -O0, -O2) gets bit-identical values.
-  struct Affine {
-    double at_ref = 0.0;
-    double ddx = 0.0;
-    double ddy = 0.0;
-    double operator()(double dx, double dy) const { return (at_ref + ddy * dy) + ddx * dx; }
+  struct Affine {  // plain data: setup() sets the planes it is asked for
+    double at_ref;
+    double ddx;
+    double ddy;
+    double rowPart(double dy) const { return at_ref + ddy * dy; }
   };
 
-  double x0_ = 0.0;
-  double y0_ = 0.0;
+  double x0_;
+  double y0_;
   Affine z_;
   Affine inv_w_;   // sum(l_i / w_i)
   Affine num_[3];  // sum(l_i / w_i * bary_i[k])

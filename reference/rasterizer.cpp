@@ -21,14 +21,6 @@ std::int64_t ceilDiv(std::int64_t n, std::int64_t d) {
   return q;
 }
 
-int clampToInt(std::int64_t v, int lo, int hi) {
-  return static_cast<int>(std::clamp<std::int64_t>(v, lo, hi));
-}
-
-// Triangles at most this many pixels wide get their row spans by scanning (cheaper than
-// three 64-bit divisions per row).
-constexpr int kScanWidth = 16;
-
 }  // namespace
 
 double guardLimitPx(int subpixel_bits) {
@@ -36,42 +28,7 @@ double guardLimitPx(int subpixel_bits) {
 }
 
 FixedVertex snapVertex(double window_x, double window_y, int subpixel_bits) {
-  const double scale = std::ldexp(1.0, subpixel_bits);
-  return FixedVertex{static_cast<std::int64_t>(roundHalfEven((window_x - 0.5) * scale)),
-                     static_cast<std::int64_t>(roundHalfEven((window_y - 0.5) * scale))};
-}
-
-std::int64_t snappedArea2(const FixedVertex& v0, const FixedVertex& v1, const FixedVertex& v2) {
-  return (v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y);
-}
-
-bool TriangleCoverage::setup(const FixedVertex& v0, const FixedVertex& v1, const FixedVertex& v2,
-                             int subpixel_bits, const PixelRect& clip) {
-  const std::int64_t area2 = snappedArea2(v0, v1, v2);
-  if (area2 == 0) return false;
-  // Counter-clockwise order, so that the inside of every edge is E > 0.
-  const FixedVertex v[3] = {v0, area2 > 0 ? v1 : v2, area2 > 0 ? v2 : v1};
-  for (int i = 0; i < 3; ++i) {
-    const FixedVertex& p = v[i];
-    const FixedVertex& q = v[(i + 1) % 3];
-    const std::int64_t A = p.y - q.y;  // inward normal (A, B)
-    const std::int64_t B = q.x - p.x;
-    const bool includes_ties = A > 0 || (A == 0 && B > 0);
-    edges_[i].a = A * (std::int64_t{1} << subpixel_bits);
-    edges_[i].b = B * (std::int64_t{1} << subpixel_bits);
-    edges_[i].c = -A * p.x - B * p.y + (includes_ties ? 1 : 0);
-  }
-  // Pixel centres inside the snapped bounding box, within the clip rectangle.
-  const std::int64_t min_x = std::min({v0.x, v1.x, v2.x});
-  const std::int64_t max_x = std::max({v0.x, v1.x, v2.x});
-  const std::int64_t min_y = std::min({v0.y, v1.y, v2.y});
-  const std::int64_t max_y = std::max({v0.y, v1.y, v2.y});
-  const std::int64_t one = std::int64_t{1} << subpixel_bits;
-  col_begin_ = clampToInt(ceilDiv(min_x, one), clip.x0, clip.x1);
-  col_end_ = clampToInt(floorDiv(max_x, one) + 1, clip.x0, clip.x1);
-  row_begin_ = clampToInt(ceilDiv(min_y, one), clip.y0, clip.y1);
-  row_end_ = clampToInt(floorDiv(max_y, one) + 1, clip.y0, clip.y1);
-  return col_begin_ < col_end_ && row_begin_ < row_end_;
+  return snapVertexScaled(window_x, window_y, std::ldexp(1.0, subpixel_bits));
 }
 
 bool TriangleCoverage::covers(int px, int py) const {

@@ -81,6 +81,7 @@ struct TriangleContext {
   const PrimitiveRef* prim = nullptr;
   const DrawPass* pass = nullptr;
   const Material* material = nullptr;
+  const PreparedShading* shading = nullptr;
   const Texture* texture = nullptr;
   const TransformedVertex* v[3] = {nullptr, nullptr, nullptr};
   const LitColor* gouraud[3] = {nullptr, nullptr, nullptr};  // per original vertex
@@ -90,6 +91,34 @@ struct TriangleContext {
   bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
 };
+
+// The depth key of a fragment at clamped window depth z01 (fragment_ops.h depthKey, with
+// the format fixed at compile time for the span loops).
+template <DepthFormat kFormat>
+inline std::uint32_t depthKeyOf(double z01) {
+  if constexpr (kFormat == DepthFormat::D16) {
+    return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 65535.0));
+  } else if constexpr (kFormat == DepthFormat::D24) {
+    return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 16777215.0));
+  } else {
+    return std::bit_cast<std::uint32_t>(static_cast<float>(z01));
+  }
+}
+
+// Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
+// a pixel; transformed vertices: 96 bytes each, Gouraud colours: 48), kept per thread
+// between renders so that rendering many frames does not page-fault fresh memory each
+// time; buffers over the kMaxKept* sizes are released after the frame. Contents never
+// carry over: every render refills what it reads.
+struct Scratch {
+  std::vector<std::uint32_t> depth;
+  DepthGapTracker gaps;
+  std::vector<std::vector<TransformedVertex>> vertices;  // per object
+  std::vector<std::vector<LitColor>> gouraud;            // per object, Gouraud only
+};
+thread_local Scratch t_scratch;
+constexpr std::size_t kMaxKeptScratchPixels = std::size_t{1} << 22;
+constexpr std::size_t kMaxKeptScratchVertices = std::size_t{1} << 20;
 
 class Renderer {
  public:
@@ -106,19 +135,37 @@ class Renderer {
         uncertainty_(options.uncertainty && trace == nullptr),
         depth_format_(scene.state.depth_format),
         color_format_(scene.state.color_format),
+        snap_scale_(std::ldexp(1.0, options.subpixel_bits)),
         camera_(cameraTransform(scene)),
         lighting_(sceneLighting(scene)),
-        volume_(clipVolume(scene.width, scene.height, guardLimitPx(options.subpixel_bits))) {}
+        volume_(clipVolume(scene.width, scene.height, guardLimitPx(options.subpixel_bits))),
+        vertices_(t_scratch.vertices),
+        gouraud_(t_scratch.gouraud),
+        depth_(t_scratch.depth),
+        gaps_(t_scratch.gaps) {
+    shading_.reserve(scene.materials.size());
+    for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
+  }
 
   Frame run();
 
  private:
   void transformVertices();
   void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
+  void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
+                   int count);
   void prepareTriangle(TriangleContext& t) const;
-  template <Shading kShading, bool kTrace>
-  void shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py, int x_begin,
-                 int x_end);
+  void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
+                const FragmentInterpolator& interp);
+  template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
+  void fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                 const FragmentInterpolator& interp, Shade&& shade);
+  template <DepthFormat kFormat>
+  void shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
+                      const FragmentInterpolator& interp);
+  template <Shading kShading>
+  void traceSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                  const FragmentInterpolator& interp);
   template <Shading kShading>
   glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b,
                            ShadingTerms* terms) const;
@@ -135,31 +182,37 @@ class Renderer {
   const bool uncertainty_;
   const DepthFormat depth_format_;
   const ColorFormat color_format_;
+  const double snap_scale_;  // 2^subpixel_bits
   const CameraTransform camera_;
   const Lighting lighting_;
   const ClipVolume volume_;
+  std::vector<PreparedShading> shading_;  // per material
 
-  std::vector<std::vector<TransformedVertex>> vertices_;  // per object
-  std::vector<std::vector<LitColor>> gouraud_;            // per object, Gouraud only
-  Frame frame_;                       // colour, id, edge_dist over the clip rectangle
-  std::vector<std::uint32_t> depth_;  // depth keys (fragment_ops.h)
-  DepthGapTracker gaps_;
+  std::vector<std::vector<TransformedVertex>>& vertices_;  // per object, scratch
+  std::vector<std::vector<LitColor>>& gouraud_;            // per object, Gouraud only, scratch
+  Frame frame_;                        // colour, id, edge_dist over the clip rectangle
+  std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
+  DepthGapTracker& gaps_;              // scratch
+  std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
+  std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
 };
 
 void Renderer::transformVertices() {
   vertices_.resize(scene_.objects.size());
-  if (scene_.state.shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
+  for (auto& v : vertices_) v.clear();
+  const Shading shading = scene_.state.shading;
+  if (shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
   for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
     const Object& obj = scene_.objects[o];
     if (obj.mesh.triangles.empty()) continue;
-    transformObject(obj, camera_, vertices_[o]);
-    if (scene_.state.shading != Shading::Gouraud) continue;
+    // Flat shading lights the face normal: vertex normals would go unused (unless traced).
+    transformObject(obj, camera_, vertices_[o], shading != Shading::Flat || trace_ != nullptr);
+    if (shading != Shading::Gouraud) continue;
     // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
-    const Material& material = scene_.materials[obj.material];
+    const PreparedShading& prepared = shading_[obj.material];
     gouraud_[o].resize(vertices_[o].size());
     for (std::size_t i = 0; i < vertices_[o].size(); ++i)
-      gouraud_[o][i] =
-          shadePoint(lighting_, material, vertices_[o][i].world, vertices_[o][i].normal);
+      gouraud_[o][i] = shadePrepared(prepared, vertices_[o][i].world, vertices_[o][i].normal);
   }
 }
 
@@ -171,7 +224,7 @@ Frame Renderer::run() {
   frame_.allocate(fb_width_, fb_height_, clear_rgba,
                   static_cast<float>(storedDepth(clear_key, depth_format_)), uncertainty_);
   depth_.assign(frame_.pixelCount(), clear_key);
-  if (uncertainty_) gaps_.reset(frame_.pixelCount());
+  if (uncertainty_) gaps_.reset(frame_.pixelCount(), depth_format_, frame_.depth_gap.data());
 
   transformVertices();
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter))
@@ -185,13 +238,21 @@ Frame Renderer::run() {
     const double steps = depthStepsPerUnit(depth_format_);
     for (std::size_t i = 0; i < n; ++i) frame_.depth[i] = static_cast<float>(depth_[i] / steps);
   }
-  if (uncertainty_)
-    for (std::size_t i = 0; i < n; ++i) frame_.depth_gap[i] = gaps_.gapSteps(i, depth_format_);
+  if (depth_.capacity() > kMaxKeptScratchPixels) depth_ = {};
+  if (gaps_.capacity() > kMaxKeptScratchPixels) gaps_.release();
+  std::size_t kept_vertices = 0;
+  for (const auto& v : vertices_) kept_vertices += v.capacity();
+  if (kept_vertices > kMaxKeptScratchVertices) {
+    vertices_ = {};
+    gouraud_ = {};
+  }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   frame_.meta = {{"renderer", "rastercheck reference"},
                  {"subpixel_bits", options_.subpixel_bits},
                  {"painter_forced", options_.force_painter},
+                 {"triangles_rasterized", triangles_drawn_},
+                 {"fragments", fragments_},
                  {"timing_ms", {{"render", ms}}}};
   return std::move(frame_);
 }
@@ -200,10 +261,11 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   const Object& obj = scene_.objects[t.prim->object];
   const auto& tri = obj.mesh.triangles[t.prim->triangle];
   t.material = &scene_.materials[obj.material];
+  t.shading = &shading_[obj.material];
   t.texture = t.material->texture.get();
   for (int k = 0; k < 3; ++k) {
     t.v[k] = &vertices_[t.prim->object][tri[k]];
-    if (!gouraud_.empty()) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];
+    if (scene_.state.shading == Shading::Gouraud) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];
   }
   if (scene_.state.shading != Shading::Flat) return;
   // Flat: lit once, at the original triangle's centroid, with its face normal.
@@ -212,7 +274,7 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   const glm::dvec3& p2 = t.v[2]->world;
   t.centroid = (p0 + p1 + p2) / 3.0;
   t.face_normal = safeNormalize(glm::cross(p1 - p0, p2 - p0));
-  t.flat = shadePoint(lighting_, *t.material, t.centroid, t.face_normal);
+  t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
   t.constant = t.texture == nullptr && !t.pass->blend;
   if (t.constant) {
     const glm::dvec4 c = finalColor(t.flat, glm::dvec3(1.0), t.material->opacity);
@@ -229,15 +291,35 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   const glm::dvec4& c2 = verts[tri[2]].clip;
   if (!isFinite(c0) || !isFinite(c1) || !isFinite(c2)) return;  // NaN/Inf geometry: dropped
 
-  ClipPolygon poly;
-  if (!clipTriangle(c0, c1, c2, volume_, poly)) return;
+  switch (classifyTriangle(c0, c1, c2, volume_)) {
+    case ClipClass::Rejected:
+      return;
+    case ClipClass::Inside: {  // what clipTriangle() would return, without its bookkeeping
+      const ClipVertex whole[3] = {
+          {c0, {1.0, 0.0, 0.0}}, {c1, {0.0, 1.0, 0.0}}, {c2, {0.0, 0.0, 1.0}}};
+      drawPolygon(prim, pass, whole, 3);
+      return;
+    }
+    case ClipClass::Cut: {
+      ClipPolygon poly;
+      if (clipTriangle(c0, c1, c2, volume_, poly))
+        drawPolygon(prim, pass, poly.v.data(), poly.count);
+      return;
+    }
+  }
+}
+
+// Draws the (clipped) polygon of one original triangle: window coordinates, snapping,
+// culling, the uncertainty channels, then each fan triangle's coverage and fragments.
+void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
+                           int count) {
   WindowVertex wv[kMaxClipVertices];
   FixedVertex fv[kMaxClipVertices];
-  for (int i = 0; i < poly.count; ++i) {
-    if (!(poly.v[i].clip.w > 0.0)) return;  // only a degenerate camera gets here
-    wv[i] = toWindow(poly.v[i], scene_.width, scene_.height);
+  for (int i = 0; i < count; ++i) {
+    if (!(poly[i].clip.w > 0.0)) return;  // only a degenerate camera gets here
+    wv[i] = toWindow(poly[i], scene_.width, scene_.height);
     if (!std::isfinite(wv[i].x) || !std::isfinite(wv[i].y) || !std::isfinite(wv[i].z)) return;
-    fv[i] = snapVertex(wv[i].x, wv[i].y, options_.subpixel_bits);
+    fv[i] = snapVertexScaled(wv[i].x, wv[i].y, snap_scale_);
   }
 
   const bool ccw_is_front = scene_.state.front_face == FrontFace::CCW;
@@ -248,10 +330,10 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   };
 
   if (uncertainty_) {
-    const double area2 = polygonArea2(wv, poly.count);
+    const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
-    if (rasterized || cullCouldFlip(wv, poly.count))
-      addEdgeDistances(wv, poly.count, clip_, fb_width_, fb_height_, frame_.edge_dist.data());
+    if (rasterized || cullCouldFlip(wv, count))
+      addEdgeDistances(wv, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data());
   }
 
   TriangleContext t;
@@ -260,35 +342,33 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   bool prepared = false;
   // The clipped polygon is drawn as a fan; each piece is culled by its own snapped area
   // (as GL implementations set up each post-clip triangle).
-  for (int i = 1; i + 1 < poly.count; ++i) {
+  for (int i = 1; i + 1 < count; ++i) {
     const std::int64_t area2 = snappedArea2(fv[0], fv[i], fv[i + 1]);
     if (area2 == 0 || culled(area2 > 0)) continue;
     TriangleCoverage coverage;
     if (!coverage.setup(fv[0], fv[i], fv[i + 1], options_.subpixel_bits, clip_)) continue;
-    FragmentInterpolator interp;
-    interp.setup(wv[0], wv[i], wv[i + 1]);
     if (!prepared) {
       prepareTriangle(t);
       prepared = true;
     }
-    auto run = [&](auto span) {
-      coverage.forEachSpan([&](int py, int x0, int x1) { (this->*span)(t, interp, py, x0, x1); });
-    };
-    const bool tracing = trace_ != nullptr;
-    switch (scene_.state.shading) {
-      case Shading::Flat:
-        tracing ? run(&Renderer::shadeSpan<Shading::Flat, true>)
-                : run(&Renderer::shadeSpan<Shading::Flat, false>);
-        break;
-      case Shading::Gouraud:
-        tracing ? run(&Renderer::shadeSpan<Shading::Gouraud, true>)
-                : run(&Renderer::shadeSpan<Shading::Gouraud, false>);
-        break;
-      case Shading::Phong:
-        tracing ? run(&Renderer::shadeSpan<Shading::Phong, true>)
-                : run(&Renderer::shadeSpan<Shading::Phong, false>);
-        break;
+    FragmentInterpolator interp;
+    // A triangle of one stored colour needs no barycentrics (unless traced).
+    interp.setup(wv[0], wv[i], wv[i + 1], !t.constant || trace_ != nullptr);
+    if (trace_ != nullptr) {
+      switch (scene_.state.shading) {
+        case Shading::Flat:
+          traceSpans<Shading::Flat>(t, coverage, interp);
+          break;
+        case Shading::Gouraud:
+          traceSpans<Shading::Gouraud>(t, coverage, interp);
+          break;
+        case Shading::Phong:
+          traceSpans<Shading::Phong>(t, coverage, interp);
+          break;
+      }
+      continue;
     }
+    shadeFan(t, coverage, interp);
   }
 }
 
@@ -313,7 +393,7 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
     const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
     const glm::dvec3 n =
         safeNormalize(b.x * t.v[0]->normal + b.y * t.v[1]->normal + b.z * t.v[2]->normal);
-    lit = shadePoint(lighting_, *t.material, p, n, terms);
+    lit = shadePrepared(*t.shading, p, n, terms);
   }
   const glm::dvec4 color = finalColor(lit, tex, t.material->opacity);
   if (terms) {
@@ -329,12 +409,11 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
 void Renderer::traceTerms(const TriangleContext& t, const glm::dvec3& b,
                           ShadingTerms& terms) const {
   if (scene_.state.shading == Shading::Flat) {
-    shadePoint(lighting_, *t.material, t.centroid, t.face_normal, &terms);
+    shadePrepared(*t.shading, t.centroid, t.face_normal, &terms);
     return;
   }
   ShadingTerms vt[3];
-  for (int k = 0; k < 3; ++k)
-    shadePoint(lighting_, *t.material, t.v[k]->world, t.v[k]->normal, &vt[k]);
+  for (int k = 0; k < 3; ++k) shadePrepared(*t.shading, t.v[k]->world, t.v[k]->normal, &vt[k]);
   terms.ambient = b.x * vt[0].ambient + b.y * vt[1].ambient + b.z * vt[2].ambient;
   terms.lights.assign(vt[0].lights.size(), LightTerms{});
   for (std::size_t i = 0; i < terms.lights.size(); ++i) {
@@ -361,65 +440,199 @@ inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool 
   for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
 }
 
-template <Shading kShading, bool kTrace>
-void Renderer::shadeSpan(const TriangleContext& t, const FragmentInterpolator& interp, int py,
-                         int x_begin, int x_end) {
-  const double cy = py + 0.5;  // pixel centres
-  const std::size_t row =
-      static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+// The fragment loop: for every covered pixel centre, depth (from the unsnapped plane,
+// clamped, quantized), the depth test, the uncertainty bookkeeping, then depth, id and
+// colour writes. `shade(index, row, dx)` writes the colour of a fragment that passed.
+// Everything constant along a row is computed once per row (FragmentInterpolator::Row).
+template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
+void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                         const FragmentInterpolator& interp, Shade&& shade) {
   const bool always = t.pass->depth_func == DepthFunc::Always;
   const bool depth_write = t.pass->depth_write;
-  const bool blend = t.pass->blend;
-  const bool track_gaps = uncertainty_;
-  const DepthFormat depth_format = depth_format_;
-  std::uint32_t* const depth = depth_.data();  // locals: the stores below cannot alias them
-  std::uint32_t* const ids = frame_.id.data();
-  float* const colors = frame_.color.data();
   const std::uint32_t id = t.prim->id;
-  for (int px = x_begin; px < x_end; ++px) {
-    const double cx = px + 0.5;
-    const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
-    const double z = clampDepth(interp.depth(cx, cy));
-    if (track_gaps) gaps_.add(index, z);
-    const std::uint32_t key = depthKey(z, depth_format);
-    const std::uint32_t against = depth[index];
-    const bool pass = always || key < against;
+  std::uint32_t* const depth = depth_.data();
+  std::uint32_t* const ids = frame_.id.data();
+  ++triangles_drawn_;
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    fragments_ += static_cast<std::uint64_t>(x_end - x_begin);
+    const double cy = py + 0.5;  // pixel centres
+    const FragmentInterpolator::Row row = kBarycentrics ? interp.row(cy) : interp.depthRow(cy);
+    const std::size_t row_index =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    for (int px = x_begin; px < x_end; ++px) {
+      const double dx = interp.dx(px + 0.5);
+      const std::size_t index = row_index + static_cast<std::size_t>(px - clip_.x0);
+      const double z = clampDepth(interp.depthAt(row, dx));
+      const std::uint32_t key = depthKeyOf<kFormat>(z);
+      const bool pass = always || key < depth[index];
+      if constexpr (kGaps) {
+        if (pass) {
+          gaps_.passed(index, z, !always, depth_write);
+        } else {
+          gaps_.failed(index, z);
+        }
+      }
+      if (!pass) continue;
+      if (depth_write) depth[index] = key;
+      ids[index] = id;
+      shade(index, row, dx);
+    }
+  });
+}
 
-    if constexpr (kTrace) {
+template <DepthFormat kFormat>
+void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
+                              const FragmentInterpolator& interp) {
+  auto fill = [&](auto&& shade) {
+    if (uncertainty_) {
+      fillSpans<kFormat, true, true>(t, coverage, interp, shade);
+    } else {
+      fillSpans<kFormat, false, true>(t, coverage, interp, shade);
+    }
+  };
+  float* const colors = frame_.color.data();
+  const bool blend = t.pass->blend;
+  if (t.constant) {  // one stored colour for the whole triangle
+    const float c0 = t.constant_stored[0];
+    const float c1 = t.constant_stored[1];
+    const float c2 = t.constant_stored[2];
+    const float c3 = t.constant_stored[3];
+    auto shade = [=](std::size_t index, const FragmentInterpolator::Row&, double) {
+      float* c = colors + 4 * index;
+      c[0] = c0;
+      c[1] = c1;
+      c[2] = c2;
+      c[3] = c3;
+    };
+    if (uncertainty_) {  // only the depth plane was set up
+      fillSpans<kFormat, true, false>(t, coverage, interp, shade);
+    } else {
+      fillSpans<kFormat, false, false>(t, coverage, interp, shade);
+    }
+    return;
+  }
+  // Untextured, unblended Gouraud and Phong: fragmentColor() and writeColor() written out
+  // with the triangle's constants in locals (the same expressions: an untextured colour is
+  // (ambient + diffuse) * 1 + specular, and x * 1 == x exactly).
+  if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat) {
+    const bool rgba8 = color_format_ == ColorFormat::RGBA8;
+    const float alpha = storeColor(t.material->opacity, color_format_);
+    auto store = [=](std::size_t index, const glm::dvec3& c) {
+      float* out = colors + 4 * index;
+      if (rgba8) {
+        out[0] = storeColor(c.x, ColorFormat::RGBA8);
+        out[1] = storeColor(c.y, ColorFormat::RGBA8);
+        out[2] = storeColor(c.z, ColorFormat::RGBA8);
+      } else {
+        out[0] = static_cast<float>(c.x);
+        out[1] = static_cast<float>(c.y);
+        out[2] = static_cast<float>(c.z);
+      }
+      out[3] = alpha;
+    };
+    if (scene_.state.shading == Shading::Gouraud) {
+      const LitColor g0 = *t.gouraud[0];
+      const LitColor g1 = *t.gouraud[1];
+      const LitColor g2 = *t.gouraud[2];
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        const glm::dvec3 b = interp.barycentricAt(row, dx);
+        const glm::dvec3 ad =
+            b.x * g0.ambient_diffuse + b.y * g1.ambient_diffuse + b.z * g2.ambient_diffuse;
+        const glm::dvec3 sp = b.x * g0.specular + b.y * g1.specular + b.z * g2.specular;
+        store(index, ad + sp);
+      });
+    } else {
+      const glm::dvec3 w0 = t.v[0]->world;
+      const glm::dvec3 w1 = t.v[1]->world;
+      const glm::dvec3 w2 = t.v[2]->world;
+      const glm::dvec3 n0 = t.v[0]->normal;
+      const glm::dvec3 n1 = t.v[1]->normal;
+      const glm::dvec3 n2 = t.v[2]->normal;
+      const PreparedShading& shading = *t.shading;
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        const glm::dvec3 b = interp.barycentricAt(row, dx);
+        const glm::dvec3 p = b.x * w0 + b.y * w1 + b.z * w2;
+        const glm::dvec3 n = safeNormalize(b.x * n0 + b.y * n1 + b.z * n2);
+        const LitColor lit = shadePrepared(shading, p, n);
+        store(index, lit.ambient_diffuse + lit.specular);
+      });
+    }
+    return;
+  }
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        writeColor(index, fragmentColor<Shading::Flat>(t, interp.barycentricAt(row, dx), nullptr),
+                   blend);
+      });
+      break;
+    case Shading::Gouraud:
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        writeColor(index,
+                   fragmentColor<Shading::Gouraud>(t, interp.barycentricAt(row, dx), nullptr),
+                   blend);
+      });
+      break;
+    case Shading::Phong:
+      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+        writeColor(index, fragmentColor<Shading::Phong>(t, interp.barycentricAt(row, dx), nullptr),
+                   blend);
+      });
+      break;
+  }
+}
+
+void Renderer::shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
+                        const FragmentInterpolator& interp) {
+  switch (depth_format_) {
+    case DepthFormat::D16:
+      shadeFanFormat<DepthFormat::D16>(t, coverage, interp);
+      break;
+    case DepthFormat::D24:
+      shadeFanFormat<DepthFormat::D24>(t, coverage, interp);
+      break;
+    case DepthFormat::D32F:
+      shadeFanFormat<DepthFormat::D32F>(t, coverage, interp);
+      break;
+  }
+}
+
+// The fragment loop of tracePixel(): the same depth, test and writes as fillSpans() (the
+// same expressions; FragmentInterpolator's per-pixel forms equal its row forms), with a
+// FragmentTrace per fragment. The uncertainty channels are not computed when tracing.
+template <Shading kShading>
+void Renderer::traceSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                          const FragmentInterpolator& interp) {
+  const bool always = t.pass->depth_func == DepthFunc::Always;
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    const double cy = py + 0.5;
+    const std::size_t row =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    for (int px = x_begin; px < x_end; ++px) {
+      const double cx = px + 0.5;
+      const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
+      const double z = clampDepth(interp.depth(cx, cy));
+      const std::uint32_t key = depthKey(z, depth_format_);
+      const std::uint32_t against = depth_[index];
+      const bool pass = always || key < against;
       FragmentTrace f;
-      f.primitive = id;
+      f.primitive = t.prim->id;
       f.object = t.prim->object;
       f.barycentric = interp.barycentric(cx, cy);
       f.window_z = z;
-      f.stored_z = storedDepth(key, depth_format);
+      f.stored_z = storedDepth(key, depth_format_);
       f.depth_pass = pass;
-      f.depth_against = storedDepth(against, depth_format);
+      f.depth_against = storedDepth(against, depth_format_);
       const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading);
       if (pass) {
-        if (depth_write) depth[index] = key;
-        ids[index] = id;
-        writeColor(index, color, blend);
+        if (t.pass->depth_write) depth_[index] = key;
+        frame_.id[index] = t.prim->id;
+        writeColor(index, color, t.pass->blend);
       }
       f.color_written = storedColor(index);
       trace_->push_back(std::move(f));
-      continue;
     }
-
-    if (!pass) continue;
-    if (depth_write) depth[index] = key;
-    ids[index] = id;
-    if constexpr (kShading == Shading::Flat) {
-      if (t.constant) {  // one stored colour for the whole triangle
-        float* c = colors + 4 * index;
-        c[0] = t.constant_stored[0];
-        c[1] = t.constant_stored[1];
-        c[2] = t.constant_stored[2];
-        c[3] = t.constant_stored[3];
-        continue;
-      }
-    }
-    writeColor(index, fragmentColor<kShading>(t, interp.barycentric(cx, cy), nullptr), blend);
-  }
+  });
 }
 
 }  // namespace

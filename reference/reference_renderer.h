@@ -33,7 +33,10 @@ struct ReferenceOptions {
 // [0, 12]), images larger than 16384 px a side or 2^26 px in all, and inconsistent
 // scenes (material index, normal/uv counts, vertex indices, texture sizes). NaN or
 // infinite geometry is not an error: those triangles are dropped.
-// frame.meta: {"renderer", "subpixel_bits", "painter_forced", "timing_ms": {"render"}}.
+// frame.meta: {"renderer", "subpixel_bits", "painter_forced", "triangles_rasterized" (fan
+// triangles, after clipping and culling, that covered a pixel centre's bounding box),
+// "fragments" (covered pixel centres, whether they passed the depth test or not),
+// "timing_ms": {"render"}}.
 Frame renderReference(const Scene& scene, const ReferenceOptions& options = {});
 
 // One fragment that reached a pixel, in draw order (`rastercheck explain`).

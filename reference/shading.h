@@ -14,6 +14,7 @@
 // are undefined there). It does not interpolate or sample textures.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -61,7 +62,7 @@ struct LitColor {
 
 // normalize(v) with zero (or a non-finite length) staying zero. One division, not three
 // (within an ulp of v / |v|).
-inline glm::dvec3 safeNormalize(const glm::dvec3& v) {
+[[gnu::always_inline]] inline glm::dvec3 safeNormalize(const glm::dvec3& v) {
   const double len = std::sqrt(glm::dot(v, v));
   if (!(len > 0.0) || !std::isfinite(len)) return glm::dvec3(0.0);
   return v * (1.0 / len);
@@ -71,6 +72,114 @@ inline glm::dvec3 safeNormalize(const glm::dvec3& v) {
 // (relative error below shininess * 2^-52 against the exact power, and several times
 // faster than pow); others std::pow.
 double specularPower(double base, double shininess);
+
+// The same for a shininess whose kind is decided once (specularExponent()): exponent 0
+// is x^0 = 1, > 0 the integral exponent for repeated squaring, < 0 std::pow(base,
+// shininess). Bit-identical to specularPower(base, shininess).
+int specularExponent(double shininess);
+inline double specularPower(double base, double shininess, int exponent) {
+  if (exponent == 0) return 1.0;  // max(0, x)^0 = 1, including pow(0, 0)
+  if (!(base > 0.0)) return 0.0;
+  if (exponent < 0) return std::pow(base, shininess);
+  auto e = static_cast<unsigned>(exponent);
+  if ((e & (e - 1)) == 0) {  // 2^k: the loop below multiplies 1 by base^(2^k), exactly it
+    double result = base;
+    for (e >>= 1u; e != 0; e >>= 1u) result *= result;
+    return result;
+  }
+  double result = 1.0;
+  double square = base;
+  while (e != 0) {
+    if (e & 1u) result *= square;
+    square *= square;
+    e >>= 1u;
+  }
+  return result;
+}
+
+// The lighting model with everything that does not depend on the shaded point computed
+// once per material (shadePoint() is this, prepared per call). Hoisting changes no
+// result: each hoisted value is the very expression shadePoint() would evaluate per point
+// (radiance = color * intensity is the first product of color * intensity * att, and
+// multiplying by att = 1 is exact, so kd * radiance is kd * L for unattenuated lights).
+struct PreparedLight {
+  bool directional = false;
+  bool attenuated = false;      // a point light under inverse or inverse_square
+  glm::dvec3 position{0.0};     // point lights
+  glm::dvec3 l{0.0};            // directional: -safeNormalize(direction), towards the light
+  glm::dvec3 radiance{0.0};     // color * intensity
+  glm::dvec3 kd_radiance{0.0};  // material.diffuse * radiance (unattenuated lights)
+  glm::dvec3 ks_radiance{0.0};  // material.specular * radiance (unattenuated lights)
+};
+
+struct PreparedShading {
+  glm::dvec3 eye{0.0};
+  glm::dvec3 ambient{0.0};  // material.ambient * ambient_light
+  glm::dvec3 kd{0.0};
+  glm::dvec3 ks{0.0};
+  double shininess = 0.0;
+  int exponent = 0;  // specularExponent(shininess)
+  bool blinn = true;
+  Attenuation attenuation = Attenuation::None;
+  std::vector<PreparedLight> lights;
+};
+PreparedShading prepareShading(const Lighting& lighting, const Material& material);
+
+// Lights world point p with unit (or zero) normal n (DESIGN.md "Shading"; the formulas
+// are at the top of this file). When terms is non-null it also records every term.
+[[gnu::always_inline]] inline LitColor shadePrepared(const PreparedShading& s, const glm::dvec3& p,
+                                                     const glm::dvec3& n,
+                                                     ShadingTerms* terms = nullptr) {
+  LitColor out;
+  out.ambient_diffuse = s.ambient;
+  if (terms) {
+    terms->ambient = s.ambient;
+    terms->lights.assign(s.lights.size(), LightTerms{});
+  }
+  if (n == glm::dvec3(0.0)) return out;  // zero normal: no diffuse, no specular
+
+  const glm::dvec3 v = safeNormalize(s.eye - p);
+  for (std::size_t i = 0; i < s.lights.size(); ++i) {
+    const PreparedLight& light = s.lights[i];
+    glm::dvec3 l;
+    double att = 1.0;
+    if (light.directional) {
+      l = light.l;
+    } else {
+      const glm::dvec3 to_light = light.position - p;
+      const double r = std::sqrt(glm::dot(to_light, to_light));
+      if (!(r > 0.0)) continue;  // light at the shaded point: contributes nothing
+      const double inv_r = 1.0 / r;
+      l = to_light * inv_r;
+      if (s.attenuation == Attenuation::Inverse) att = inv_r;
+      if (s.attenuation == Attenuation::InverseSquare) att = 1.0 / (r * r);
+    }
+    const double n_dot_l = glm::dot(n, l);
+    double base = 0.0;
+    if (s.blinn) {
+      const glm::dvec3 h = safeNormalize(l + v);
+      base = std::max(0.0, glm::dot(n, h));
+    } else {
+      const glm::dvec3 r = 2.0 * n_dot_l * n - l;
+      base = std::max(0.0, glm::dot(r, v));
+    }
+    const double power = specularPower(base, s.shininess, s.exponent);
+    glm::dvec3 diffuse;
+    glm::dvec3 specular;
+    if (light.attenuated) {
+      const glm::dvec3 L = light.radiance * att;
+      diffuse = s.kd * L * std::max(0.0, n_dot_l);
+      specular = s.ks * L * power;
+    } else {
+      diffuse = light.kd_radiance * std::max(0.0, n_dot_l);
+      specular = light.ks_radiance * power;
+    }
+    out.ambient_diffuse += diffuse;
+    out.specular += specular;
+    if (terms) terms->lights[i] = LightTerms{diffuse, specular};
+  }
+  return out;
+}
 
 // Lights world point p with unit (or zero) normal n. When terms is non-null it also
 // records every term (ambient and per-light; texture and color are left to the caller).

@@ -3,16 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "reference/fragment_ops.h"
 
 namespace rc::ref {
-
-float DepthGapTracker::gapSteps(std::size_t index, DepthFormat format) const {
-  const Slot& s = slots_[index];
-  if (!std::isfinite(s.second)) return std::numeric_limits<float>::infinity();
-  return static_cast<float>((s.second - s.first) * depthStepsPerUnit(format));
-}
 
 double polygonArea2(const WindowVertex* polygon, int count) {
   double area2 = 0.0;
@@ -44,24 +39,52 @@ bool cullCouldFlip(const WindowVertex* polygon, int count) {
 
 namespace {
 
-// Distance from (px, py) to the segment a-b.
-double segmentDistance(double px, double py, double ax, double ay, double bx, double by) {
-  const double dx = bx - ax;
-  const double dy = by - ay;
-  const double len2 = dx * dx + dy * dy;
-  double t = 0.0;
-  if (len2 > 0.0) t = std::clamp(((px - ax) * dx + (py - ay) * dy) / len2, 0.0, 1.0);
-  return std::hypot(px - (ax + t * dx), py - (ay + t * dy));
+// floor(x) without a libm call (SSE2 has no rounding instruction): truncation through
+// int64 is exact for |x| < 2^52 and is corrected downwards for negative fractions. Only
+// the sign of a zero result can differ from std::floor, which the callers never see.
+inline double floorFast(double x) {
+  if (!(std::fabs(x) < 4503599627370496.0)) return std::floor(x);
+  const double t = static_cast<double>(static_cast<std::int64_t>(x));
+  return t > x ? t - 1.0 : t;
 }
+inline double ceilFast(double x) { return -floorFast(-x); }
 
 // Pixel indices whose centre (i + 0.5) lies in [lo, hi], clamped to [begin, end).
-bool centreRange(double lo, double hi, int begin, int end, int& first, int& last_excl) {
-  const double f = std::ceil(lo - 0.5);
-  const double l = std::floor(hi - 0.5);
+[[gnu::always_inline]] inline bool centreRange(double lo, double hi, int begin, int end, int& first,
+                                               int& last_excl) {
+  const double f = ceilFast(lo - 0.5);
+  const double l = floorFast(hi - 0.5);
   if (!(f <= l)) return false;
   first = static_cast<int>(std::max<double>(f, begin));
   last_excl = static_cast<int>(std::min<double>(l + 1.0, end));
   return first < last_excl;
+}
+
+// Lowers row[px] to the distance from each listed pixel centre to the segment a-b (in
+// [first, last) of the row at window y = cy), when that is smaller:
+//   t = clamp(((p - a) . d) / |d|^2, 0, 1), distance = hypot(p - (a + t d)).
+// The hypot call is skipped where it cannot lower the value: with q = p - (a + t d),
+// fl(qx^2 + qy^2) is within 2^-51 (relative) of |q|^2 and hypot is within an ulp of |q|,
+// so fl(qx^2 + qy^2) >= cur^2 (1 + 2^-40) means hypot(q) > cur and no change (cur is a
+// float, so cur^2 is exact in double). Pixels are visited in any superset of the band
+// within one pixel of the segment: a pixel farther than 1 keeps its value (<= 1).
+void lowerRow(float* row, int first, int last, double cy, const WindowVertex& a,
+              const WindowVertex& b) {
+  const double dx = b.x - a.x;
+  const double dy = b.y - a.y;
+  const double len2 = dx * dx + dy * dy;
+  const double py = cy;
+  for (int px = first; px < last; ++px) {
+    const double cx = px + 0.5;
+    double t = 0.0;
+    if (len2 > 0.0) t = std::clamp(((cx - a.x) * dx + (py - a.y) * dy) / len2, 0.0, 1.0);
+    const double qx = cx - (a.x + t * dx);
+    const double qy = py - (a.y + t * dy);
+    const double cur = row[px];
+    if (qx * qx + qy * qy >= cur * cur * (1.0 + 0x1p-40)) continue;
+    const double d = std::hypot(qx, qy);
+    if (d < cur) row[px] = static_cast<float>(d);
+  }
 }
 
 void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& clip, int width,
@@ -92,11 +115,8 @@ void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& c
     if (!centreRange(std::min(xa, xb) - 1.0, std::max(xa, xb) + 1.0, clip.x0, clip.x1, col_first,
                      col_end))
       continue;
-    float* row = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
-    for (int px = col_first; px < col_end; ++px) {
-      const double d = segmentDistance(px + 0.5, cy, a.x, a.y, b.x, b.y);
-      if (d < row[px]) row[px] = static_cast<float>(d);
-    }
+    lowerRow(edge_dist + static_cast<std::size_t>(height - 1 - py) * width, col_first, col_end, cy,
+             a, b);
   }
 }
 

@@ -15,7 +15,7 @@ CameraTransform cameraTransform(const Scene& scene) {
 }
 
 void transformObject(const Object& object, const CameraTransform& camera,
-                     std::vector<TransformedVertex>& out) {
+                     std::vector<TransformedVertex>& out, bool normals) {
   const Mesh& mesh = object.mesh;
   const glm::dmat3 normal_matrix = normalMatrix(object.model);
   out.resize(mesh.positions.size());
@@ -23,8 +23,9 @@ void transformObject(const Object& object, const CameraTransform& camera,
     TransformedVertex& v = out[i];
     v.world = glm::dvec3(object.model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0));
     v.clip = camera.view_projection * glm::dvec4(v.world, 1.0);
-    v.normal = i < mesh.normals.size() ? safeNormalize(normal_matrix * glm::dvec3(mesh.normals[i]))
-                                       : glm::dvec3(0.0);
+    v.normal = normals && i < mesh.normals.size()
+                   ? safeNormalize(normal_matrix * glm::dvec3(mesh.normals[i]))
+                   : glm::dvec3(0.0);
     v.uv = i < mesh.uvs.size() ? glm::dvec2(mesh.uvs[i]) : glm::dvec2(0.0);
   }
 }

@@ -27,8 +27,9 @@ struct TransformedVertex {
 };
 
 // Transforms every vertex of the object (non-finite input gives non-finite output;
-// the renderer drops such triangles).
+// the renderer drops such triangles). Without `normals` (flat shading lights the face
+// normal, never a vertex normal) TransformedVertex::normal is left zero.
 void transformObject(const Object& object, const CameraTransform& camera,
-                     std::vector<TransformedVertex>& out);
+                     std::vector<TransformedVertex>& out, bool normals = true);
 
 }  // namespace rc::ref

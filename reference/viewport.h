@@ -9,12 +9,14 @@
 
 namespace rc::ref {
 
+// Plain data without default values (the renderer keeps arrays of them on the stack for
+// every triangle); toWindow() sets every field.
 struct WindowVertex {
-  double x = 0.0;
-  double y = 0.0;
-  double z = 0.0;        // window depth, z_ndc * 0.5 + 0.5
-  double inv_w = 0.0;    // 1 / w_clip, for perspective-correct interpolation
-  glm::dvec3 bary{0.0};  // w.r.t. the original triangle (from the clipper)
+  double x;
+  double y;
+  double z;         // window depth, z_ndc * 0.5 + 0.5
+  double inv_w;     // 1 / w_clip, for perspective-correct interpolation
+  glm::dvec3 bary;  // w.r.t. the original triangle (from the clipper)
 };
 
 inline WindowVertex toWindow(const ClipVertex& c, int width, int height) {

@@ -89,6 +89,16 @@ TEST(Coverage, SpanMethodsAgreeWithPerPixelTestAndOracle) {
     }
     bool ok = false;
     const TriangleCoverage c = setupCoverage(t, bits, clip, ok);
+    // forEachSpan() (incremental for narrow triangles, by division for wide ones), per row.
+    std::vector<std::pair<int, int>> spans(static_cast<std::size_t>(clip.y1), {0, 0});
+    if (ok) {
+      int last_row = -1;
+      c.forEachSpan([&](int py, int x0, int x1) {
+        ASSERT_GT(py, last_row);  // bottom to top, each row once
+        last_row = py;
+        spans[static_cast<std::size_t>(py)] = {x0, x1};
+      });
+    }
     for (int py = clip.y0; py < clip.y1; ++py) {
       int d0 = 0, d1 = 0, s0 = 0, s1 = 0;
       const bool by_div = ok && c.rowSpanByDivision(py, d0, d1);
@@ -97,6 +107,12 @@ TEST(Coverage, SpanMethodsAgreeWithPerPixelTestAndOracle) {
       if (by_div) {
         ASSERT_EQ(d0, s0) << "iter " << iter;
         ASSERT_EQ(d1, s1) << "iter " << iter;
+      }
+      const auto [f0, f1] = spans[static_cast<std::size_t>(py)];
+      ASSERT_EQ(by_div, f1 > f0) << "iter " << iter << " row " << py;
+      if (by_div) {
+        ASSERT_EQ(d0, f0) << "iter " << iter;
+        ASSERT_EQ(d1, f1) << "iter " << iter;
       }
       for (int px = clip.x0; px < clip.x1; ++px) {
         const bool expected = oracleCovers(t, px, py, bits);
@@ -234,7 +250,7 @@ TEST(Coverage, JitteredGridCoversEveryPixelExactlyOnce) {
         if (variant == 2) p = glm::round(p * 256.0) / 256.0;  // on subpixel boundaries
         grid.push_back(p);
       }
-    std::vector<int> hits(48 * 40, 0);
+    std::vector<int> hits(std::size_t{48} * 40, 0);
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const glm::dvec2 a = grid[j * (n + 1) + i], b = grid[j * (n + 1) + i + 1];
@@ -258,7 +274,7 @@ TEST(Coverage, FanAroundAPixelCentreCoversEveryPixelExactlyOnce) {
   const glm::dvec2 centre(15.5, 16.5);
   const int spokes = 37;
   const double pi = std::acos(-1.0);
-  std::vector<int> hits(32 * 32, 0);
+  std::vector<int> hits(std::size_t{32} * 32, 0);
   for (int k = 0; k < spokes; ++k) {
     const double a0 = 2 * pi * k / spokes, a1 = 2 * pi * (k + 1) / spokes;
     const glm::dvec2 p0 = centre + 40.0 * glm::dvec2(std::cos(a0), std::sin(a0));

@@ -4,9 +4,13 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "reference/fragment_ops.h"
 #include "reference/reference_renderer.h"
+#include "reference/uncertainty.h"
 #include "tests/reference/test_scenes.h"
 
 namespace rc {
@@ -111,6 +115,156 @@ TEST(DepthGap, TwoParallelPlanesAKnownNumberOfStepsApart) {
         EXPECT_NEAR(gap, expected, 1e-6 * expected) << toString(fmt) << " row " << y;
     }
   }
+}
+
+// Every pixel of a frame has depth_gap +inf.
+void expectAllInfinite(const Frame& f, const std::string& what) {
+  int finite = 0;
+  for (float g : f.depth_gap) finite += !std::isinf(g);
+  EXPECT_EQ(finite, 0) << what;
+}
+
+TEST(DepthGap, PassesWithoutADepthTestDecideNothingByDepth) {
+  // Three overlapping planes: with a depth test the pixel's gap is finite; painter's
+  // (forced or from the fixture) and depth_test false draw in an order both renderers
+  // share, so no depth comparison decided the winner anywhere.
+  Scene s = test::windowScene(8, 8);
+  test::addRect(s, 0, 0, 8, 8, 0.5f);
+  test::addRect(s, 0, 0, 8, 8, 0.25f);
+  test::addRect(s, 0, 0, 8, 8, 0.75f);
+  EXPECT_EQ(renderReference(s).depth_gap[0], static_cast<float>(0.25 * 16777215.0));
+  expectAllInfinite(renderReference(s, ReferenceOptions{8, true, true}), "ref:painter");
+  Scene painter = s;
+  painter.state.visibility = Visibility::Painter;
+  expectAllInfinite(renderReference(painter), "visibility painter");
+  Scene no_test = s;
+  no_test.state.depth_test = false;
+  expectAllInfinite(renderReference(no_test), "depth_test false");
+  no_test.materials[0].opacity = 0.5;  // and the transparent pass without a test
+  no_test.state.blend = Blend::Alpha;
+  expectAllInfinite(renderReference(no_test), "depth_test false, alpha");
+}
+
+TEST(DepthGap, AlphaPassCountsOnlyTheComparisonsThatDecidedTheWinner) {
+  // Window depths (1 - world z, all exact): opaque W 0.5 and, drawn after it, opaque O2
+  // 2^-10 behind (it fails against W); transparent X at 0.75 everywhere (behind W), and on
+  // the left half transparent V at 0.5 - 2^-7 and T at 0.25, both in front of W. The
+  // transparent pass draws far-to-near: X, V, T.
+  Scene s = test::windowScene(8, 8);
+  Material glass = s.materials[0];
+  glass.opacity = 0.5;
+  const std::size_t g = test::addMaterial(s, glass);
+  s.state.blend = Blend::Alpha;
+  test::addRect(s, 0, 0, 8, 8, 0.5f);                     // W: ids 1, 2
+  test::addRect(s, 0, 0, 8, 8, 0.5f - 1.0f / 1024.0f);    // O2: ids 3, 4
+  test::addRect(s, 0, 0, 8, 8, 0.25f, g);                 // X: ids 5, 6
+  test::addRect(s, 0, 0, 4, 8, 0.5f + 1.0f / 128.0f, g);  // V: ids 7, 8
+  test::addRect(s, 0, 0, 4, 8, 0.75f, g);                 // T: ids 9, 10
+  const Frame f = renderReference(s);
+  const double steps = 16777215.0;
+  for (int y = 0; y < 8; ++y) {
+    // Right half: W is the final id. Deciding: O2 failing against W (2^-10) and X failing
+    // against W (0.25).
+    const std::size_t right = f.index(6, y);
+    EXPECT_TRUE(f.id[right] == 1 || f.id[right] == 2) << f.id[right];
+    EXPECT_EQ(f.depth_gap[right], static_cast<float>(steps / 1024.0)) << y;
+    // Left half: T is the final id. Only T's own test against W decided it (0.25); V's
+    // test (2^-7 from W) and the opaque z-fight do not: whatever they gave, T, drawn last
+    // in front of W, still wins. (The two nearest fragments, T and V, are 0.2421875 apart.)
+    const std::size_t left = f.index(1, y);
+    EXPECT_TRUE(f.id[left] == 9 || f.id[left] == 10) << f.id[left];
+    EXPECT_EQ(f.depth_gap[left], static_cast<float>(0.25 * steps)) << y;
+  }
+}
+
+// The depth_gap definition evaluated by brute force: simulate the pixel's fragments, flip
+// each depth comparison's outcome alone (later fragments re-tested against what then gets
+// stored), and keep |z_f - z_s| of every comparison whose flip changes the final fragment.
+struct TestFragment {
+  double z;
+  bool tested;  // LESS, else ALWAYS
+  bool writes;
+};
+
+double bruteForceGap(const std::vector<TestFragment>& frags, DepthFormat format) {
+  const std::uint32_t clear = ref::depthKey(1.0, format);
+  struct Run {
+    int final = -1;
+    std::vector<std::pair<int, int>> comparisons;  // (fragment, fragment that stored)
+  };
+  auto simulate = [&](int flip) {
+    Run r;
+    std::uint32_t stored = clear;
+    int stored_by = -1;
+    for (int i = 0; i < static_cast<int>(frags.size()); ++i) {
+      const TestFragment& f = frags[static_cast<std::size_t>(i)];
+      const std::uint32_t key = ref::depthKey(f.z, format);
+      bool pass = !f.tested || key < stored;
+      if (f.tested) {
+        r.comparisons.emplace_back(i, stored_by);
+        if (i == flip) pass = !pass;
+      }
+      if (!pass) continue;
+      r.final = i;
+      if (f.writes) {
+        stored = key;
+        stored_by = i;
+      }
+    }
+    return r;
+  };
+  const Run base = simulate(-1);
+  double gap = std::numeric_limits<double>::infinity();
+  for (const auto& [f, s] : base.comparisons) {
+    if (s < 0) continue;  // against the clear depth: not counted
+    if (simulate(f).final != base.final)
+      gap = std::min(gap, std::fabs(frags[static_cast<std::size_t>(f)].z -
+                                    frags[static_cast<std::size_t>(s)].z));
+  }
+  return gap;
+}
+
+TEST(DepthGap, TrackerEqualsTheBruteForceDefinitionOnRandomPixels) {
+  // Pixel histories shaped like drawPasses(): a z-buffer pass (LESS, writes) then a
+  // transparent pass (LESS, no writes), or ALWAYS passes; depths from a small set so that
+  // d16 keys tie often.
+  std::uint32_t seed = 7;
+  auto rnd = [&](std::uint32_t n) {
+    seed = seed * 1664525u + 1013904223u;
+    return (seed >> 8) % n;
+  };
+  int finite = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const DepthFormat format = trial % 2 ? DepthFormat::D16 : DepthFormat::D24;
+    const bool always = rnd(8) == 0;
+    std::vector<TestFragment> frags;
+    const std::uint32_t opaque = rnd(5);
+    const std::uint32_t transparent = rnd(4);
+    for (std::uint32_t i = 0; i < opaque + transparent; ++i) {
+      const double z = 0.25 + 0.001 * rnd(16) + (rnd(2) ? 1e-6 * rnd(8) : 0.0);
+      frags.push_back({z, !always, i < opaque});
+    }
+    float got = std::numeric_limits<float>::infinity();  // the frame's depth_gap pixel
+    ref::DepthGapTracker tracker;
+    tracker.reset(1, format, &got);
+    std::uint32_t stored = ref::depthKey(1.0, format);
+    for (const TestFragment& f : frags) {
+      const std::uint32_t key = ref::depthKey(f.z, format);
+      if (!f.tested || key < stored) {
+        tracker.passed(0, f.z, f.tested, f.writes);
+        if (f.writes) stored = key;
+      } else {
+        tracker.failed(0, f.z);
+      }
+    }
+    const double want = bruteForceGap(frags, format);
+    const float expected = std::isinf(want)
+                               ? std::numeric_limits<float>::infinity()
+                               : static_cast<float>(want * ref::depthStepsPerUnit(format));
+    ASSERT_EQ(got, expected) << "trial " << trial;
+    finite += !std::isinf(want);
+  }
+  EXPECT_GT(finite, 5000);  // the cases are not all trivial
 }
 
 // Distance from (px, py) to segment a-b: the test's own oracle.

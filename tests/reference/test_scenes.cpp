@@ -4,8 +4,6 @@
 #include <cmath>
 #include <memory>
 
-#include "reference/reference_renderer.h"
-
 namespace rc::test {
 
 Scene windowScene(int width, int height) {
@@ -230,14 +228,46 @@ std::string frameBytes(const Frame& frame) {
   return out;
 }
 
-std::string featureCorpusBytes() {
-  std::string out;
-  for (const NamedScene& s : featureScenes()) {
-    out += frameBytes(renderReference(s.scene));
-    out += frameBytes(renderReference(s.scene, ReferenceOptions{4, false, true}));
-    out += frameBytes(renderReference(s.scene, ReferenceOptions{12, true, true}));
+Scene smallTrianglesScene(int size, int count) {
+  Scene s = windowScene(size, size);
+  s.name = "bench/small_triangles";
+  s.state.shading = Shading::Flat;
+  Object o;
+  o.name = "triangles";
+  std::uint32_t seed = 1;
+  auto rnd = [&]() {
+    seed = seed * 1664525u + 1013904223u;
+    return static_cast<float>(seed >> 8) / static_cast<float>(1 << 24) *
+               static_cast<float>(size - 4) +
+           1.0f;
+  };
+  for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(count); ++i) {
+    const float x = rnd();
+    const float y = rnd();
+    const float z = 0.25f + 0.5f * static_cast<float>(i % 97) / 97.0f;
+    o.mesh.positions.insert(o.mesh.positions.end(), {{x, y, z}, {x + 2, y, z}, {x, y + 2, z}});
+    o.mesh.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
   }
-  return out;
+  o.mesh.normals.assign(o.mesh.positions.size(), {0.0f, 0.0f, 1.0f});
+  s.objects.push_back(std::move(o));
+  return s;
+}
+
+Scene layersScene(Shading shading, int size, int layers) {
+  Scene s = windowScene(size, size);
+  s.name = std::string("bench/layers_") + toString(shading);
+  s.state.shading = shading;
+  s.ambient_light = glm::dvec3(0.1);
+  const double k = size / 1024.0;
+  s.lights.push_back(
+      Light{LightType::Point, {300.0 * k, 700.0 * k, 400.0 * k}, {}, {1.0, 1.0, 1.0}, 1.0});
+  s.materials[0].diffuse = {0.6, 0.5, 0.4};
+  s.materials[0].specular = glm::dvec3(0.5);
+  s.materials[0].shininess = 32.0;
+  const auto edge = static_cast<float>(size) + 1.0f;
+  for (int layer = 0; layer < layers; ++layer)
+    addRect(s, -1.0f, -1.0f, edge, edge, 0.1f + 0.1f * static_cast<float>(layer));
+  return s;
 }
 
 }  // namespace rc::test

@@ -1,5 +1,7 @@
-// Scenes built in code for the reference renderer's tests, benchmarks and the
-// cross-optimisation-level dump tool (no dependency on the fixture loader).
+// Scenes built in code for the reference renderer's tests, the benchmarks of both
+// renderers (bench_reference and bench_gl render the very same scenes) and the
+// cross-optimisation-level dump tools. Library rc_scene_builders: depends on the scene
+// model only (no loader, no renderer).
 #pragma once
 
 #include <array>
@@ -52,8 +54,18 @@ std::vector<NamedScene> featureScenes();
 // bit-exact comparisons.
 std::string frameBytes(const Frame& frame);
 
-// Renders every feature scene with a few option sets and concatenates frameBytes(): what
-// the cross-optimisation-level dump tools write.
-std::string featureCorpusBytes();
+// ---- benchmark scenes (bench/reference, bench/gl) ----------------------------------------
+
+// `count` right triangles with 2-pixel legs (area 2 px^2: about two fragments each) at
+// pseudo-random positions in a size x size window scene, flat shaded, one material, depths
+// cycling through 97 values in [0.25, 0.75). Setup-bound: measures triangles per second.
+Scene smallTrianglesScene(int size = 1024, int count = 100000);
+
+// `layers` rectangles one pixel larger than the size x size window on every side, drawn
+// back to front (z = 0.1, 0.2, ...; every fragment passes the depth test and is shaded and
+// written), lit by one point light at (300, 700, 400) * size / 1024, ambient 0.1, Blinn-Phong
+// specular 0.5 with shininess 32. Fragment-bound: measures fragments per second
+// (layers * size^2 fragments per frame).
+Scene layersScene(Shading shading, int size = 1024, int layers = 8);
 
 }  // namespace rc::test
