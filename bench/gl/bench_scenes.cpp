@@ -1,6 +1,5 @@
-// Benchmark scenes: see bench_scenes.h. smallTriangles() and layers() must stay equal to
-// their twins in bench/reference/bench_reference.cpp (same seed, sizes and materials);
-// move both into tests/reference/test_scenes.cpp once that library carries them.
+// Benchmark scenes: see bench_scenes.h. smallTriangles() and layers() are the reference
+// benchmark's own scenes (rc_scene_builders), so the ratios compare the same work.
 #include "bench/gl/bench_scenes.h"
 
 #include <cmath>
@@ -51,36 +50,8 @@ Scene sphere1080p(ColorFormat color) {
   return s;
 }
 
-Scene smallTriangles() {
-  Scene s = test::windowScene(kRefSize, kRefSize);
-  s.state.shading = Shading::Flat;
-  Object o;
-  std::uint32_t seed = 1;
-  auto rnd = [&]() {
-    seed = seed * 1664525u + 1013904223u;
-    return static_cast<float>(seed >> 8) / static_cast<float>(1 << 24) * (kRefSize - 4) + 1.0f;
-  };
-  for (std::uint32_t i = 0; i < 100000; ++i) {
-    const float x = rnd(), y = rnd(), z = 0.25f + 0.5f * (i % 97) / 97.0f;
-    o.mesh.positions.insert(o.mesh.positions.end(), {{x, y, z}, {x + 2, y, z}, {x, y + 2, z}});
-    o.mesh.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
-  }
-  o.mesh.normals.assign(o.mesh.positions.size(), {0.0f, 0.0f, 1.0f});
-  s.objects.push_back(o);
-  return s;
-}
+Scene smallTriangles() { return test::smallTrianglesScene(kRefSize, 100000); }
 
-Scene layers(Shading shading) {
-  Scene s = test::windowScene(kRefSize, kRefSize);
-  s.state.shading = shading;
-  s.ambient_light = glm::dvec3(0.1);
-  s.lights.push_back(Light{LightType::Point, {300.0, 700.0, 400.0}, {}, {1.0, 1.0, 1.0}, 1.0});
-  s.materials[0].diffuse = {0.6, 0.5, 0.4};
-  s.materials[0].specular = glm::dvec3(0.5);
-  s.materials[0].shininess = 32.0;
-  for (int layer = 0; layer < 8; ++layer)
-    test::addRect(s, -1.0f, -1.0f, kRefSize + 1.0f, kRefSize + 1.0f, 0.1f + 0.1f * layer);
-  return s;
-}
+Scene layers(Shading shading) { return test::layersScene(shading, kRefSize, 8); }
 
 }  // namespace rc::bench
