@@ -31,16 +31,16 @@ std::vector<Rgb8> heatColorStops(int count);
 // [0, 1]. Log-scaled so that one-step errors stay visible next to large ones.
 float heatPosition(float value, double scale);
 
-// Writes into `dir` (created if needed): expected.png, actual.png, visibility.png,
-// depth_heat.png, shading_heat.png and diff.exr (float channels id_class, depth_steps,
-// depth_tolerance, shading_abs, dR, dG, dB, dA), and records them in result.images and
-// the heat scales in result. Throws InputError when a file cannot be written; then none
-// of them is left behind.
+// Writes into `dir` (created if needed), all files concurrently: expected.png, actual.png,
+// visibility.png, depth_heat.png, shading_heat.png and diff.exr (float channels id_class,
+// depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG, dB, dA; see
+// docs/reports.md), and records them in result.images and the heat scales in result.
+// Throws InputError when a file cannot be written; then none of them is left behind.
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
                      const std::filesystem::path& dir, PairResult& result);
 
-// A folder for one pair's images under a report folder: <out>/<fixture>/<expected>_vs_
-// <actual>, every name reduced to [A-Za-z0-9._-].
+// A folder for one pair's images under a report folder: <out>/pairs/<fixture>/<expected>
+// _vs_<actual>, every name reduced to [A-Za-z0-9._-] (fixture "a/b" becomes "a_b").
 std::filesystem::path pairDirectory(const std::filesystem::path& out_dir, const PairResult& result);
 
 }  // namespace rc
