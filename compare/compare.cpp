@@ -10,6 +10,10 @@
 #include <cstring>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <fmt/format.h>
 
 #include "compare/slopes.h"
@@ -74,21 +78,29 @@ inline V load(const T* p) {
   return v;
 }
 
-// Lane masks are 0 or -1.
-inline bool any(V4i m) {
-  const V4i h = m | __builtin_shufflevector(m, m, 2, 3, 0, 1);
-  return (h[0] | h[1]) != 0;
+template <typename V, typename T>
+inline void store(T* p, V v) {
+  std::memcpy(p, &v, sizeof v);
 }
-inline bool all(V4i m) { return !any(~m); }
+
+// Lane masks are 0 or -1. x86 reads the four sign bits at once (movmskps); elsewhere the
+// lanes are combined.
+inline int signBits(V4i m) {
+#if defined(__SSE__)
+  return __builtin_ia32_movmskps(reinterpret_cast<V4f>(m));
+#else
+  return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8);
+#endif
+}
+inline bool any(V4i m) { return signBits(m) != 0; }
+inline bool all(V4i m) { return signBits(m) == 15; }
 
 inline V4f absf(V4f v) { return reinterpret_cast<V4f>(reinterpret_cast<V4i>(v) & 0x7fffffff); }
 inline V2d absd(V2d v) {
   return reinterpret_cast<V2d>(reinterpret_cast<V2l>(v) & 0x7fffffffffffffffLL);
 }
-inline V4f maxf(V4f a, V4f b) {
-  const V4i gt = a > b;
-  return reinterpret_cast<V4f>((gt & reinterpret_cast<V4i>(a)) | (~gt & reinterpret_cast<V4i>(b)));
-}
+// a > b ? a : b per lane (maxps on x86; the inputs are never NaN here).
+inline V4f maxf(V4f a, V4f b) { return a > b ? a : b; }
 inline V4i nonFiniteLanes(V4f v) { return (reinterpret_cast<V4i>(v) & 0x7f800000) == 0x7f800000; }
 // Largest lane (one pixel's R G B A).
 inline float lanesMax(V4f v) {
@@ -96,11 +108,50 @@ inline float lanesMax(V4f v) {
   const V4f s2 = maxf(s1, __builtin_shufflevector(s1, s1, 2, 3, 0, 1));
   return s2[0];
 }
+inline bool any2(V2l m) {
+#if defined(__SSE2__)
+  return __builtin_ia32_movmskpd(reinterpret_cast<V2d>(m)) != 0;
+#else
+  return (m[0] | m[1]) != 0;
+#endif
+}
+// Two pairs of doubles as four floats.
+inline V4f join(V2d lo, V2d hi) {
+#if defined(__SSE2__)
+  return reinterpret_cast<V4f>(_mm_movelh_ps(_mm_cvtpd_ps(reinterpret_cast<__m128d>(lo)),
+                                             _mm_cvtpd_ps(reinterpret_cast<__m128d>(hi))));
+#else
+  using V2f = float __attribute__((vector_size(8)));
+  return __builtin_shufflevector(__builtin_convertvector(lo, V2f), __builtin_convertvector(hi, V2f),
+                                 0, 1, 2, 3);
+#endif
+}
+inline V2d maxd(V2d a, V2d b) { return a > b ? a : b; }
+// Largest lane of each of four vectors, as one vector: [max d0, max d1, max d2, max d3].
+inline V4f pixelMaxima(const V4f* d) {
+  const V4f m01 = maxf(__builtin_shufflevector(d[0], d[1], 0, 1, 4, 5),
+                       __builtin_shufflevector(d[0], d[1], 2, 3, 6, 7));
+  const V4f m23 = maxf(__builtin_shufflevector(d[2], d[3], 0, 1, 4, 5),
+                       __builtin_shufflevector(d[2], d[3], 2, 3, 6, 7));
+  return maxf(__builtin_shufflevector(m01, m23, 0, 2, 4, 6),
+              __builtin_shufflevector(m01, m23, 1, 3, 5, 7));
+}
+// float <-> double lanes. GCC scalarises the generic form of the high half, so x86 gets
+// the two-instruction intrinsic sequences.
 inline V2d lowHalf(V4f v) {
+#if defined(__SSE2__)
+  return reinterpret_cast<V2d>(_mm_cvtps_pd(reinterpret_cast<__m128>(v)));
+#else
   return __builtin_convertvector(__builtin_shufflevector(v, v, 0, 1), V2d);
+#endif
 }
 inline V2d highHalf(V4f v) {
+#if defined(__SSE2__)
+  const __m128 m = reinterpret_cast<__m128>(v);
+  return reinterpret_cast<V2d>(_mm_cvtps_pd(_mm_movehl_ps(m, m)));
+#else
   return __builtin_convertvector(__builtin_shufflevector(v, v, 2, 3), V2d);
+#endif
 }
 
 // Small errors are by far the most common. Counting them in four interleaved tables (one
@@ -110,7 +161,10 @@ class HotBins {
  public:
   static constexpr int kBins = 256;  // <= ErrorHistogram::kLinearBins
   explicit HotBins(ErrorHistogram& h)
-      : h_(h), inverse_quantum_(1.0 / h.quantum()), counts_(4 * kBins, 0) {}
+      : h_(h),
+        inverse_quantum_(1.0 / h.quantum()),
+        inverse_quantum_f_(static_cast<float>(inverse_quantum_)),
+        counts_(4 * kBins, 0) {}
   void add(int lane, double value) {
     const double u = value * inverse_quantum_;
     if (u < kBins) {
@@ -119,6 +173,35 @@ class HotBins {
       h_.add(value);
     }
   }
+  // Four values that the caller knows are below `limit()`, one per table; the same bins
+  // as add() because the quantum is a power of two (value / quantum is exact in float).
+  void add4InRange(V4f values) {
+    const V4i bin = __builtin_convertvector(values * inverse_quantum_f_, V4i);
+    ++counts_[bin[0]];
+    ++counts_[kBins + bin[1]];
+    ++counts_[2 * kBins + bin[2]];
+    ++counts_[3 * kBins + bin[3]];
+  }
+  // Four doubles (two pairs) that the caller knows are below `limit()`.
+  void add4InRange(V2d lo, V2d hi) {
+    const V2d q = {inverse_quantum_, inverse_quantum_};
+#if defined(__SSE2__)
+    const V4i bin = reinterpret_cast<V4i>(
+        _mm_unpacklo_epi64(_mm_cvttpd_epi32(reinterpret_cast<__m128d>(lo * q)),
+                           _mm_cvttpd_epi32(reinterpret_cast<__m128d>(hi * q))));
+#else
+    const V2d ul = lo * q;
+    const V2d uh = hi * q;
+    const V4i bin = {static_cast<int>(ul[0]), static_cast<int>(ul[1]), static_cast<int>(uh[0]),
+                     static_cast<int>(uh[1])};
+#endif
+    ++counts_[bin[0]];
+    ++counts_[kBins + bin[1]];
+    ++counts_[2 * kBins + bin[2]];
+    ++counts_[3 * kBins + bin[3]];
+  }
+  // Values at or above this leave the small tables (one quantum below the first such).
+  double limit() const { return (kBins - 1) / inverse_quantum_; }
   void flush() {
     for (int b = 0; b < kBins; ++b) {
       const std::uint64_t n = std::uint64_t{counts_[b]} + counts_[kBins + b] +
@@ -131,6 +214,7 @@ class HotBins {
  private:
   ErrorHistogram& h_;
   double inverse_quantum_;
+  float inverse_quantum_f_;
   std::vector<std::uint32_t> counts_;  // frames hold < 2^31 pixels: no overflow
 };
 
@@ -174,6 +258,7 @@ class Comparator {
   }
 
   void run(ClassMaps* maps) {
+    maps_ = maps;
     if (maps) {
       const std::size_t n = e_.pixelCount();
       maps->width = e_.width;
@@ -187,14 +272,17 @@ class Comparator {
     }
     for (int y = 0; y < e_.height; ++y) {
       if (maps) {
-        runRange<true>(y, 0, e_.width, maps);
+        scale_.quantized ? (quantized_color_ ? runRowFast<true, true, true>(y)
+                                             : runRowFast<true, false, true>(y))
+                         : (quantized_color_ ? runRowFast<false, true, true>(y)
+                                             : runRowFast<false, false, true>(y));
       } else if (scale_.quantized) {
-        quantized_color_ ? runRowFast<true, true>(y) : runRowFast<true, false>(y);
+        quantized_color_ ? runRowFast<true, true, false>(y) : runRowFast<true, false, false>(y);
       } else {
-        quantized_color_ ? runRowFast<false, true>(y) : runRowFast<false, false>(y);
+        quantized_color_ ? runRowFast<false, true, false>(y) : runRowFast<false, false, false>(y);
       }
     }
-    finish(maps);
+    finish();
   }
 
  private:
@@ -205,9 +293,10 @@ class Comparator {
     return std::fabs(((a * 255.0f + kMagic) - kMagic) - ((b * 255.0f + kMagic) - kMagic));
   }
 
-  // The general path: any pixel, NaN/Inf, per-pixel maps. Pixels [x0, x1) of row y.
+  // The general path: any pixel, NaN/Inf. Pixels [x0, x1) of row y.
   template <bool kMaps>
-  void runRange(int y, int x0, int x1, ClassMaps* maps) {
+  void runRange(int y, int x0, int x1) {
+    ClassMaps* maps = maps_;
     const std::size_t row = static_cast<std::size_t>(y) * e_.width;
     const std::uint32_t* ida = &e_.id[row];
     const std::uint32_t* idb = &a_.id[row];
@@ -265,7 +354,6 @@ class Comparator {
         if (dz > depth_warn) depthOverBase(x, y, i, dz);
         if (kMaps) maps->depth_steps[i] = static_cast<float>(dz);
       }
-      if (kMaps) mapDepthTolerance(x, y, i, maps);
 
       // Shading.
       if (!color_finite) {
@@ -285,11 +373,7 @@ class Comparator {
         shade_max_at_ = i;
       }
       if (e > shade_warn) shadingOver(x, y, i, d);
-      if (kMaps) {
-        maps->shading_abs[i] = e;
-        const ShadingExcess s = shadingExcess(x, y, i, d, true);
-        maps->shading_tolerance[i] = static_cast<float>(tol_.shading.warn + s.allowance);
-      }
+      if (kMaps) maps->shading_abs[i] = e;
     }
     shade_sum_ += shade_sum;
     shade_sq_ += shade_sq;
@@ -301,8 +385,9 @@ class Comparator {
   // checked for NaN/Inf; any other chunk, and the row's tail, takes runRange. Both paths
   // compute every per-pixel value with the same operations, so results agree exactly
   // (sums up to their order of addition).
-  template <bool kQuantizedDepth, bool kQuantizedColor>
+  template <bool kQuantizedDepth, bool kQuantizedColor, bool kMaps>
   void runRowFast(int y) {
+    ClassMaps* maps = maps_;
     const int w = e_.width;
     const std::size_t row = static_cast<std::size_t>(y) * w;
     const std::uint32_t* ida = &e_.id[row];
@@ -314,6 +399,8 @@ class Comparator {
     const double depth_warn = tol_.depth.warn;
     const float shade_warn = static_cast<float>(tol_.shading.warn);
     const double scale = scale_.steps_per_unit;
+    const double depth_limit = depth_hot_.limit();
+    const auto shade_limit = static_cast<float>(shade_hot_.limit());
     constexpr double kMagic = 6755399441055744.0;
     constexpr float kMagicF = 12582912.0f;
     V2d depth_sum = {};
@@ -331,8 +418,6 @@ class Comparator {
     };
     V4f channel_max = {};
     std::uint64_t matched = 0;
-    double depth_max = depth_max_;
-    float shade_max = shade_max_;
     int x = 0;
     for (; x + 4 <= w; x += 4) {
       const V4u a = load<V4u>(ida + x);
@@ -341,25 +426,33 @@ class Comparator {
       const V4f z_b = load<V4f>(zb + x);
       V4f c_a[4];
       V4f c_b[4];
-      V4i bad = nonFiniteLanes(z_a) | nonFiniteLanes(z_b);
       for (int k = 0; k < 4; ++k) {
         c_a[k] = load<V4f>(ca + (x + k) * 4);
         c_b[k] = load<V4f>(cb + (x + k) * 4);
-        bad |= nonFiniteLanes(c_a[k]) | nonFiniteLanes(c_b[k]);
       }
+      // A NaN or Inf on either side makes a difference NaN or Inf, and then times 0 NaN
+      // (so does an overflow of huge finite values: conservative, the general path
+      // sorts them out). No fast-math, so x * 0 is not folded to 0.
+      const V4f probe = ((c_a[0] - c_b[0]) + (c_a[1] - c_b[1])) +
+                        ((c_a[2] - c_b[2]) + (c_a[3] - c_b[3])) + (z_a - z_b);
+      const V4i bad = (probe * 0.0f) != 0.0f;
       const V4i same = reinterpret_cast<V4i>(a == b);
       const V4i drawn = reinterpret_cast<V4i>(a != 0u);
       if (any(bad) || !all(same & drawn)) {
         if (any(bad) || any(drawn | ~same)) {
-          depth_max_ = depth_max;
-          shade_max_ = shade_max;
-          runRange<false>(y, x, x + 4, nullptr);
-          depth_max = depth_max_;
-          shade_max = shade_max_;
+          runRange<kMaps>(y, x, x + 4);
+        } else if (kMaps) {  // background on both sides: only the colour delta
+          for (int k = 0; k < 4; ++k)
+            store(&maps->delta_rgba[(row + x + k) * 4], (c_b[k] - c_a[k]) * 255.0f);
         }
-        continue;  // else background on both sides
+        continue;
       }
       matched += 4;
+      if (kMaps) {
+        std::memset(&maps->pixel_class[row + x], static_cast<int>(PixelClass::Match), 4);
+        for (int k = 0; k < 4; ++k)
+          store(&maps->delta_rgba[(row + x + k) * 4], (c_b[k] - c_a[k]) * 255.0f);
+      }
 
       // Depth, in double like runRange.
       V2d sa[2] = {lowHalf(z_a) * scale, highHalf(z_a) * scale};
@@ -373,50 +466,63 @@ class Comparator {
       const V2d dz01 = absd(sa[0] - sb[0]);
       const V2d dz23 = absd(sa[1] - sb[1]);
       depth_sum += dz01 + dz23;
-      const double dz[4] = {dz01[0], dz01[1], dz23[0], dz23[1]};
-      for (int l = 0; l < 4; ++l) {
-        depth_hot_.add(l, dz[l]);
-        if (dz[l] > depth_max) {
-          depth_max = dz[l];
-          depth_max_at_ = row + x + l;
+      if (kMaps) store(&maps->depth_steps[row + x], join(dz01, dz23));
+      // One test for the rare cases: a new maximum, over warn, beyond the small bins.
+      const double depth_rare = std::min(std::min(depth_max_, depth_warn), depth_limit);
+      if (!any2(maxd(dz01, dz23) > V2d{depth_rare, depth_rare})) {
+        depth_hot_.add4InRange(dz01, dz23);
+      } else {
+        const double d[4] = {dz01[0], dz01[1], dz23[0], dz23[1]};
+        for (int l = 0; l < 4; ++l) {
+          depth_hot_.add(l, d[l]);
+          if (d[l] > depth_max_) {
+            depth_max_ = d[l];
+            depth_max_at_ = row + x + l;
+          }
+          if (d[l] > depth_warn) depthOverBase(x + l, y, row + x + l, d[l]);
         }
-        if (dz[l] > depth_warn) depthOverBase(x + l, y, row + x + l, dz[l]);
       }
 
-      // Shading: one pixel's R G B A per vector.
+      // Shading: one pixel's R G B A per vector; e = each pixel's largest channel.
+      V4f d[4];
       for (int k = 0; k < 4; ++k) {
-        V4f d;
         if (kQuantizedColor) {
-          d = absf(((c_a[k] * 255.0f + kMagicF) - kMagicF) -
-                   ((c_b[k] * 255.0f + kMagicF) - kMagicF));
+          d[k] = absf(((c_a[k] * 255.0f + kMagicF) - kMagicF) -
+                      ((c_b[k] * 255.0f + kMagicF) - kMagicF));
         } else {
-          d = absf(c_a[k] - c_b[k]) * 255.0f;
+          d[k] = absf(c_a[k] - c_b[k]) * 255.0f;
         }
-        color_sum += d;
-        color_sq += d * d;
-        channel_max = maxf(channel_max, d);
-        const float e = lanesMax(d);
-        shade_hot_.add(k, e);
-        if (e > shade_warn) {
-          const float dk[4] = {d[0], d[1], d[2], d[3]};
-          shadingOver(x + k, y, row + x + k, dk);
-        }
-        if (e > shade_max) {
-          shade_max = e;
-          shade_max_at_ = row + x + k;
+        color_sum += d[k];
+        color_sq += d[k] * d[k];
+      }
+      channel_max = maxf(channel_max, maxf(maxf(d[0], d[1]), maxf(d[2], d[3])));
+      const V4f e = pixelMaxima(d);
+      if (kMaps) store(&maps->shading_abs[row + x], e);
+      const float shade_rare = std::min(std::min(shade_max_, shade_warn), shade_limit);
+      if (!any(e > V4f{shade_rare, shade_rare, shade_rare, shade_rare})) {
+        shade_hot_.add4InRange(e);
+      } else {
+        for (int k = 0; k < 4; ++k) {
+          shade_hot_.add(k, e[k]);
+          if (e[k] > shade_max_) {
+            shade_max_ = e[k];
+            shade_max_at_ = row + x + k;
+          }
+          if (e[k] > shade_warn) {
+            const float dk[4] = {d[k][0], d[k][1], d[k][2], d[k][3]};
+            shadingOver(x + k, y, row + x + k, dk);
+          }
         }
       }
       if ((summed += 4) == 16) flushColorSums();
     }
     flushColorSums();
-    depth_max_ = depth_max;
-    shade_max_ = shade_max;
     vis_match_ += matched;
     depth_sum_ += depth_sum[0] + depth_sum[1];
     shade_sum_ += shade_sum[0] + shade_sum[1];
     shade_sq_ += shade_sq[0] + shade_sq[1];
     for (int c = 0; c < 4; ++c) shade_max_rgba_[c] = std::max(shade_max_rgba_[c], channel_max[c]);
-    if (x < w) runRange<false>(y, x, w, nullptr);
+    if (x < w) runRange<kMaps>(y, x, w);
   }
 
   // ---- Depth: slope allowance (docs/tolerances.md) ----
@@ -454,7 +560,7 @@ class Comparator {
       return;
     }
     // The local magnitude is a lower bound of the slope: within its allowance, done.
-    if (local.any() && dz <= tol_.depth.warn + depth_slope_band_ * local.magnitude()) {
+    if (!maps_ && local.any() && dz <= tol_.depth.warn + depth_slope_band_ * local.magnitude()) {
       r_.depth.max_slope = std::max(r_.depth.max_slope, local.magnitude());
       return;
     }
@@ -465,6 +571,9 @@ class Comparator {
   void applyDepth(std::size_t i, double dz, std::optional<double> slope, bool fitted) {
     DepthStats& d = r_.depth;
     if (fitted) ++d.slope_fitted;
+    if (maps_)
+      maps_->depth_tolerance[i] =
+          static_cast<float>(tol_.depth.warn + depth_slope_band_ * slope.value_or(0.0));
     if (!slope) {
       // Nothing tells how steep this primitive is: its legal error is unbounded, so it
       // can warn but not fail.
@@ -487,17 +596,6 @@ class Comparator {
     ++r_.depth.over_tolerance;
     ++r_.depth.over_fail;
     depth_worst_.offer(kInf, i, std::numeric_limits<double>::quiet_NaN(), 0.0);
-  }
-
-  void mapDepthTolerance(int x, int y, std::size_t i, ClassMaps* maps) {
-    const detail::LocalSlope local = detail::localDepthSlope(u_, scale_, x, y);
-    if (local.complete()) {
-      maps->depth_tolerance[i] =
-          static_cast<float>(tol_.depth.warn + depth_slope_band_ * local.magnitude());
-    } else {
-      pending_map_.push_back(i);
-      if (u_.id[i] != 0) fits_.request(u_.id[i]);
-    }
   }
 
   // ---- Shading: relative, gradient and texture allowances (docs/tolerances.md) ----
@@ -535,8 +633,10 @@ class Comparator {
   // The pixel's largest channel error is over warn: check it against its allowance.
   __attribute__((noinline)) void shadingOver(int x, int y, std::size_t i, const float* d) {
     const double warn = tol_.shading.warn;
-    if (shadingExcess(x, y, i, d, false).excess <= warn) return;  // the cheap part suffices
+    // The terms without neighbours are a lower bound of the allowance: often enough.
+    if (!maps_ && shadingExcess(x, y, i, d, false).excess <= warn) return;
     const ShadingExcess s = shadingExcess(x, y, i, d, true);
+    if (maps_) maps_->shading_tolerance[i] = static_cast<float>(warn + s.allowance);
     if (s.excess <= warn) return;
     ++r_.shading.over_tolerance;
     if (s.excess > tol_.shading.fail) ++r_.shading.over_fail;
@@ -604,7 +704,7 @@ class Comparator {
   }
 
   // Deferred pixels: one pass fits the planes of their primitives, then each is decided.
-  void resolveDeferred(ClassMaps* maps) {
+  void resolveDeferred() {
     // The largest error's allowance is reported even when nothing is over.
     if (!depth_worst_.any && depth_max_ > 0.0 && pending_depth_.empty()) {
       const PixelRef p = pixelAt(depth_max_at_);
@@ -621,20 +721,14 @@ class Comparator {
       const double slope = resolvedSlope(p.index).value_or(0.0);
       const bool by_gap = p.gap <= 2.0 * (tol_.depth.fail + depth_slope_band_ * slope);
       const PixelClass cls = record(p.index, 1, 2, by_gap, by_gap, p.edge);  // wrong_primitive
-      if (maps) maps->pixel_class[p.index] = cls;
-    }
-    if (maps) {
-      for (std::size_t i : pending_map_) {
-        const double slope = resolvedSlope(i).value_or(0.0);
-        maps->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + depth_slope_band_ * slope);
-      }
+      if (maps_) maps_->pixel_class[p.index] = cls;
     }
   }
 
-  void finish(ClassMaps* maps) {
+  void finish() {
     depth_hot_.flush();
     shade_hot_.flush();
-    resolveDeferred(maps);
+    resolveDeferred();
 
     VisibilityStats& v = r_.visibility;
     auto count = [&](PixelClass c) { return class_counts_[static_cast<int>(c)]; };
@@ -746,7 +840,7 @@ class Comparator {
   detail::PlaneFits fits_;
   std::vector<PendingDepth> pending_depth_;
   std::vector<PendingMismatch> pending_wrong_;
-  std::vector<std::size_t> pending_map_;
+  ClassMaps* maps_ = nullptr;
 };
 
 }  // namespace

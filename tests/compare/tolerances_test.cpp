@@ -85,16 +85,16 @@ TEST(SnapBand, HalfDiagonalOfTheSnapGridPerSide) {
   in.actual_bits = 4;
   in.width = 640;
   in.height = 480;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(8) + snapMovePx(4));
-  in.uncertainty_is_expected = false;
-  in.uncertainty_bits = 8;
-  in.expected_bits = 4;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(4) + snapMovePx(8));
-  in.expected_bits = 8;
+  // Coverage: each side within its own snap of the exact edge edge_dist is measured to.
+  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(4));
+  // Planes: each side's own plane moves with its own vertices.
+  EXPECT_DOUBLE_EQ(slopeBandPx(t, in), snapMovePx(8) + snapMovePx(4));
   in.actual_bits = 8;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), 2.0 * snapMovePx(8));
+  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(8));
+  EXPECT_DOUBLE_EQ(slopeBandPx(t, in), 2.0 * snapMovePx(8));
   t.window_error_ulps = 16.0;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), 2.0 * snapMovePx(8) + 16.0 * 640.0 / 16777216.0);
+  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(8) + 16.0 * 640.0 / 16777216.0);
+  EXPECT_DOUBLE_EQ(slopeBandPx(t, in), 2.0 * snapMovePx(8) + 16.0 * 640.0 / 16777216.0);
   t.band_px = 0.25;
   EXPECT_EQ(snapBandPx(t, in), 0.25);
 }
