@@ -47,8 +47,9 @@ int compareCommand(const CompareArgs& args) {
   Report report;
   report.tool_version = kVersion;
   report.command = "compare";
+  const PairPictures pictures{readyPicture(args.expected), readyPicture(args.actual)};
   report.results.push_back(
-      comparePair(expected, actual, *uncertainty, tolerances, folder.staging()));
+      comparePair(expected, actual, *uncertainty, tolerances, folder.staging(), pictures));
   folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);

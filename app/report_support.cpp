@@ -42,8 +42,19 @@ Tolerances pairTolerances(const Frame& expected, const Frame& actual,
   return tol;
 }
 
+fs::path readyPicture(const fs::path& frame_dir) {
+  std::error_code ec;
+  const fs::path png = frame_dir / "color.png";
+  const auto png_time = fs::last_write_time(png, ec);
+  if (ec) return {};
+  const auto exr_time = fs::last_write_time(frame_dir / "frame.exr", ec);
+  if (ec || png_time < exr_time) return {};
+  return png;
+}
+
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
-                       const Tolerances& tolerances, const fs::path& out_dir) {
+                       const Tolerances& tolerances, const fs::path& out_dir,
+                       const PairPictures& pictures) {
   ClassMaps maps;
   PairResult result = compareFrames(expected, actual, uncertainty, tolerances, &maps);
   auto name = [](const Frame& f, const char* fallback) {
@@ -55,7 +66,7 @@ PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& 
   result.actual = name(actual, "actual");
   if (expected.meta.contains("fixture") && expected.meta["fixture"].is_string())
     result.fixture = expected.meta["fixture"].get<std::string>();
-  writePairImages(expected, actual, maps, pairDirectory(out_dir, result), result);
+  writePairImages(expected, actual, maps, pairDirectory(out_dir, result), result, pictures);
   return result;
 }
 

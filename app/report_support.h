@@ -8,6 +8,7 @@
 #include <ostream>
 
 #include "compare/compare.h"
+#include "compare/pair_images.h"
 #include "compare/report.h"
 #include "compare/tolerances.h"
 #include "fixtures/frame.h"
@@ -27,7 +28,12 @@ Tolerances pairTolerances(const Frame& expected, const Frame& actual,
 
 // Compares and writes the pair's images under out_dir (pairDirectory).
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
-                       const Tolerances& tolerances, const std::filesystem::path& out_dir);
+                       const Tolerances& tolerances, const std::filesystem::path& out_dir,
+                       const PairPictures& pictures = {});
+
+// A frame folder's color.png when it is no older than its frame.exr (`render` writes both
+// from one frame), else empty: then the comparator encodes the picture itself.
+std::filesystem::path readyPicture(const std::filesystem::path& frame_dir);
 
 // A report folder written all-or-nothing. Everything goes to a staging folder inside it;
 // commit() writes the report there, then removes what an earlier run left (the files its

@@ -268,7 +268,6 @@ class Comparator {
       maps->depth_tolerance.assign(n, 0.0f);
       maps->shading_abs.assign(n, 0.0f);
       maps->shading_tolerance.assign(n, 0.0f);
-      maps->delta_rgba.assign(n * 4, 0.0f);
     }
     for (int y = 0; y < e_.height; ++y) {
       if (maps) {
@@ -326,9 +325,6 @@ class Comparator {
         }
         tally(za[x], 4, r_.nonfinite_expected);
         tally(zb[x], 4, r_.nonfinite_actual);
-      }
-      if (kMaps) {
-        for (int c = 0; c < 4; ++c) maps->delta_rgba[i * 4 + c] = (pb[c] - pa[c]) * 255.0f;
       }
       if (a != b) {
         const PixelClass cls = classifyMismatch(x, y, i, a, b);
@@ -439,20 +435,11 @@ class Comparator {
       const V4i same = reinterpret_cast<V4i>(a == b);
       const V4i drawn = reinterpret_cast<V4i>(a != 0u);
       if (any(bad) || !all(same & drawn)) {
-        if (any(bad) || any(drawn | ~same)) {
-          runRange<kMaps>(y, x, x + 4);
-        } else if (kMaps) {  // background on both sides: only the colour delta
-          for (int k = 0; k < 4; ++k)
-            store(&maps->delta_rgba[(row + x + k) * 4], (c_b[k] - c_a[k]) * 255.0f);
-        }
-        continue;
+        if (any(bad) || any(drawn | ~same)) runRange<kMaps>(y, x, x + 4);
+        continue;  // else background on both sides
       }
       matched += 4;
-      if (kMaps) {
-        std::memset(&maps->pixel_class[row + x], static_cast<int>(PixelClass::Match), 4);
-        for (int k = 0; k < 4; ++k)
-          store(&maps->delta_rgba[(row + x + k) * 4], (c_b[k] - c_a[k]) * 255.0f);
-      }
+      if (kMaps) std::memset(&maps->pixel_class[row + x], static_cast<int>(PixelClass::Match), 4);
 
       // Depth, in double like runRange.
       V2d sa[2] = {lowHalf(z_a) * scale, highHalf(z_a) * scale};

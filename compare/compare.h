@@ -147,6 +147,7 @@ PairResult errorResult(std::string fixture, std::string expected, std::string ac
                        std::string message);
 
 // Per-pixel results, for images and diff.exr. Index y * width + x (image coordinates).
+// (The colour deltas diff.exr also holds come straight from the frames.)
 struct ClassMaps {
   int width = 0;
   int height = 0;
@@ -155,7 +156,6 @@ struct ClassMaps {
   std::vector<float> depth_tolerance;    // warn + slope allowance where compared, else 0
   std::vector<float> shading_abs;        // largest channel error where compared (NaN: non-finite)
   std::vector<float> shading_tolerance;  // warn + allowance of the deciding channel, else 0
-  std::vector<float> delta_rgba;         // (actual - expected) * 255 per channel, 4 per pixel
 };
 
 // Compares `actual` with `expected`. `uncertainty` is the reference frame whose

@@ -30,8 +30,12 @@ using OIIO::TypeDesc;
 // looked at, not archived.
 constexpr int kPngCompressionLevel = 1;
 constexpr int kPngFilterSub = 16;
-// diff.exr: mostly zero rows (background, no error) that fast zip level 1 shrinks well.
+// diff.exr: mostly zero rows (background, no error) that fast zip (level 1) shrinks to a
+// few percent, at ~0.1 us per pixel. Above ~1 M pixels that is the longest single task of
+// a comparison (0.24 s CPU at 1080p, five times the comparison itself), so large frames
+// are written uncompressed (36 bytes per pixel).
 constexpr const char* kDiffExrCompression = "zip:1";
+constexpr std::size_t kDiffExrCompressUpTo = std::size_t{1} << 20;
 
 void writeImage(const fs::path& file, ImageSpec spec, TypeDesc format, const void* data,
                 const fs::path& target) {
@@ -50,19 +54,34 @@ void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_
   writeImage(file, ImageSpec(w, h, 3, TypeDesc::UINT8), TypeDesc::UINT8, rgb.data(), target);
 }
 
+// v in [0, 255] (or NaN) rounded to nearest, halves up: lround without the call. NaN
+// fails both comparisons and becomes 0.
+inline std::uint8_t toByte(float v) {
+  v = v > 0.0f ? v : 0.0f;
+  v = v < 255.0f ? v : 255.0f;
+  return static_cast<std::uint8_t>(static_cast<int>(v + 0.5f));
+}
+
 // The frame's colour as people see it: clamped to [0, 1], rounded, NaN as black (as
 // render's color.png, but from the frame that was compared).
 std::vector<std::uint8_t> colorRgb8(const Frame& frame) {
   const std::size_t n = frame.pixelCount();
   std::vector<std::uint8_t> rgb(n * 3);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      const float v = frame.color[i * 4 + c];
-      rgb[i * 3 + c] = static_cast<std::uint8_t>(
-          std::lround((std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f)) * 255.0f));
-    }
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = toByte(frame.color[i * 4 + c] * 255.0f);
   return rgb;
+}
+
+// The picture of one frame: a link to (or copy of) a ready-made one, else encoded.
+void writePicture(const Frame& frame, const fs::path& ready, const fs::path& file,
+                  const fs::path& target) {
+  if (!ready.empty()) {
+    std::error_code ec;
+    fs::create_hard_link(ready, file, ec);
+    if (!ec) return;
+    if (fs::copy_file(ready, file, fs::copy_options::overwrite_existing, ec)) return;
+  }
+  writeRgb8(file, frame.width, frame.height, colorRgb8(frame), target);
 }
 
 float luminance(const float* c) {
@@ -91,11 +110,54 @@ std::vector<std::uint8_t> heatImage(const ClassMaps& maps, const std::vector<flo
       px = kNonFiniteColor;
     } else {
       px = lut[static_cast<std::size_t>(
-          std::lround(heatPosition(values[i], scale) * static_cast<float>(kHeatLutSize - 1)))];
+          heatPosition(values[i], scale) * static_cast<float>(kHeatLutSize - 1) + 0.5f)];
     }
     std::copy(px.begin(), px.end(), out.begin() + static_cast<std::ptrdiff_t>(i * 3));
   }
   return out;
+}
+
+// diff.exr: every float a tool might want, one channel each, written in bands of rows so
+// that the interleaved pixels never exist for the whole image.
+void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& maps,
+                  const PairResult& result, const fs::path& file, const fs::path& target) {
+  const int w = maps.width;
+  const int h = maps.height;
+  const std::vector<std::string> names = {
+      "id_class", "depth_steps", "depth_tolerance", "shading_abs", "shading_tolerance", "dR", "dG",
+      "dB",       "dA"};
+  const int nch = static_cast<int>(names.size());
+  ImageSpec spec(w, h, nch, TypeDesc::FLOAT);
+  spec.channelnames = names;
+  spec.attribute("compression", static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo
+                                    ? kDiffExrCompression
+                                    : "none");
+  spec.attribute("rastercheck:fixture", result.fixture);
+  spec.attribute("rastercheck:pair", result.expected + " vs " + result.actual);
+  auto out = OIIO::ImageOutput::create(file.string());
+  auto fail = [&] {
+    throw InputError(fmt::format("{}: cannot write: {}", target.string(),
+                                 out ? out->geterror() : OIIO::geterror()));
+  };
+  if (!out || !out->open(file.string(), spec)) fail();
+  constexpr int kBandRows = 32;  // a multiple of every EXR compression's block height
+  std::vector<float> band(static_cast<std::size_t>(w) * kBandRows * nch);
+  for (int y0 = 0; y0 < h; y0 += kBandRows) {
+    const int y1 = std::min(h, y0 + kBandRows);
+    for (std::size_t i = static_cast<std::size_t>(y0) * w, k = 0;
+         i < static_cast<std::size_t>(y1) * w; ++i, ++k) {
+      float* p = &band[k * nch];
+      p[0] = static_cast<float>(maps.pixel_class[i]);
+      p[1] = maps.depth_steps[i];
+      p[2] = maps.depth_tolerance[i];
+      p[3] = maps.shading_abs[i];
+      p[4] = maps.shading_tolerance[i];
+      for (int c = 0; c < 4; ++c)
+        p[5 + c] = (actual.color[i * 4 + c] - expected.color[i * 4 + c]) * 255.0f;
+    }
+    if (!out->write_scanlines(y0, y1, 0, TypeDesc::FLOAT, band.data())) fail();
+  }
+  if (!out->close()) fail();
 }
 
 // Runs the writers concurrently (each file is independent and most time is deflate), and
@@ -173,14 +235,14 @@ std::vector<Rgb8> heatColorStops(int count) {
 }
 
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
-                     const fs::path& dir, PairResult& result) {
+                     const fs::path& dir, PairResult& result, const PairPictures& pictures) {
   const int w = maps.width;
   const int h = maps.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
   if (w <= 0 || h <= 0 || expected.width != w || expected.height != h || actual.width != w ||
       actual.height != h || maps.pixel_class.size() != n || maps.depth_steps.size() != n ||
       maps.depth_tolerance.size() != n || maps.shading_abs.size() != n ||
-      maps.shading_tolerance.size() != n || maps.delta_rgba.size() != n * 4)
+      maps.shading_tolerance.size() != n)
     throw InputError(fmt::format("{}: class maps do not match the frames ({}x{})", dir.string(),
                                  expected.width, expected.height));
 
@@ -204,16 +266,15 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
   heatLut();  // built once, before the threads that share it
 
   runAll({
-      [&] { writeRgb8(tmp_expected, w, h, colorRgb8(expected), expected_png); },
-      [&] { writeRgb8(tmp_actual, w, h, colorRgb8(actual), actual_png); },
+      [&] { writePicture(expected, pictures.expected, tmp_expected, expected_png); },
+      [&] { writePicture(actual, pictures.actual, tmp_actual, actual_png); },
       [&] {
         // Visibility: classes in colour over a dim copy of the expected image for context.
         std::vector<std::uint8_t> vis(n * 3);
         for (std::size_t i = 0; i < n; ++i) {
           Rgb8 px = classColor(maps.pixel_class[i]);
           if (maps.pixel_class[i] == PixelClass::Match) {
-            const auto g = static_cast<std::uint8_t>(
-                std::lround(48.0f + 96.0f * luminance(&expected.color[i * 4])));
+            const std::uint8_t g = toByte(48.0f + 96.0f * luminance(&expected.color[i * 4]));
             px = {g, g, g};
           }
           std::copy(px.begin(), px.end(), vis.begin() + static_cast<std::ptrdiff_t>(i * 3));
@@ -228,35 +289,7 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
         writeRgb8(tmp_shading, w, h, heatImage(maps, maps.shading_abs, result.shading_heat_scale),
                   shading_png);
       },
-      [&] {
-        // diff.exr: every float a tool might want, one channel each.
-        const std::vector<std::string> names = {"id_class",
-                                                "depth_steps",
-                                                "depth_tolerance",
-                                                "shading_abs",
-                                                "shading_tolerance",
-                                                "dR",
-                                                "dG",
-                                                "dB",
-                                                "dA"};
-        const int nch = static_cast<int>(names.size());
-        ImageSpec spec(w, h, nch, TypeDesc::FLOAT);
-        spec.channelnames = names;
-        spec.attribute("compression", kDiffExrCompression);
-        spec.attribute("rastercheck:fixture", result.fixture);
-        spec.attribute("rastercheck:pair", result.expected + " vs " + result.actual);
-        std::vector<float> diff(n * nch);
-        for (std::size_t i = 0; i < n; ++i) {
-          float* p = &diff[i * nch];
-          p[0] = static_cast<float>(maps.pixel_class[i]);
-          p[1] = maps.depth_steps[i];
-          p[2] = maps.depth_tolerance[i];
-          p[3] = maps.shading_abs[i];
-          p[4] = maps.shading_tolerance[i];
-          for (int c = 0; c < 4; ++c) p[5 + c] = maps.delta_rgba[i * 4 + c];
-        }
-        writeImage(tmp_diff, spec, TypeDesc::FLOAT, diff.data(), diff_exr);
-      },
+      [&] { writeDiffExr(expected, actual, maps, result, tmp_diff, diff_exr); },
   });
 
   files.commit();

@@ -36,8 +36,16 @@ float heatPosition(float value, double scale);
 // depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG, dB, dA; see
 // docs/reports.md), and records them in result.images and the heat scales in result.
 // Throws InputError when a file cannot be written; then none of them is left behind.
+// Ready-made 8-bit pictures of the two frames (the frame folders' color.png, which
+// `render` writes from the same frame with the same conversion). When given, they are
+// linked (or copied) as expected.png/actual.png instead of encoding the frames again.
+struct PairPictures {
+  std::filesystem::path expected;
+  std::filesystem::path actual;
+};
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
-                     const std::filesystem::path& dir, PairResult& result);
+                     const std::filesystem::path& dir, PairResult& result,
+                     const PairPictures& pictures = {});
 
 // A folder for one pair's images under a report folder: <out>/pairs/<fixture>/<expected>
 // _vs_<actual>, every name reduced to [A-Za-z0-9._-] (fixture "a/b" becomes "a_b").

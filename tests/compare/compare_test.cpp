@@ -432,7 +432,6 @@ TEST_F(CompareTest, ClassMapsHoldThePerPixelResults) {
   EXPECT_EQ(maps.depth_steps[gl_.index(kBackBlock.x0, kBackBlock.y0)], kN);
   EXPECT_EQ(maps.depth_steps[gl_.index(kBackBlock.x0 - 1, kBackBlock.y0)], 0.0f);
   EXPECT_NEAR(maps.shading_abs[gl_.index(60, 60)], 2.0f, 1e-4);
-  EXPECT_NEAR(maps.delta_rgba[gl_.index(60, 60) * 4 + 2], 2.0f, 1e-4);
   // Tolerances are kept where the error is over warn (where the allowance decides).
   EXPECT_GT(maps.depth_tolerance[gl_.index(kBackBlock.x0, kBackBlock.y0)], tol_.depth.warn);
   EXPECT_EQ(maps.depth_tolerance[gl_.index(60, 60)], 0.0f);
