@@ -62,9 +62,10 @@ struct DrawnWith {
 // The documented defaults for a pair rendered with these formats (docs/tolerances.md).
 Tolerances defaultTolerances(DepthFormat depth, ColorFormat color, DrawnWith drawn = {});
 
-// The relative error of float32 lighting (GLSL 4.60 section 4.7.1 precisions, Blinn-Phong
-// and Phong exponents up to 1024): 2^-11.
-inline constexpr double kShadingRelative = 1.0 / 2048.0;
+// The relative error of float32 lighting at the GLSL 4.60 precisions (section 4.7.1): pow
+// through exp2(s log2 x) is the worst term, ~5.7e-7 per unit of shininess s, so 2^-10
+// covers exponents up to ~1700 (docs/tolerances.md).
+inline constexpr double kShadingRelative = 1.0 / 1024.0;
 // Linear filtering with weights of 8 fractional bits (llvmpipe; D3D's minimum subtexel
 // precision): each of the two weights off by up to 2^-8, each moving the filtered value by
 // up to that fraction of the footprint's contrast.
