@@ -44,7 +44,7 @@ Tolerances pairTolerances(const Frame& expected, const Frame& actual,
 
 fs::path readyPicture(const fs::path& frame_dir) {
   std::error_code ec;
-  const fs::path png = frame_dir / "color.png";
+  fs::path png = frame_dir / "color.png";
   const auto png_time = fs::last_write_time(png, ec);
   if (ec) return {};
   const auto exr_time = fs::last_write_time(frame_dir / "frame.exr", ec);

@@ -15,8 +15,6 @@
 
 #include "fixtures/errors.h"
 
-extern char** environ;
-
 namespace rc {
 namespace {
 

@@ -164,7 +164,7 @@ class HotBins {
       : h_(h),
         inverse_quantum_(1.0 / h.quantum()),
         inverse_quantum_f_(static_cast<float>(inverse_quantum_)),
-        counts_(4 * kBins, 0) {}
+        counts_(static_cast<std::size_t>(4 * kBins), 0) {}
   void add(int lane, double value) {
     const double u = value * inverse_quantum_;
     if (u < kBins) {
@@ -312,8 +312,8 @@ class Comparator {
       const std::uint32_t a = ida[x];
       const std::uint32_t b = idb[x];
       const std::size_t i = row + x;
-      const float* pa = ca + x * 4;
-      const float* pb = cb + x * 4;
+      const float* pa = ca + static_cast<std::ptrdiff_t>(x) * 4;
+      const float* pb = cb + static_cast<std::ptrdiff_t>(x) * 4;
       bool depth_finite = !isNonFinite(za[x]) && !isNonFinite(zb[x]);
       bool color_finite = true;
       for (int c = 0; c < 4; ++c)
@@ -423,8 +423,8 @@ class Comparator {
       V4f c_a[4];
       V4f c_b[4];
       for (int k = 0; k < 4; ++k) {
-        c_a[k] = load<V4f>(ca + (x + k) * 4);
-        c_b[k] = load<V4f>(cb + (x + k) * 4);
+        c_a[k] = load<V4f>(ca + static_cast<std::ptrdiff_t>(x + k) * 4);
+        c_b[k] = load<V4f>(cb + static_cast<std::ptrdiff_t>(x + k) * 4);
       }
       // A NaN or Inf on either side makes a difference NaN or Inf, and then times 0 NaN
       // (so does an overflow of huge finite values: conservative, the general path

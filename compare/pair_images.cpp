@@ -37,7 +37,7 @@ constexpr int kPngFilterSub = 16;
 constexpr const char* kDiffExrCompression = "zip:1";
 constexpr std::size_t kDiffExrCompressUpTo = std::size_t{1} << 20;
 
-void writeImage(const fs::path& file, ImageSpec spec, TypeDesc format, const void* data,
+void writeImage(const fs::path& file, ImageSpec spec, const TypeDesc& format, const void* data,
                 const fs::path& target) {
   if (file.extension() == ".png") {
     spec.attribute("png:compressionLevel", kPngCompressionLevel);
@@ -54,12 +54,18 @@ void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_
   writeImage(file, ImageSpec(w, h, 3, TypeDesc::UINT8), TypeDesc::UINT8, rgb.data(), target);
 }
 
-// v in [0, 255] (or NaN) rounded to nearest, halves up: lround without the call. NaN
-// fails both comparisons and becomes 0.
+// v >= 0 rounded to nearest, halves up, as std::lround: v - trunc(v) is exact in float
+// (adding 0.5 first would round 0.49999997 up).
+inline int roundHalfUp(float v) {
+  const auto q = static_cast<int>(v);
+  return q + (v - static_cast<float>(q) >= 0.5f ? 1 : 0);
+}
+
+// v clamped to [0, 255] and rounded; NaN fails both comparisons and becomes 0.
 inline std::uint8_t toByte(float v) {
   v = v > 0.0f ? v : 0.0f;
   v = v < 255.0f ? v : 255.0f;
-  return static_cast<std::uint8_t>(static_cast<int>(v + 0.5f));
+  return static_cast<std::uint8_t>(roundHalfUp(v));
 }
 
 // The frame's colour as people see it: clamped to [0, 1], rounded, NaN as black (as
@@ -110,7 +116,7 @@ std::vector<std::uint8_t> heatImage(const ClassMaps& maps, const std::vector<flo
       px = kNonFiniteColor;
     } else {
       px = lut[static_cast<std::size_t>(
-          heatPosition(values[i], scale) * static_cast<float>(kHeatLutSize - 1) + 0.5f)];
+          roundHalfUp(heatPosition(values[i], scale) * static_cast<float>(kHeatLutSize - 1)))];
     }
     std::copy(px.begin(), px.end(), out.begin() + static_cast<std::ptrdiff_t>(i * 3));
   }

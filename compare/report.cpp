@@ -260,7 +260,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
 std::string describe(const PairResult& r) {
   std::string status = toString(r.status);
   for (char& ch : status) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  const std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
+  std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
   if (r.status == Status::Error) return head + ": " + r.error;
   // The classes that set the pair's status; at pass, nothing to say.
   std::vector<std::string> parts;

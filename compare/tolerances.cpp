@@ -144,7 +144,7 @@ ToleranceOverrides toleranceFromJson(const nlohmann::json& j, const std::string&
     if (!t) throw bad("." + cls, "unknown class (visibility, depth, shading)");
     if (!value.is_object()) throw bad("." + cls, "must be an object");
     for (const auto& [key, v] : value.items()) {
-      const std::string path = "." + cls + "." + key;
+      const std::string path = fmt::format(".{}.{}", cls, key);
       if (key == "warn")
         t->warn = number(v, path);
       else if (key == "fail")
