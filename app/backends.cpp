@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "app/version.h"
+#include "compare/pair_images.h"
 #include "compare/tolerances.h"
 #include "fixtures/errors.h"
 
@@ -88,6 +89,7 @@ Frame renderWith(const BackendSpec& backend, const Scene& scene) {
   m["textured"] = std::any_of(scene.materials.begin(), scene.materials.end(),
                               [](const Material& mat) { return mat.texture != nullptr; });
   m["tolerance"] = toleranceJson(scene.tolerance);
+  m["color_digest"] = colorDigest(frame);  // tells `compare` color.png shows this frame
   if (!m.contains("subpixel_bits")) m["subpixel_bits"] = backend.reference.subpixel_bits;
   m["time_ms"] = ms;
   return frame;

@@ -47,7 +47,8 @@ int compareCommand(const CompareArgs& args) {
   Report report;
   report.tool_version = kVersion;
   report.command = "compare";
-  const PairPictures pictures{readyPicture(args.expected), readyPicture(args.actual)};
+  const PairPictures pictures{readyPicture(args.expected, expected),
+                              readyPicture(args.actual, actual)};
   report.results.push_back(
       comparePair(expected, actual, *uncertainty, tolerances, folder.staging(), pictures));
   folder.commit(report);

@@ -42,14 +42,13 @@ Tolerances pairTolerances(const Frame& expected, const Frame& actual,
   return tol;
 }
 
-fs::path readyPicture(const fs::path& frame_dir) {
-  std::error_code ec;
+fs::path readyPicture(const fs::path& frame_dir, const Frame& frame) {
+  const auto it = frame.meta.find("color_digest");
+  if (it == frame.meta.end() || !it->is_string() || it->get<std::string>() != colorDigest(frame))
+    return {};
   fs::path png = frame_dir / "color.png";
-  const auto png_time = fs::last_write_time(png, ec);
-  if (ec) return {};
-  const auto exr_time = fs::last_write_time(frame_dir / "frame.exr", ec);
-  if (ec || png_time < exr_time) return {};
-  return png;
+  std::error_code ec;
+  return fs::is_regular_file(png, ec) ? png : fs::path();
 }
 
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,

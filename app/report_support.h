@@ -31,9 +31,10 @@ PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& 
                        const Tolerances& tolerances, const std::filesystem::path& out_dir,
                        const PairPictures& pictures = {});
 
-// A frame folder's color.png when it is no older than its frame.exr (`render` writes both
-// from one frame), else empty: then the comparator encodes the picture itself.
-std::filesystem::path readyPicture(const std::filesystem::path& frame_dir);
+// A frame folder's color.png when it shows `frame` (frame.json's "color_digest", written
+// by `render`, matches the frame that was read), else empty: then the comparator encodes
+// the picture itself.
+std::filesystem::path readyPicture(const std::filesystem::path& frame_dir, const Frame& frame);
 
 // A report folder written all-or-nothing. Everything goes to a staging folder inside it;
 // commit() writes the report there, then removes what an earlier run left (the files its

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <functional>
 #include <future>
@@ -195,6 +196,23 @@ std::string safeName(const std::string& s) {
 }
 
 }  // namespace
+
+std::string colorDigest(const Frame& frame) {
+  // 64-bit FNV-1a over whole words: not cryptographic, only to notice a changed frame.
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  auto mix = [&](std::uint64_t w) { h = (h ^ w) * 0x100000001b3ull; };
+  mix(static_cast<std::uint64_t>(frame.width) << 32 | static_cast<std::uint32_t>(frame.height));
+  const std::size_t bytes = frame.color.size() * sizeof(float);
+  const auto* p = reinterpret_cast<const unsigned char*>(frame.color.data());
+  std::size_t k = 0;
+  for (; k + 8 <= bytes; k += 8) {
+    std::uint64_t w;
+    std::memcpy(&w, p + k, 8);
+    mix(w);
+  }
+  for (; k < bytes; ++k) mix(p[k]);
+  return fmt::format("{:016x}", h);
+}
 
 Rgb8 classColor(PixelClass c) {
   switch (c) {

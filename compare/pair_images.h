@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "compare/compare.h"
@@ -36,6 +37,11 @@ float heatPosition(float value, double scale);
 // depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG, dB, dA; see
 // docs/reports.md), and records them in result.images and the heat scales in result.
 // Throws InputError when a file cannot be written; then none of them is left behind.
+// A digest of a frame's size and colour buffer (16 hex digits). `render` records it in
+// frame.json ("color_digest"), so that a reader can tell whether the folder's color.png
+// still shows the colour in frame.exr.
+std::string colorDigest(const Frame& frame);
+
 // Ready-made 8-bit pictures of the two frames (the frame folders' color.png, which
 // `render` writes from the same frame with the same conversion). When given, they are
 // linked (or copied) as expected.png/actual.png instead of encoding the frames again.

@@ -355,3 +355,23 @@ TEST(CliRun, SummaryTableListsEveryFixtureAndBackend) {
     EXPECT_NE(r.out.find(f, header), std::string::npos) << f << "\n" << r.out;
   EXPECT_NE(r.out.find("v: hard visibility px"), std::string::npos);
 }
+
+TEST(CliCompare, PicturesAreReusedOnlyWhenTheyShowTheComparedFrames) {
+  const fs::path dir = scratch("cmp_pictures");
+  const std::string fixture = catalog("coverage/triangle_fan.json");
+  const fs::path a = renderTo(dir, "a", fixture, "ref");
+  const fs::path b = renderTo(dir, "b", fixture, "ref:subpixel=8");
+  // b's frame.exr changed after `render` (a fault injected into the colour only):
+  // frame.json still has the old digest, so b's color.png no longer shows the frame.
+  rc::Frame changed = rc::readFrameDir(b);
+  for (std::size_t i = 0; i < changed.pixelCount(); ++i)
+    if (changed.id[i] != 0) changed.color[i * 4] += 0.25f;
+  rc::writeFrameExr(changed, b / "frame.exr");
+  const fs::path out = dir / "report";
+  const Result r = run("compare " + a.string() + " " + b.string() + " --out " + out.string());
+  EXPECT_EQ(r.code, 1) << r.out;
+  const fs::path pair = out / "pairs" / "coverage_triangle_fan" / "ref_vs_ref_subpixel_8";
+  EXPECT_TRUE(fs::equivalent(pair / "expected.png", a / "color.png"));  // linked
+  EXPECT_FALSE(fs::equivalent(pair / "actual.png", b / "color.png"));   // encoded anew
+  EXPECT_NE(readFile(pair / "actual.png"), readFile(b / "color.png"));
+}
