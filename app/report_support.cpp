@@ -187,11 +187,12 @@ std::string summaryTable(const Report& report, std::size_t max_rows) {
   const bool compact = fixtures.size() > max_rows;
   if (compact) std::erase_if(rows, allPass);
 
-  std::size_t first = std::string("fixture").size();
+  std::size_t first = std::max<std::size_t>(std::string("fixture").size(),
+                                            fmt::format("(all {})", fixtures.size()).size());
   for (const std::string& f : rows) first = std::max(first, f.size());
   std::vector<std::size_t> widths;
   for (const std::string& b : backends) {
-    std::size_t w = b.size();
+    std::size_t w = std::max<std::size_t>(b.size(), compact ? 30 : 0);
     for (const std::string& f : rows) {
       const auto it = cells.find({f, b});
       if (it != cells.end()) w = std::max(w, cellText(*it->second).size());
@@ -211,8 +212,25 @@ std::string summaryTable(const Report& report, std::size_t max_rows) {
     while (!line.empty() && line.back() == ' ') line.pop_back();
     out += line + '\n';
   }
-  if (compact)
-    out += fmt::format("({} more fixtures pass on every backend)\n", fixtures.size() - rows.size());
+  if (compact) {
+    // One more row: every fixture's verdicts per backend.
+    std::string line = fmt::format("{:<{}}", fmt::format("(all {})", fixtures.size()), first);
+    for (std::size_t k = 0; k < backends.size(); ++k) {
+      std::map<Status, int> n;
+      for (const std::string& f : fixtures)
+        if (const auto it = cells.find({f, backends[k]}); it != cells.end())
+          ++n[it->second->status];
+      std::string text;
+      for (const Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error})
+        if (n[st] > 0)
+          text += fmt::format("{}{} {}", text.empty() ? "" : ", ", n[st], toString(st));
+      line += fmt::format("  {:<{}}", text, widths[k]);
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + '\n';
+    out += fmt::format("({} fixtures that pass on every backend not listed)\n",
+                       fixtures.size() - rows.size());
+  }
   out += "v: hard visibility px, d: depth max (steps), s: shading max (8-bit units)\n";
   return out;
 }

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "app/report_support.h"
 #include "fixtures/frame_io.h"
 
 namespace fs = std::filesystem;
@@ -374,4 +375,38 @@ TEST(CliCompare, PicturesAreReusedOnlyWhenTheyShowTheComparedFrames) {
   EXPECT_TRUE(fs::equivalent(pair / "expected.png", a / "color.png"));  // linked
   EXPECT_FALSE(fs::equivalent(pair / "actual.png", b / "color.png"));   // encoded anew
   EXPECT_NE(readFile(pair / "actual.png"), readFile(b / "color.png"));
+}
+
+TEST(SummaryTable, CompactForBigCatalogsListsOnlyWhatDidNotPass) {
+  rc::Report report;
+  for (int f = 0; f < 6; ++f) {
+    for (const char* backend : {"gl:a", "gl:b"}) {
+      rc::PairResult r;
+      r.fixture = "set/fixture" + std::to_string(f);
+      r.expected = "ref";
+      r.actual = backend;
+      if (f == 3 && std::string(backend) == "gl:b") {
+        r.status = rc::Status::Fail;
+        r.visibility.hard = 12;
+        r.depth.max_steps = 40;
+        r.shading.max_abs = 2.5;
+      }
+      report.results.push_back(r);
+    }
+  }
+  report.results.push_back(rc::errorResult("set/fixture5", "ref", "gl:b", "no driver"));
+  const std::string full = rc::summaryTable(report, 40);
+  for (int f = 0; f < 6; ++f)
+    EXPECT_NE(full.find("set/fixture" + std::to_string(f)), std::string::npos) << full;
+  EXPECT_NE(full.find("FAIL v12 d40 s2.5"), std::string::npos) << full;
+  const std::string compact = rc::summaryTable(report, 4);
+  EXPECT_EQ(compact.find("set/fixture0"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("set/fixture3"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("set/fixture5"), std::string::npos) << compact;  // the error row
+  EXPECT_NE(compact.find("ERROR"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("(all 6)"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("6 pass"), std::string::npos) << compact;  // gl:a
+  EXPECT_NE(compact.find("4 pass, 1 fail, 1 error"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("(4 fixtures that pass on every backend not listed)"), std::string::npos)
+      << compact;
 }
