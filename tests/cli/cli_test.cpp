@@ -410,3 +410,24 @@ TEST(SummaryTable, CompactForBigCatalogsListsOnlyWhatDidNotPass) {
   EXPECT_NE(compact.find("(4 fixtures that pass on every backend not listed)"), std::string::npos)
       << compact;
 }
+
+TEST(CliCompare, TheFixturesToleranceBlockAppliesAndTheCommandLineWins) {
+  const fs::path dir = scratch("cmp_tolerance");
+  // The interpenetrating quads with a visibility tolerance that forgives painter's order.
+  std::string text = readFile(crafted("interpenetrating.json"));
+  text.replace(text.rfind('}'), 1,
+               R"(, "tolerance": {"visibility": {"warn": 0, "fail": 100000}}})");
+  const fs::path fixture = dir / "forgiving.json";
+  std::ofstream(fixture) << text;
+  const fs::path a = renderTo(dir, "z", fixture.string(), "ref");
+  const fs::path b = renderTo(dir, "p", fixture.string(), "ref:painter");
+  // render recorded the block in frame.json: compare applies it without the fixture.
+  fs::remove(fixture);
+  Result r =
+      run("compare " + a.string() + " " + b.string() + " --out " + (dir / "report").string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.substr(r.out.size() - 8), "WARNING\n") << r.out;
+  r = run("compare " + a.string() + " " + b.string() + " --out " + (dir / "report").string() +
+          " --tolerance visibility.fail=10");
+  EXPECT_EQ(r.code, 1) << r.out;
+}
