@@ -1,12 +1,15 @@
 // Backend SPEC parsing and dispatch: see backends.h.
 #include "app/backends.h"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 
 #include <fmt/format.h>
 
 #include "app/version.h"
+#include "compare/pair_images.h"
+#include "compare/tolerances.h"
 #include "fixtures/errors.h"
 
 namespace rc {
@@ -81,6 +84,12 @@ Frame renderWith(const BackendSpec& backend, const Scene& scene) {
   m["depth_format"] = toString(scene.state.depth_format);
   m["color_format"] = toString(scene.state.color_format);
   m["clear_depth"] = scene.clear_depth;
+  // What the comparator's shading allowance depends on (docs/tolerances.md).
+  m["texture_filter"] = toString(scene.state.texture_filter);
+  m["textured"] = std::any_of(scene.materials.begin(), scene.materials.end(),
+                              [](const Material& mat) { return mat.texture != nullptr; });
+  m["tolerance"] = toleranceJson(scene.tolerance);
+  m["color_digest"] = colorDigest(frame);  // tells `compare` color.png shows this frame
   if (!m.contains("subpixel_bits")) m["subpixel_bits"] = backend.reference.subpixel_bits;
   m["time_ms"] = ms;
   return frame;

@@ -1,6 +1,7 @@
 // `rastercheck compare EXPECTED_DIR ACTUAL_DIR --out DIR`: one pair of frame folders,
 // one report (report.json, junit.xml, report.html) with the pair's images.
 #include <filesystem>
+#include <future>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -9,7 +10,6 @@
 #include "app/report_support.h"
 #include "app/version.h"
 #include "compare/compare.h"
-#include "compare/pair_images.h"
 #include "compare/report.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
@@ -18,27 +18,40 @@ namespace rc {
 namespace fs = std::filesystem;
 
 int compareCommand(const CompareArgs& args) {
-  ToleranceOverrides cli;
+  CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
-  const Frame expected = readFrameDir(args.expected);
-  const Frame actual = readFrameDir(args.actual);
+  // The frames are independent files: read them concurrently (decompression dominates).
+  auto read = [](const fs::path& dir) {
+    return std::async(std::launch::async, [dir] { return readFrameDir(dir); });
+  };
+  std::future<Frame> expected_f = read(args.expected);
+  std::future<Frame> actual_f = read(args.actual);
+  std::future<Frame> third_f;
+  if (!args.uncertainty.empty()) third_f = read(args.uncertainty);
+  const Frame expected = expected_f.get();
+  const Frame actual = actual_f.get();
   checkSameSize(expected, actual, args.expected, args.actual);
   Frame third;
   const Frame* uncertainty = &expected;
-  if (!args.uncertainty.empty()) {
-    third = readFrameDir(args.uncertainty);
+  if (third_f.valid()) {
+    third = third_f.get();
     checkSameSize(expected, third, args.expected, args.uncertainty);
     uncertainty = &third;
   } else if (!expected.hasUncertainty() && actual.hasUncertainty()) {
     uncertainty = &actual;  // comparing a driver against the reference the other way round
   }
+  const Tolerances tolerances =
+      pairTolerances(expected, actual, fixtureTolerance(expected, actual), cli);
 
-  PairResult result = comparePair(expected, actual, *uncertainty, cli, args.out);
+  ReportFolder folder(args.out);
   Report report;
   report.tool_version = kVersion;
   report.command = "compare";
-  report.results.push_back(std::move(result));
-  writeReport(report, args.out);
+  const PairPictures pictures{readyPicture(args.expected, expected),
+                              readyPicture(args.actual, actual)};
+  report.results.push_back(
+      comparePair(expected, actual, *uncertainty, tolerances, folder.staging(), pictures));
+  folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);
 }

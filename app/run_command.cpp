@@ -2,7 +2,9 @@
 // renders every fixture with every backend, each render in its own child process
 // (`rastercheck render`, so a driver crash costs one row and each process picks its own
 // GL driver), then compares every backend with --against, classifying with the
-// reference's uncertainty channels, and writes one report.
+// reference's uncertainty channels, and writes one report. Everything the user gave is
+// checked before the first render (exit 2, nothing written); the outputs replace an
+// earlier run's only once all of them are written.
 #include <unistd.h>
 
 #include <algorithm>
@@ -35,57 +37,76 @@ struct FixtureEntry {
   fs::path file;
   std::string name;
   std::string slug;  // unique folder name
+  ToleranceOverrides tolerance;
 };
 
-// The last meaningful line a failed child printed, without our own prefixes.
-std::string childError(const Job& job) {
+// The last meaningful line a failed child printed, without our own prefixes and without
+// the "<fixture>: <spec>: " the render command puts in front (the report row names both).
+std::string childError(const Job& job, const std::string& fixture, const std::string& spec) {
   std::ifstream in(job.log);
   std::string line;
   std::string last;
   while (std::getline(in, line)) {
     if (!line.empty()) last = line;
   }
-  for (const char* prefix :
-       {"rastercheck: backend error: ", "rastercheck: error: ", "rastercheck: internal error: "}) {
-    if (last.rfind(prefix, 0) == 0) last = last.substr(std::string(prefix).size());
+  for (const std::string& prefix :
+       {std::string("rastercheck: backend error: "), std::string("rastercheck: error: "),
+        std::string("rastercheck: internal error: "), fixture + ": ", spec + ": "}) {
+    if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
   }
   if (!job.signal_name.empty())
     return fmt::format("crashed ({}){}", job.signal_name, last.empty() ? "" : ": " + last);
   return last.empty() ? fmt::format("exited with code {}", job.exit_code) : last;
 }
 
+// One status line on a terminal, redrawn in place; nothing when stderr is not a tty.
 class Progress {
  public:
-  explicit Progress(std::size_t total) : total_(total), tty_(::isatty(STDERR_FILENO) != 0) {}
-  void step(const std::string& what) {
-    ++done_;
+  Progress() : tty_(::isatty(STDERR_FILENO) != 0) {}
+  void show(const std::string& text) {
     if (!tty_) return;
-    std::string line = fmt::format("[{}/{}] {}", done_, total_, what);
-    if (line.size() > 100) line.resize(100);
+    std::string line = text;
+    if (line.size() > 110) line.resize(110);
     std::cerr << '\r' << line << std::string(width_ > line.size() ? width_ - line.size() : 0, ' ')
               << std::flush;
     width_ = line.size();
   }
-  void finish() {
+  void clear() {
     if (tty_ && width_ > 0) std::cerr << '\r' << std::string(width_, ' ') << '\r' << std::flush;
+    width_ = 0;
   }
 
  private:
-  std::size_t total_;
-  std::size_t done_ = 0;
-  std::size_t width_ = 0;
   bool tty_;
+  std::size_t width_ = 0;
 };
+
+// The tolerances each pair of this fixture will use, computed now so that a malformed
+// block or a warn above fail stops the run before anything is rendered.
+void checkTolerances(const Scene& scene, const CommandLineTolerances& cli) {
+  try {
+    DrawnWith drawn;
+    drawn.linear_textures = scene.state.texture_filter == TextureFilter::Linear;
+    Tolerances t = defaultTolerances(scene.state.depth_format, scene.state.color_format, drawn);
+    applyOverrides(t, scene.tolerance);
+    applyOverrides(t, cli);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", scene.source.string(), e.what()));
+  }
+}
 
 }  // namespace
 
 int runCommand(const RunArgs& args) {
-  ToleranceOverrides cli;
+  CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
   if (args.backends.empty()) throw InputError("run: --backends needs at least one SPEC");
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));
   const BackendSpec against = parseBackendSpec(args.against);
+  std::error_code ec;
+  if (fs::exists(args.out, ec) && !fs::is_directory(args.out, ec))
+    throw InputError(fmt::format("{}: --out names a file; it must be a folder", args.out.string()));
 
   // Every SPEC rendered once per fixture: the backends, --against, and the reference
   // whose edge_dist/depth_gap classify every pair.
@@ -105,42 +126,75 @@ int runCommand(const RunArgs& args) {
   std::set<std::string> slugs;
   for (const fs::path& file : findFixtures(inputs)) {
     const Scene scene = loadScene(file);
+    checkTolerances(scene, cli);
     std::string slug = fixtureSlug(scene.name);
     for (int k = 2; !slugs.insert(slug).second; ++k)
       slug = fixtureSlug(scene.name) + "~" + std::to_string(k);
-    fixtures.push_back({fs::absolute(file), scene.name, slug});
+    fixtures.push_back({fs::absolute(file), scene.name, slug, scene.tolerance});
   }
   if (fixtures.empty()) throw InputError("run: no fixtures found in the given paths");
 
-  const fs::path frames_dir = args.out / "frames";
-  fs::create_directories(frames_dir);
+  ReportFolder folder(args.out);
+  const fs::path frames_dir = folder.staging() / "frames";
   const std::string self = selfExecutable().string();
   std::vector<Job> jobs;
+  std::vector<std::size_t> fixture_of;  // per job
   std::map<std::pair<std::size_t, std::string>, std::size_t> job_of;
   for (std::size_t f = 0; f < fixtures.size(); ++f) {
     const fs::path dir = frames_dir / fixtures[f].slug;
-    fs::create_directories(dir);
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError(fmt::format("{}: cannot create: {}", dir.string(), ec.message()));
     for (const std::string& spec : render_specs) {
       const fs::path out = dir / fixtureSlug(spec);
       job_of[{f, spec}] = jobs.size();
+      fixture_of.push_back(f);
       jobs.push_back(
           Job{{self, "render", fixtures[f].file.string(), "--backend", spec, "--out", out.string()},
               dir / (fixtureSlug(spec) + ".log")});
     }
   }
 
+  // Rendering: the line names the first fixture still rendering (k of N; the ones before
+  // it are done) and the SPECs running for it.
   const int parallel = args.jobs > 0
                            ? args.jobs
                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  Progress progress(jobs.size());
-  runJobs(jobs, parallel, [&](std::size_t i) {
-    progress.step(fmt::format("{} @ {}", fixtures[i / render_specs.size()].name,
-                              render_specs[i % render_specs.size()]));
-  });
-  progress.finish();
+  Progress progress;
+  std::vector<std::size_t> left(fixtures.size(), render_specs.size());
+  std::vector<std::set<std::string>> running(fixtures.size());
+  auto showRender = [&] {
+    for (std::size_t f = 0; f < fixtures.size(); ++f) {
+      if (left[f] == 0) continue;
+      std::string specs;
+      for (const std::string& s : running[f]) specs += (specs.empty() ? "" : ", ") + s;
+      progress.show(fmt::format("[{}/{}] rendering {}{}", f + 1, fixtures.size(), fixtures[f].name,
+                                specs.empty() ? "" : " (" + specs + ")"));
+      return;
+    }
+  };
+  runJobs(
+      jobs, parallel,
+      [&](std::size_t i) {
+        running[fixture_of[i]].insert(render_specs[i % render_specs.size()]);
+        showRender();
+      },
+      [&](std::size_t i) {
+        const std::size_t f = fixture_of[i];
+        running[f].erase(render_specs[i % render_specs.size()]);
+        --left[f];
+        showRender();
+      });
 
   auto frameDir = [&](std::size_t f, const std::string& spec) {
     return frames_dir / fixtures[f].slug / fixtureSlug(spec);
+  };
+  // A frame a child said it wrote but that cannot be read is that backend's failure.
+  auto readRendered = [&](std::size_t f, const std::string& spec) {
+    try {
+      return readFrameDir(frameDir(f, spec));
+    } catch (const InputError& e) {
+      throw BackendError(fmt::format("{}: wrote an unreadable frame: {}", spec, e.what()));
+    }
   };
   Report report;
   report.tool_version = kVersion;
@@ -149,37 +203,52 @@ int runCommand(const RunArgs& args) {
   if (args.variants)
     report.variants = detectVariants(render_specs, args.out / "variants", parallel);
   for (std::size_t f = 0; f < fixtures.size(); ++f) {
+    const FixtureEntry& fx = fixtures[f];
+    progress.show(fmt::format("[{}/{}] comparing {}", f + 1, fixtures.size(), fx.name));
     const Job& against_job = jobs[job_of[{f, against.text}]];
     const Job& ref_job = jobs[job_of[{f, std::string("ref")}]];
     for (const BackendSpec& b : backends) {
       if (b.text == against.text) continue;
       const Job& job = jobs[job_of[{f, b.text}]];
       if (against_job.exit_code != 0) {
-        report.results.push_back(errorResult(fixtures[f].name, against.text, b.text,
-                                             against.text + ": " + childError(against_job)));
+        report.results.push_back(
+            errorResult(fx.name, against.text, b.text,
+                        against.text + ": " + childError(against_job, fx.name, against.text)));
         continue;
       }
       if (job.exit_code != 0) {
         report.results.push_back(
-            errorResult(fixtures[f].name, against.text, b.text, b.text + ": " + childError(job)));
+            errorResult(fx.name, against.text, b.text, childError(job, fx.name, b.text)));
         continue;
       }
       try {
-        const Frame expected = readFrameDir(frameDir(f, against.text));
-        const Frame actual = readFrameDir(frameDir(f, b.text));
+        const Frame expected = readRendered(f, against.text);
+        const Frame actual = readRendered(f, b.text);
+        if (expected.width != actual.width || expected.height != actual.height)
+          throw BackendError(fmt::format("{} drew {}x{}, {} drew {}x{}", against.text,
+                                         expected.width, expected.height, b.text, actual.width,
+                                         actual.height));
         Frame ref;
         const Frame* uncertainty = &expected;
         if (!expected.hasUncertainty() && ref_job.exit_code == 0) {
-          ref = readFrameDir(frameDir(f, "ref"));
+          ref = readRendered(f, "ref");
+          if (ref.width != expected.width || ref.height != expected.height)
+            throw BackendError(fmt::format("ref drew {}x{}, {} drew {}x{}", ref.width, ref.height,
+                                           against.text, expected.width, expected.height));
           uncertainty = &ref;
         }
-        report.results.push_back(comparePair(expected, actual, *uncertainty, cli, args.out));
-      } catch (const InputError& e) {
-        report.results.push_back(errorResult(fixtures[f].name, against.text, b.text, e.what()));
+        // The tolerances were checked up front; an InputError from here on (a fixture
+        // changed under us) ends the run with exit 2 and no report.
+        const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
+        report.results.push_back(
+            comparePair(expected, actual, *uncertainty, tol, folder.staging()));
+      } catch (const BackendError& e) {
+        report.results.push_back(errorResult(fx.name, against.text, b.text, e.what()));
       }
     }
   }
-  writeReport(report, args.out);
+  progress.clear();
+  folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);
 }

@@ -15,8 +15,6 @@
 
 #include "fixtures/errors.h"
 
-extern char** environ;
-
 namespace rc {
 namespace {
 
@@ -42,7 +40,7 @@ pid_t spawn(const Job& job) {
 
 }  // namespace
 
-void runJobs(std::vector<Job>& jobs, int parallel,
+void runJobs(std::vector<Job>& jobs, int parallel, const std::function<void(std::size_t)>& on_start,
              const std::function<void(std::size_t)>& on_done) {
   parallel = std::max(1, parallel);
   std::map<pid_t, std::size_t> running;
@@ -50,6 +48,7 @@ void runJobs(std::vector<Job>& jobs, int parallel,
   while (next < jobs.size() || !running.empty()) {
     while (next < jobs.size() && static_cast<int>(running.size()) < parallel) {
       running[spawn(jobs[next])] = next;
+      if (on_start) on_start(next);
       ++next;
     }
     int status = 0;
@@ -70,7 +69,7 @@ void runJobs(std::vector<Job>& jobs, int parallel,
     }
     const std::size_t index = it->second;
     running.erase(it);
-    on_done(index);
+    if (on_done) on_done(index);
   }
 }
 

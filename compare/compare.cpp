@@ -10,21 +10,19 @@
 #include <cstring>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <fmt/format.h>
 
+#include "compare/slopes.h"
 #include "fixtures/errors.h"
 
 namespace rc {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Round to nearest (ties to even) for |v| < 2^51 without calling libm: adding 1.5 * 2^52
-// leaves no fraction bits. Not folded away because we never build with fast-math.
-inline double roundNearest(double v) {
-  constexpr double kMagic = 6755399441055744.0;
-  return (v + kMagic) - kMagic;
-}
 
 inline bool isNonFinite(float f) {
   return (std::bit_cast<std::uint32_t>(f) & 0x7f800000u) == 0x7f800000u;
@@ -80,21 +78,29 @@ inline V load(const T* p) {
   return v;
 }
 
-// Lane masks are 0 or -1.
-inline bool any(V4i m) {
-  const V4i h = m | __builtin_shufflevector(m, m, 2, 3, 0, 1);
-  return (h[0] | h[1]) != 0;
+template <typename V, typename T>
+inline void store(T* p, V v) {
+  std::memcpy(p, &v, sizeof v);
 }
-inline bool all(V4i m) { return !any(~m); }
+
+// Lane masks are 0 or -1. x86 reads the four sign bits at once (movmskps); elsewhere the
+// lanes are combined.
+inline int signBits(V4i m) {
+#if defined(__SSE__)
+  return __builtin_ia32_movmskps(reinterpret_cast<V4f>(m));
+#else
+  return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8);
+#endif
+}
+inline bool any(V4i m) { return signBits(m) != 0; }
+inline bool all(V4i m) { return signBits(m) == 15; }
 
 inline V4f absf(V4f v) { return reinterpret_cast<V4f>(reinterpret_cast<V4i>(v) & 0x7fffffff); }
 inline V2d absd(V2d v) {
   return reinterpret_cast<V2d>(reinterpret_cast<V2l>(v) & 0x7fffffffffffffffLL);
 }
-inline V4f maxf(V4f a, V4f b) {
-  const V4i gt = a > b;
-  return reinterpret_cast<V4f>((gt & reinterpret_cast<V4i>(a)) | (~gt & reinterpret_cast<V4i>(b)));
-}
+// a > b ? a : b per lane (maxps on x86; the inputs are never NaN here).
+inline V4f maxf(V4f a, V4f b) { return a > b ? a : b; }
 inline V4i nonFiniteLanes(V4f v) { return (reinterpret_cast<V4i>(v) & 0x7f800000) == 0x7f800000; }
 // Largest lane (one pixel's R G B A).
 inline float lanesMax(V4f v) {
@@ -102,11 +108,50 @@ inline float lanesMax(V4f v) {
   const V4f s2 = maxf(s1, __builtin_shufflevector(s1, s1, 2, 3, 0, 1));
   return s2[0];
 }
+inline bool any2(V2l m) {
+#if defined(__SSE2__)
+  return __builtin_ia32_movmskpd(reinterpret_cast<V2d>(m)) != 0;
+#else
+  return (m[0] | m[1]) != 0;
+#endif
+}
+// Two pairs of doubles as four floats.
+inline V4f join(V2d lo, V2d hi) {
+#if defined(__SSE2__)
+  return reinterpret_cast<V4f>(_mm_movelh_ps(_mm_cvtpd_ps(reinterpret_cast<__m128d>(lo)),
+                                             _mm_cvtpd_ps(reinterpret_cast<__m128d>(hi))));
+#else
+  using V2f = float __attribute__((vector_size(8)));
+  return __builtin_shufflevector(__builtin_convertvector(lo, V2f), __builtin_convertvector(hi, V2f),
+                                 0, 1, 2, 3);
+#endif
+}
+inline V2d maxd(V2d a, V2d b) { return a > b ? a : b; }
+// Largest lane of each of four vectors, as one vector: [max d0, max d1, max d2, max d3].
+inline V4f pixelMaxima(const V4f* d) {
+  const V4f m01 = maxf(__builtin_shufflevector(d[0], d[1], 0, 1, 4, 5),
+                       __builtin_shufflevector(d[0], d[1], 2, 3, 6, 7));
+  const V4f m23 = maxf(__builtin_shufflevector(d[2], d[3], 0, 1, 4, 5),
+                       __builtin_shufflevector(d[2], d[3], 2, 3, 6, 7));
+  return maxf(__builtin_shufflevector(m01, m23, 0, 2, 4, 6),
+              __builtin_shufflevector(m01, m23, 1, 3, 5, 7));
+}
+// float <-> double lanes. GCC scalarises the generic form of the high half, so x86 gets
+// the two-instruction intrinsic sequences.
 inline V2d lowHalf(V4f v) {
+#if defined(__SSE2__)
+  return reinterpret_cast<V2d>(_mm_cvtps_pd(reinterpret_cast<__m128>(v)));
+#else
   return __builtin_convertvector(__builtin_shufflevector(v, v, 0, 1), V2d);
+#endif
 }
 inline V2d highHalf(V4f v) {
+#if defined(__SSE2__)
+  const __m128 m = reinterpret_cast<__m128>(v);
+  return reinterpret_cast<V2d>(_mm_cvtps_pd(_mm_movehl_ps(m, m)));
+#else
   return __builtin_convertvector(__builtin_shufflevector(v, v, 2, 3), V2d);
+#endif
 }
 
 // Small errors are by far the most common. Counting them in four interleaved tables (one
@@ -116,7 +161,10 @@ class HotBins {
  public:
   static constexpr int kBins = 256;  // <= ErrorHistogram::kLinearBins
   explicit HotBins(ErrorHistogram& h)
-      : h_(h), inverse_quantum_(1.0 / h.quantum()), counts_(4 * kBins, 0) {}
+      : h_(h),
+        inverse_quantum_(1.0 / h.quantum()),
+        inverse_quantum_f_(static_cast<float>(inverse_quantum_)),
+        counts_(static_cast<std::size_t>(4 * kBins), 0) {}
   void add(int lane, double value) {
     const double u = value * inverse_quantum_;
     if (u < kBins) {
@@ -125,6 +173,35 @@ class HotBins {
       h_.add(value);
     }
   }
+  // Four values that the caller knows are below `limit()`, one per table; the same bins
+  // as add() because the quantum is a power of two (value / quantum is exact in float).
+  void add4InRange(V4f values) {
+    const V4i bin = __builtin_convertvector(values * inverse_quantum_f_, V4i);
+    ++counts_[bin[0]];
+    ++counts_[kBins + bin[1]];
+    ++counts_[2 * kBins + bin[2]];
+    ++counts_[3 * kBins + bin[3]];
+  }
+  // Four doubles (two pairs) that the caller knows are below `limit()`.
+  void add4InRange(V2d lo, V2d hi) {
+    const V2d q = {inverse_quantum_, inverse_quantum_};
+#if defined(__SSE2__)
+    const V4i bin = reinterpret_cast<V4i>(
+        _mm_unpacklo_epi64(_mm_cvttpd_epi32(reinterpret_cast<__m128d>(lo * q)),
+                           _mm_cvttpd_epi32(reinterpret_cast<__m128d>(hi * q))));
+#else
+    const V2d ul = lo * q;
+    const V2d uh = hi * q;
+    const V4i bin = {static_cast<int>(ul[0]), static_cast<int>(ul[1]), static_cast<int>(uh[0]),
+                     static_cast<int>(uh[1])};
+#endif
+    ++counts_[bin[0]];
+    ++counts_[kBins + bin[1]];
+    ++counts_[2 * kBins + bin[2]];
+    ++counts_[3 * kBins + bin[3]];
+  }
+  // Values at or above this leave the small tables (one quantum below the first such).
+  double limit() const { return (kBins - 1) / inverse_quantum_; }
   void flush() {
     for (int b = 0; b < kBins; ++b) {
       const std::uint64_t n = std::uint64_t{counts_[b]} + counts_[kBins + b] +
@@ -137,6 +214,7 @@ class HotBins {
  private:
   ErrorHistogram& h_;
   double inverse_quantum_;
+  float inverse_quantum_f_;
   std::vector<std::uint32_t> counts_;  // frames hold < 2^31 pixels: no overflow
 };
 
@@ -147,18 +225,40 @@ void tally(float v, int channel, NonFiniteCounts& counts) {
     ++counts.inf[channel];
 }
 
+// A candidate for a class's "worst" pixel. The vector path, the general path and the
+// deferred pixels meet candidates in different orders, so the choice must not depend on
+// it: the largest key wins, then the first pixel in row order.
+struct WorstPixel {
+  bool any = false;
+  double key = 0.0;
+  std::size_t index = 0;
+  double value = 0.0;      // the error there
+  double allowance = 0.0;  // its allowance there
+  void offer(double k, std::size_t i, double v, double allow) {
+    if (any && !(k > key) && !(k == key && i < index)) return;
+    any = true;
+    key = k;
+    index = i;
+    value = v;
+    allowance = allow;
+  }
+};
+
 class Comparator {
  public:
   Comparator(const Frame& e, const Frame& a, const Frame& u, const Tolerances& tol, PairResult& r)
       : e_(e), a_(a), u_(u), tol_(tol), r_(r) {
-    step_scale_ = depthStepsPerUnit(tol.depth_format);
-    quantized_depth_ = tol.depth_format != DepthFormat::D32F;
+    scale_ = {depthStepsPerUnit(tol.depth_format), tol.depth_format != DepthFormat::D32F};
     quantized_color_ = tol.color_format == ColorFormat::RGBA8;
     have_uncertainty_ = u.hasUncertainty();
     band_ = r.visibility.band_px;
+    depth_slope_band_ = tol.depth_slope_factor * r.depth.band_px;
+    shade_slope_band_ = tol.shading_slope_factor * r.depth.band_px;
+    shade_relative_units_ = 255.0 * tol.shading_relative;
   }
 
   void run(ClassMaps* maps) {
+    maps_ = maps;
     if (maps) {
       const std::size_t n = e_.pixelCount();
       maps->width = e_.width;
@@ -167,25 +267,24 @@ class Comparator {
       maps->depth_steps.assign(n, 0.0f);
       maps->depth_tolerance.assign(n, 0.0f);
       maps->shading_abs.assign(n, 0.0f);
-      maps->delta_rgba.assign(n * 4, 0.0f);
+      maps->shading_tolerance.assign(n, 0.0f);
     }
     for (int y = 0; y < e_.height; ++y) {
       if (maps) {
-        runRange<true>(y, 0, e_.width, maps);
-      } else if (quantized_depth_) {
-        quantized_color_ ? runRowFast<true, true>(y) : runRowFast<true, false>(y);
+        scale_.quantized ? (quantized_color_ ? runRowFast<true, true, true>(y)
+                                             : runRowFast<true, false, true>(y))
+                         : (quantized_color_ ? runRowFast<false, true, true>(y)
+                                             : runRowFast<false, false, true>(y));
+      } else if (scale_.quantized) {
+        quantized_color_ ? runRowFast<true, true, false>(y) : runRowFast<true, false, false>(y);
       } else {
-        quantized_color_ ? runRowFast<false, true>(y) : runRowFast<false, false>(y);
+        quantized_color_ ? runRowFast<false, true, false>(y) : runRowFast<false, false, false>(y);
       }
     }
     finish();
   }
 
  private:
-  double depthSteps(float z) const {
-    const double s = static_cast<double>(z) * step_scale_;
-    return quantized_depth_ ? roundNearest(s) : s;
-  }
   // 8-bit error of one channel; rgba8 compares the stored 8-bit values.
   float colorError(float a, float b) const {
     if (!quantized_color_) return std::fabs(a - b) * 255.0f;
@@ -193,9 +292,10 @@ class Comparator {
     return std::fabs(((a * 255.0f + kMagic) - kMagic) - ((b * 255.0f + kMagic) - kMagic));
   }
 
-  // The general path: any pixel, NaN/Inf, per-pixel maps. Pixels [x0, x1) of row y.
+  // The general path: any pixel, NaN/Inf. Pixels [x0, x1) of row y.
   template <bool kMaps>
-  void runRange(int y, int x0, int x1, ClassMaps* maps) {
+  void runRange(int y, int x0, int x1) {
+    ClassMaps* maps = maps_;
     const std::size_t row = static_cast<std::size_t>(y) * e_.width;
     const std::uint32_t* ida = &e_.id[row];
     const std::uint32_t* idb = &a_.id[row];
@@ -205,7 +305,6 @@ class Comparator {
     const float* cb = &a_.color[row * 4];
     const double depth_warn = tol_.depth.warn;
     const float shade_warn = static_cast<float>(tol_.shading.warn);
-    const float shade_fail = static_cast<float>(tol_.shading.fail);
     double shade_sum = 0.0;
     double shade_sq = 0.0;
     double depth_sum = 0.0;
@@ -213,8 +312,8 @@ class Comparator {
       const std::uint32_t a = ida[x];
       const std::uint32_t b = idb[x];
       const std::size_t i = row + x;
-      const float* pa = ca + x * 4;
-      const float* pb = cb + x * 4;
+      const float* pa = ca + static_cast<std::ptrdiff_t>(x) * 4;
+      const float* pb = cb + static_cast<std::ptrdiff_t>(x) * 4;
       bool depth_finite = !isNonFinite(za[x]) && !isNonFinite(zb[x]);
       bool color_finite = true;
       for (int c = 0; c < 4; ++c)
@@ -227,11 +326,8 @@ class Comparator {
         tally(za[x], 4, r_.nonfinite_expected);
         tally(zb[x], 4, r_.nonfinite_actual);
       }
-      if (kMaps) {
-        for (int c = 0; c < 4; ++c) maps->delta_rgba[i * 4 + c] = (pb[c] - pa[c]) * 255.0f;
-      }
       if (a != b) {
-        const PixelClass cls = classifyMismatch(x, y, a, b);
+        const PixelClass cls = classifyMismatch(x, y, i, a, b);
         if (kMaps) maps->pixel_class[i] = cls;
         continue;
       }
@@ -241,20 +337,19 @@ class Comparator {
 
       // Depth.
       if (!depth_finite) {
-        depthNonFinite(x, y);
+        depthNonFinite(i);
         if (kMaps) maps->depth_steps[i] = std::numeric_limits<float>::quiet_NaN();
       } else {
-        const double dz = std::fabs(depthSteps(za[x]) - depthSteps(zb[x]));
+        const double dz = std::fabs(scale_(za[x]) - scale_(zb[x]));
         depth_sum += dz;
         r_.depth.histogram.add(dz);
         if (dz > depth_max_) {
           depth_max_ = dz;
           depth_max_at_ = i;
         }
-        if (dz > depth_warn) depthOverBase(x, y, dz);
+        if (dz > depth_warn) depthOverBase(x, y, i, dz);
         if (kMaps) maps->depth_steps[i] = static_cast<float>(dz);
       }
-      if (kMaps) maps->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allowance(x, y));
 
       // Shading.
       if (!color_finite) {
@@ -273,10 +368,7 @@ class Comparator {
         shade_max_ = e;
         shade_max_at_ = i;
       }
-      if (e > shade_warn) {
-        ++r_.shading.over_tolerance;
-        if (e > shade_fail) ++r_.shading.over_fail;
-      }
+      if (e > shade_warn) shadingOver(x, y, i, d);
       if (kMaps) maps->shading_abs[i] = e;
     }
     shade_sum_ += shade_sum;
@@ -289,8 +381,9 @@ class Comparator {
   // checked for NaN/Inf; any other chunk, and the row's tail, takes runRange. Both paths
   // compute every per-pixel value with the same operations, so results agree exactly
   // (sums up to their order of addition).
-  template <bool kQuantizedDepth, bool kQuantizedColor>
+  template <bool kQuantizedDepth, bool kQuantizedColor, bool kMaps>
   void runRowFast(int y) {
+    ClassMaps* maps = maps_;
     const int w = e_.width;
     const std::size_t row = static_cast<std::size_t>(y) * w;
     const std::uint32_t* ida = &e_.id[row];
@@ -301,8 +394,9 @@ class Comparator {
     const float* cb = &a_.color[row * 4];
     const double depth_warn = tol_.depth.warn;
     const float shade_warn = static_cast<float>(tol_.shading.warn);
-    const float shade_fail = static_cast<float>(tol_.shading.fail);
-    const double scale = step_scale_;
+    const double scale = scale_.steps_per_unit;
+    const double depth_limit = depth_hot_.limit();
+    const auto shade_limit = static_cast<float>(shade_hot_.limit());
     constexpr double kMagic = 6755399441055744.0;
     constexpr float kMagicF = 12582912.0f;
     V2d depth_sum = {};
@@ -320,10 +414,6 @@ class Comparator {
     };
     V4f channel_max = {};
     std::uint64_t matched = 0;
-    std::uint64_t over_warn = 0;
-    std::uint64_t over_fail = 0;
-    double depth_max = depth_max_;
-    float shade_max = shade_max_;
     int x = 0;
     for (; x + 4 <= w; x += 4) {
       const V4u a = load<V4u>(ida + x);
@@ -332,25 +422,24 @@ class Comparator {
       const V4f z_b = load<V4f>(zb + x);
       V4f c_a[4];
       V4f c_b[4];
-      V4i bad = nonFiniteLanes(z_a) | nonFiniteLanes(z_b);
       for (int k = 0; k < 4; ++k) {
-        c_a[k] = load<V4f>(ca + (x + k) * 4);
-        c_b[k] = load<V4f>(cb + (x + k) * 4);
-        bad |= nonFiniteLanes(c_a[k]) | nonFiniteLanes(c_b[k]);
+        c_a[k] = load<V4f>(ca + static_cast<std::ptrdiff_t>(x + k) * 4);
+        c_b[k] = load<V4f>(cb + static_cast<std::ptrdiff_t>(x + k) * 4);
       }
+      // A NaN or Inf on either side makes a difference NaN or Inf, and then times 0 NaN
+      // (so does an overflow of huge finite values: conservative, the general path
+      // sorts them out). No fast-math, so x * 0 is not folded to 0.
+      const V4f probe = ((c_a[0] - c_b[0]) + (c_a[1] - c_b[1])) +
+                        ((c_a[2] - c_b[2]) + (c_a[3] - c_b[3])) + (z_a - z_b);
+      const V4i bad = (probe * 0.0f) != 0.0f;
       const V4i same = reinterpret_cast<V4i>(a == b);
       const V4i drawn = reinterpret_cast<V4i>(a != 0u);
       if (any(bad) || !all(same & drawn)) {
-        if (any(bad) || any(drawn | ~same)) {
-          depth_max_ = depth_max;
-          shade_max_ = shade_max;
-          runRange<false>(y, x, x + 4, nullptr);
-          depth_max = depth_max_;
-          shade_max = shade_max_;
-        }
+        if (any(bad) || any(drawn | ~same)) runRange<kMaps>(y, x, x + 4);
         continue;  // else background on both sides
       }
       matched += 4;
+      if (kMaps) std::memset(&maps->pixel_class[row + x], static_cast<int>(PixelClass::Match), 4);
 
       // Depth, in double like runRange.
       V2d sa[2] = {lowHalf(z_a) * scale, highHalf(z_a) * scale};
@@ -364,141 +453,225 @@ class Comparator {
       const V2d dz01 = absd(sa[0] - sb[0]);
       const V2d dz23 = absd(sa[1] - sb[1]);
       depth_sum += dz01 + dz23;
-      const double dz[4] = {dz01[0], dz01[1], dz23[0], dz23[1]};
-      for (int l = 0; l < 4; ++l) {
-        depth_hot_.add(l, dz[l]);
-        if (dz[l] > depth_max) {
-          depth_max = dz[l];
-          depth_max_at_ = row + x + l;
+      if (kMaps) store(&maps->depth_steps[row + x], join(dz01, dz23));
+      // One test for the rare cases: a new maximum, over warn, beyond the small bins.
+      const double depth_rare = std::min(std::min(depth_max_, depth_warn), depth_limit);
+      if (!any2(maxd(dz01, dz23) > V2d{depth_rare, depth_rare})) {
+        depth_hot_.add4InRange(dz01, dz23);
+      } else {
+        const double d[4] = {dz01[0], dz01[1], dz23[0], dz23[1]};
+        for (int l = 0; l < 4; ++l) {
+          depth_hot_.add(l, d[l]);
+          if (d[l] > depth_max_) {
+            depth_max_ = d[l];
+            depth_max_at_ = row + x + l;
+          }
+          if (d[l] > depth_warn) depthOverBase(x + l, y, row + x + l, d[l]);
         }
-        if (dz[l] > depth_warn) depthOverBase(x + l, y, dz[l]);
       }
 
-      // Shading: one pixel's R G B A per vector.
+      // Shading: one pixel's R G B A per vector; e = each pixel's largest channel.
+      V4f d[4];
       for (int k = 0; k < 4; ++k) {
-        V4f d;
         if (kQuantizedColor) {
-          d = absf(((c_a[k] * 255.0f + kMagicF) - kMagicF) -
-                   ((c_b[k] * 255.0f + kMagicF) - kMagicF));
+          d[k] = absf(((c_a[k] * 255.0f + kMagicF) - kMagicF) -
+                      ((c_b[k] * 255.0f + kMagicF) - kMagicF));
         } else {
-          d = absf(c_a[k] - c_b[k]) * 255.0f;
+          d[k] = absf(c_a[k] - c_b[k]) * 255.0f;
         }
-        color_sum += d;
-        color_sq += d * d;
-        channel_max = maxf(channel_max, d);
-        const float e = lanesMax(d);
-        shade_hot_.add(k, e);
-        over_warn += e > shade_warn ? 1 : 0;
-        over_fail += e > shade_fail ? 1 : 0;
-        if (e > shade_max) {
-          shade_max = e;
-          shade_max_at_ = row + x + k;
+        color_sum += d[k];
+        color_sq += d[k] * d[k];
+      }
+      channel_max = maxf(channel_max, maxf(maxf(d[0], d[1]), maxf(d[2], d[3])));
+      const V4f e = pixelMaxima(d);
+      if (kMaps) store(&maps->shading_abs[row + x], e);
+      const float shade_rare = std::min(std::min(shade_max_, shade_warn), shade_limit);
+      if (!any(e > V4f{shade_rare, shade_rare, shade_rare, shade_rare})) {
+        shade_hot_.add4InRange(e);
+      } else {
+        for (int k = 0; k < 4; ++k) {
+          shade_hot_.add(k, e[k]);
+          if (e[k] > shade_max_) {
+            shade_max_ = e[k];
+            shade_max_at_ = row + x + k;
+          }
+          if (e[k] > shade_warn) {
+            const float dk[4] = {d[k][0], d[k][1], d[k][2], d[k][3]};
+            shadingOver(x + k, y, row + x + k, dk);
+          }
         }
       }
       if ((summed += 4) == 16) flushColorSums();
     }
     flushColorSums();
-    depth_max_ = depth_max;
-    shade_max_ = shade_max;
     vis_match_ += matched;
-    r_.shading.over_tolerance += over_warn;
-    r_.shading.over_fail += over_fail;
     depth_sum_ += depth_sum[0] + depth_sum[1];
     shade_sum_ += shade_sum[0] + shade_sum[1];
     shade_sq_ += shade_sq[0] + shade_sq[1];
     for (int c = 0; c < 4; ++c) shade_max_rgba_[c] = std::max(shade_max_rgba_[c], channel_max[c]);
-    if (x < w) runRange<false>(y, x, w, nullptr);
+    if (x < w) runRange<kMaps>(y, x, w);
   }
 
-  // Local depth slope of the uncertainty frame at (x, y) in steps/px, from same-id
-  // neighbours: per axis the larger one-sided difference at distance 1, else at distance
-  // 2 (halved); an axis with neither borrows the other's. nullopt when neither axis has.
-  std::optional<double> slope(int x, int y) const {
-    const std::size_t i = u_.index(x, y);
-    const std::uint32_t id = u_.id[i];
-    if (id == 0 || isNonFinite(u_.depth[i])) return std::nullopt;
-    const double z0 = depthSteps(u_.depth[i]);
-    auto axis = [&](int dx, int dy) -> std::optional<double> {
-      for (int dist = 1; dist <= 2; ++dist) {
-        std::optional<double> g;
-        for (int sign : {-1, 1}) {
-          const int nx = x + sign * dist * dx;
-          const int ny = y + sign * dist * dy;
-          if (nx < 0 || ny < 0 || nx >= u_.width || ny >= u_.height) continue;
-          const std::size_t j = u_.index(nx, ny);
-          if (u_.id[j] != id || isNonFinite(u_.depth[j])) continue;
-          const double diff = std::fabs(depthSteps(u_.depth[j]) - z0) / dist;
-          g = std::max(g.value_or(0.0), diff);
-        }
-        if (g) return g;
-      }
-      return std::nullopt;
-    };
-    std::optional<double> gx = axis(1, 0);
-    std::optional<double> gy = axis(0, 1);
-    if (!gx && !gy) return std::nullopt;
-    if (!gx) gx = gy;
-    if (!gy) gy = gx;
-    return std::hypot(*gx, *gy);
+  // ---- Depth: slope allowance (docs/tolerances.md) ----
+
+  // The depth slope (steps/px) of the uncertainty frame's primitive at pixel i, from its
+  // neighbourhood when that shows the primitive along both axes, else also from the
+  // primitive's fitted plane (fits_ must hold it) or, when the primitive's pixels do not
+  // span a plane, from the surface around it. nullopt: unknown. `fitted` says whether the
+  // fit was used.
+  std::optional<double> resolvedSlope(std::size_t i, bool* fitted = nullptr) const {
+    const int x = static_cast<int>(i % u_.width);
+    const int y = static_cast<int>(i / u_.width);
+    const detail::LocalSlope local = detail::localDepthSlope(u_, scale_, x, y);
+    if (local.complete()) return local.magnitude();
+    std::optional<double> s;
+    auto take = [&](double v) { s = std::max(s.value_or(0.0), v); };
+    if (local.any()) take(local.magnitude());
+    const detail::PlaneFits::Fit* fit = u_.id[i] != 0 ? fits_.find(u_.id[i]) : nullptr;
+    if (fit && fit->pixels >= 2) {
+      take(fit->slope);
+      if (fitted) *fitted = true;
+    }
+    if (!fit || !fit->plane) {
+      if (const std::optional<double> surface = detail::surfaceDepthSlope(u_, scale_, x, y))
+        take(*surface);
+    }
+    return s;
   }
 
-  // Steps a triangle's stored depth may move at (x, y) when its vertices move by the band.
-  double allowance(int x, int y) {
-    const std::optional<double> s = slope(x, y);
-    if (!s) return 0.0;
-    r_.depth.max_slope = std::max(r_.depth.max_slope, *s);
-    return tol_.depth_slope_factor * *s * band_;
+  // dz is over warn: decide now when the neighbourhood settles it, else defer to finish().
+  __attribute__((noinline)) void depthOverBase(int x, int y, std::size_t i, double dz) {
+    const detail::LocalSlope local = detail::localDepthSlope(u_, scale_, x, y);
+    if (local.complete()) {
+      applyDepth(i, dz, local.magnitude(), false);
+      return;
+    }
+    // The local magnitude is a lower bound of the slope: within its allowance, done.
+    if (!maps_ && local.any() && dz <= tol_.depth.warn + depth_slope_band_ * local.magnitude()) {
+      r_.depth.max_slope = std::max(r_.depth.max_slope, local.magnitude());
+      return;
+    }
+    pending_depth_.push_back({i, dz});
+    if (u_.id[i] != 0) fits_.request(u_.id[i]);
   }
 
-  __attribute__((noinline)) void depthOverBase(int x, int y, double dz) {
-    const std::optional<double> s = slope(x, y);
-    if (!s) ++r_.depth.slope_unknown;
-    const double allow = s ? tol_.depth_slope_factor * *s * band_ : 0.0;
-    if (s) r_.depth.max_slope = std::max(r_.depth.max_slope, *s);
+  void applyDepth(std::size_t i, double dz, std::optional<double> slope, bool fitted) {
+    DepthStats& d = r_.depth;
+    if (fitted) ++d.slope_fitted;
+    if (maps_)
+      maps_->depth_tolerance[i] =
+          static_cast<float>(tol_.depth.warn + depth_slope_band_ * slope.value_or(0.0));
+    if (!slope) {
+      // Nothing tells how steep this primitive is: its legal error is unbounded, so it
+      // can warn but not fail.
+      ++d.slope_unknown;
+      ++d.over_tolerance;
+      depth_worst_.offer(dz - tol_.depth.warn, i, dz, 0.0);
+      return;
+    }
+    d.max_slope = std::max(d.max_slope, *slope);
+    const double allow = depth_slope_band_ * *slope;
     const double excess = dz - (tol_.depth.warn + allow);
     if (excess <= 0.0) return;
-    ++r_.depth.over_tolerance;
-    if (dz > tol_.depth.fail + allow) ++r_.depth.over_fail;
-    if (!depth_over_any_ || excess > depth_worst_excess_) {
-      depth_over_any_ = true;
-      depth_worst_excess_ = excess;
-      depth_worst_at_ = e_.index(x, y);
-      depth_worst_allow_ = allow;
-    }
+    ++d.over_tolerance;
+    if (dz > tol_.depth.fail + allow) ++d.over_fail;
+    depth_worst_.offer(excess, i, dz, allow);
   }
 
-  __attribute__((noinline)) void depthNonFinite(int x, int y) {
+  __attribute__((noinline)) void depthNonFinite(std::size_t i) {
     ++r_.depth.nonfinite;
     ++r_.depth.over_tolerance;
     ++r_.depth.over_fail;
-    if (!depth_over_any_ || depth_worst_excess_ < kInf) {
-      depth_over_any_ = true;
-      depth_worst_excess_ = kInf;
-      depth_worst_at_ = e_.index(x, y);
-      depth_worst_allow_ = 0.0;
+    depth_worst_.offer(kInf, i, std::numeric_limits<double>::quiet_NaN(), 0.0);
+  }
+
+  // ---- Shading: relative, gradient and texture allowances (docs/tolerances.md) ----
+
+  struct ShadingExcess {
+    double excess = -kInf;   // max over channels of error - allowance
+    int channel = 0;         // the channel that gives it
+    double allowance = 0.0;  // that channel's allowance
+    std::array<double, 4> allowances{};
+  };
+  // With `neighbourhood` false, only the terms that need no neighbours (a lower bound).
+  ShadingExcess shadingExcess(int x, int y, std::size_t i, const float* d,
+                              bool neighbourhood) const {
+    const float* pa = &e_.color[i * 4];
+    const float* pb = &a_.color[i * 4];
+    detail::ColourNeighbourhood around;
+    if (neighbourhood) around = detail::colourNeighbourhood(e_, x, y);
+    ShadingExcess out;
+    for (int c = 0; c < 4; ++c) {
+      const double m = std::max(std::fabs(pa[c]), std::fabs(pb[c]));
+      const double allow = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
+                           tol_.texture_weight_error * around.range[c] +
+                           tol_.texture_rounding_units * std::max(1.0, m);
+      out.allowances[c] = allow;
+      const double excess = d[c] - allow;
+      if (excess > out.excess) {
+        out.excess = excess;
+        out.channel = c;
+        out.allowance = allow;
+      }
     }
+    return out;
+  }
+
+  // The pixel's largest channel error is over warn: check it against its allowance.
+  __attribute__((noinline)) void shadingOver(int x, int y, std::size_t i, const float* d) {
+    const double warn = tol_.shading.warn;
+    // The terms without neighbours are a lower bound of the allowance: often enough.
+    if (!maps_ && shadingExcess(x, y, i, d, false).excess <= warn) return;
+    const ShadingExcess s = shadingExcess(x, y, i, d, true);
+    if (maps_) maps_->shading_tolerance[i] = static_cast<float>(warn + s.allowance);
+    if (s.excess <= warn) return;
+    ++r_.shading.over_tolerance;
+    if (s.excess > tol_.shading.fail) ++r_.shading.over_fail;
+    shade_worst_.offer(s.excess, i, d[s.channel], s.allowance);
   }
 
   __attribute__((noinline)) void shadingNonFinite(std::size_t i) {
-    if (r_.shading.nonfinite++ == 0) shade_nonfinite_at_ = i;
+    ++r_.shading.nonfinite;
     ++r_.shading.over_tolerance;
     ++r_.shading.over_fail;
+    shade_worst_.offer(kInf, i, std::numeric_limits<double>::quiet_NaN(), 0.0);
   }
 
-  __attribute__((noinline)) PixelClass classifyMismatch(int x, int y, std::uint32_t a,
-                                                        std::uint32_t b) {
-    const std::size_t i = e_.index(x, y);
+  // ---- Visibility ----
+
+  static constexpr PixelClass kDeferred = PixelClass::Background;
+
+  __attribute__((noinline)) PixelClass classifyMismatch(int x, int y, std::size_t i,
+                                                        std::uint32_t a, std::uint32_t b) {
     const double edge = have_uncertainty_ ? static_cast<double>(u_.edge_dist[i]) : kInf;
     bool ambiguous = edge <= band_;  // false for NaN
+    bool by_gap = false;
     if (!ambiguous && a != 0 && b != 0 && have_uncertainty_) {
-      // Each surface's stored depth may be off by its tolerance; the two are assumed to
-      // share the local slope (they are nearly coplanar where they tie).
+      // Each surface's stored depth may be off by its tolerance, fail + slope allowance,
+      // in either direction; two fragments closer than the sum may swap. The surfaces
+      // are taken to share the winner's slope (docs/tolerances.md).
       const double gap = u_.depth_gap[i];
-      if (gap <= 2.0 * (tol_.depth.fail + allowance(x, y))) {
-        ambiguous = true;
-        ++r_.visibility.ambiguous_by_depth_gap;
+      const double flat = 2.0 * tol_.depth.fail;
+      if (gap <= flat) {
+        by_gap = true;
+      } else if (gap < kInf) {
+        const detail::LocalSlope local = detail::localDepthSlope(u_, scale_, x, y);
+        const double lower = flat + 2.0 * depth_slope_band_ * local.magnitude();
+        if (gap <= lower) {
+          by_gap = true;
+        } else if (!local.complete()) {
+          pending_wrong_.push_back({i, edge, gap});
+          if (u_.id[i] != 0) fits_.request(u_.id[i]);
+          return kDeferred;
+        }
       }
+      ambiguous = by_gap;
     }
+    return record(i, a, b, ambiguous, by_gap, edge);
+  }
+
+  PixelClass record(std::size_t i, std::uint32_t a, std::uint32_t b, bool ambiguous, bool by_gap,
+                    double edge) {
     PixelClass cls;
     if (b == 0)
       cls = ambiguous ? PixelClass::MissingAmbiguous : PixelClass::MissingHard;
@@ -507,15 +680,9 @@ class Comparator {
     else
       cls = ambiguous ? PixelClass::WrongAmbiguous : PixelClass::WrongHard;
     ++class_counts_[static_cast<int>(cls)];
-    if (!ambiguous) {
-      const double rank = std::isnan(edge) ? -1.0 : edge;
-      if (!vis_worst_any_ || rank > vis_worst_edge_) {
-        vis_worst_any_ = true;
-        vis_worst_edge_ = rank;
-        r_.visibility.worst = {x, y};
-        r_.visibility.worst_edge_dist = edge;
-      }
-    }
+    if (by_gap) ++r_.visibility.ambiguous_by_depth_gap;
+    // The hard mismatch farthest from any edge is the least excusable.
+    if (!ambiguous) vis_worst_.offer(std::isnan(edge) ? -1.0 : edge, i, edge, 0.0);
     return cls;
   }
 
@@ -523,9 +690,33 @@ class Comparator {
     return {static_cast<int>(i % e_.width), static_cast<int>(i / e_.width)};
   }
 
+  // Deferred pixels: one pass fits the planes of their primitives, then each is decided.
+  void resolveDeferred() {
+    // The largest error's allowance is reported even when nothing is over.
+    if (!depth_worst_.any && depth_max_ > 0.0 && pending_depth_.empty()) {
+      const PixelRef p = pixelAt(depth_max_at_);
+      if (!detail::localDepthSlope(u_, scale_, p.x, p.y).complete() && u_.id[depth_max_at_] != 0)
+        fits_.request(u_.id[depth_max_at_]);
+    }
+    if (fits_.pending()) fits_.build(u_, scale_);
+    for (const PendingDepth& p : pending_depth_) {
+      bool fitted = false;
+      const std::optional<double> slope = resolvedSlope(p.index, &fitted);
+      applyDepth(p.index, p.dz, slope, fitted);
+    }
+    for (const PendingMismatch& p : pending_wrong_) {
+      const double slope = resolvedSlope(p.index).value_or(0.0);
+      const bool by_gap = p.gap <= 2.0 * (tol_.depth.fail + depth_slope_band_ * slope);
+      const PixelClass cls = record(p.index, 1, 2, by_gap, by_gap, p.edge);  // wrong_primitive
+      if (maps_) maps_->pixel_class[p.index] = cls;
+    }
+  }
+
   void finish() {
     depth_hot_.flush();
     shade_hot_.flush();
+    resolveDeferred();
+
     VisibilityStats& v = r_.visibility;
     auto count = [&](PixelClass c) { return class_counts_[static_cast<int>(c)]; };
     v.missing = count(PixelClass::MissingAmbiguous) + count(PixelClass::MissingHard);
@@ -539,6 +730,10 @@ class Comparator {
     v.ambiguous = v.mismatched - v.hard;
     v.uncertainty_available = have_uncertainty_;
     v.status = tol_.visibility.verdict(static_cast<double>(v.hard));
+    if (vis_worst_.any) {
+      v.worst = pixelAt(vis_worst_.index);
+      v.worst_edge_dist = vis_worst_.value;
+    }
 
     DepthStats& d = r_.depth;
     d.compared = vis_match_;
@@ -546,18 +741,14 @@ class Comparator {
     d.max_steps = depth_max_;
     d.mean_steps = depth_finite ? depth_sum_ / static_cast<double>(depth_finite) : 0.0;
     d.p99_steps = d.histogram.percentile(0.99, depth_max_);
-    if (depth_over_any_) {
-      d.worst = pixelAt(depth_worst_at_);
-      d.worst_allowance = depth_worst_allow_;
-      d.worst_steps = std::isinf(depth_worst_excess_)
-                          ? std::numeric_limits<double>::quiet_NaN()
-                          : depth_worst_excess_ + tol_.depth.warn + depth_worst_allow_;
+    if (depth_worst_.any) {
+      d.worst = pixelAt(depth_worst_.index);
+      d.worst_steps = depth_worst_.value;
+      d.worst_allowance = depth_worst_.allowance;
     } else if (depth_max_ > 0.0) {  // all equal: no worst pixel
       d.worst = pixelAt(depth_max_at_);
       d.worst_steps = depth_max_;
-      const PixelRef p = d.worst;
-      const std::optional<double> s = slope(p.x, p.y);
-      d.worst_allowance = s ? tol_.depth_slope_factor * *s * band_ : 0.0;
+      d.worst_allowance = depth_slope_band_ * resolvedSlope(depth_max_at_).value_or(0.0);
     }
     d.status = d.over_fail ? Status::Fail : d.over_tolerance ? Status::Warn : Status::Pass;
 
@@ -570,50 +761,73 @@ class Comparator {
       const double values = 4.0 * static_cast<double>(shade_finite);
       s.mean_abs = shade_sum_ / values;
       s.rmse = std::sqrt(shade_sq_ / values);
-      if (s.rmse > 0.0) s.psnr_db = 20.0 * std::log10(255.0 / s.rmse);
     }
+    s.psnr_db = s.rmse > 0.0 ? std::min(kPsnrCapDb, 20.0 * std::log10(255.0 / s.rmse)) : kPsnrCapDb;
     s.p99_abs = s.histogram.percentile(0.99, shade_max_);
-    if (s.nonfinite > 0)
-      s.worst = pixelAt(shade_nonfinite_at_);
-    else if (shade_max_ > 0.0f)
+    if (shade_worst_.any) {
+      s.worst = pixelAt(shade_worst_.index);
+      s.worst_abs = shade_worst_.value;
+      s.worst_allowance = shade_worst_.allowance;
+    } else if (shade_max_ > 0.0f) {
       s.worst = pixelAt(shade_max_at_);
+      float dk[4];
+      for (int c = 0; c < 4; ++c)
+        dk[c] = colorError(e_.color[shade_max_at_ * 4 + c], a_.color[shade_max_at_ * 4 + c]);
+      const int c = static_cast<int>(std::max_element(dk, dk + 4) - dk);
+      s.worst_abs = dk[c];
+      s.worst_allowance =
+          shadingExcess(s.worst.x, s.worst.y, shade_max_at_, dk, true).allowances[c];
+    }
     s.status = s.over_fail ? Status::Fail : s.over_tolerance ? Status::Warn : Status::Pass;
 
     r_.status = worse(v.status, worse(d.status, s.status));
   }
+
+  struct PendingDepth {
+    std::size_t index;
+    double dz;
+  };
+  struct PendingMismatch {
+    std::size_t index;
+    double edge;
+    double gap;
+  };
 
   const Frame& e_;
   const Frame& a_;
   const Frame& u_;
   const Tolerances& tol_;
   PairResult& r_;
-  double step_scale_ = 1.0;
-  bool quantized_depth_ = true;
+  detail::DepthScale scale_;
   bool quantized_color_ = false;
   bool have_uncertainty_ = false;
   double band_ = 0.0;
+  double depth_slope_band_ = 0.0;  // depth_slope_factor * slope band
+  double shade_slope_band_ = 0.0;  // shading_slope_factor * slope band
+  double shade_relative_units_ = 0.0;
 
   std::uint64_t class_counts_[kPixelClassCount] = {};
   std::uint64_t vis_match_ = 0;
-  bool vis_worst_any_ = false;
-  double vis_worst_edge_ = 0.0;
+  WorstPixel vis_worst_;
 
   double depth_sum_ = 0.0;
   double depth_max_ = 0.0;
   std::size_t depth_max_at_ = 0;
-  bool depth_over_any_ = false;
-  double depth_worst_excess_ = 0.0;
-  std::size_t depth_worst_at_ = 0;
-  double depth_worst_allow_ = 0.0;
+  WorstPixel depth_worst_;
 
   double shade_sum_ = 0.0;
   double shade_sq_ = 0.0;
   float shade_max_ = 0.0f;
   std::size_t shade_max_at_ = 0;
-  std::size_t shade_nonfinite_at_ = 0;
   float shade_max_rgba_[4] = {};
+  WorstPixel shade_worst_;
   HotBins depth_hot_{r_.depth.histogram};
   HotBins shade_hot_{r_.shading.histogram};
+
+  detail::PlaneFits fits_;
+  std::vector<PendingDepth> pending_depth_;
+  std::vector<PendingMismatch> pending_wrong_;
+  ClassMaps* maps_ = nullptr;
 };
 
 }  // namespace
@@ -688,18 +902,16 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
   BandInputs band;
   band.expected_bits = r.expected_subpixel_bits;
   band.actual_bits = r.actual_subpixel_bits;
-  band.uncertainty_bits =
-      separate_uncertainty ? subpixelBits(uncertainty, "uncertainty") : r.expected_subpixel_bits;
-  band.uncertainty_is_expected = !separate_uncertainty;
   band.width = expected.width;
   band.height = expected.height;
   r.visibility.band_px = snapBandPx(tolerances, band);
+  r.depth.band_px = slopeBandPx(tolerances, band);
 
   // Quantized formats have integer errors: exact percentiles (histogram.h).
   const bool int_depth = tolerances.depth_format != DepthFormat::D32F;
   const bool int_color = tolerances.color_format == ColorFormat::RGBA8;
   r.depth.histogram = ErrorHistogram(int_depth ? 1.0 : 1.0 / 64.0, int_depth);
-  r.shading.histogram = ErrorHistogram(int_color ? 1.0 : 1.0 / 64.0, int_color);
+  r.shading.histogram = ErrorHistogram(int_color ? 1.0 : 1.0 / 4096.0, int_color);
   Comparator(expected, actual, uncertainty, tolerances, r).run(maps);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
@@ -739,7 +951,15 @@ Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual) {
     cf = ColorFormat::RGBA8;
   else if (!color.empty() && color != "rgba32f")
     throw InputError(fmt::format("frame.json: unknown color_format '{}'", color));
-  return defaultTolerances(df, cf);
+  // Linear filtering of a textured material (frame.json "texture_filter", "textured").
+  auto linearTextures = [](const Frame& f) {
+    const auto textured = f.meta.find("textured");
+    return metaString(f, "texture_filter") == "linear" && textured != f.meta.end() &&
+           textured->is_boolean() && textured->get<bool>();
+  };
+  DrawnWith drawn;
+  drawn.linear_textures = linearTextures(expected) || linearTextures(actual);
+  return defaultTolerances(df, cf, drawn);
 }
 
 void checkSameSize(const Frame& expected, const Frame& actual,

@@ -69,15 +69,25 @@ struct DepthStats {
   std::uint64_t over_tolerance = 0;  // |dZ| > warn + allowance (non-finite pixels count)
   std::uint64_t over_fail = 0;       // |dZ| > fail + allowance (non-finite pixels count)
   std::uint64_t nonfinite = 0;       // Z NaN or Inf on either side
-  std::uint64_t slope_unknown = 0;   // pixels over the base threshold whose slope is unknown
-  // The pixel furthest over its tolerance when any is over, else the largest error; none
-  // when every compared depth is equal.
+  // Pixels over warn whose slope is unknown (a primitive seen at one pixel with no drawn
+  // neighbour): they warn but cannot fail, since their legal error is unbounded.
+  std::uint64_t slope_unknown = 0;
+  // Pixels over warn whose slope came from the primitive's plane fitted over all its
+  // pixels (their neighbourhood did not show the primitive along both axes).
+  std::uint64_t slope_fitted = 0;
+  double band_px = 0.0;  // the slope band: allowance = factor * slope * band
+  // The pixel furthest over its tolerance when any is over, else the largest error (first
+  // in row order on ties); none when every compared depth is equal.
   PixelRef worst;
   double worst_steps = 0.0;
   double worst_allowance = 0.0;  // the slope allowance there (steps)
-  double max_slope = 0.0;        // largest local slope met while checking pixels (steps/px)
+  double max_slope = 0.0;        // largest slope met while checking pixels (steps/px)
   ErrorHistogram histogram{1.0, true};
 };
+
+// PSNR of identical images (rmse 0) and the cap of every PSNR: 20 log10(255 / rmse) for
+// rmse = 255e-10 units, far below any float32 difference a driver produces in practice.
+inline constexpr double kPsnrCapDb = 200.0;
 
 struct ShadingStats {
   Status status = Status::Pass;
@@ -85,14 +95,18 @@ struct ShadingStats {
   double max_abs = 0.0;        // 8-bit units, over finite pixels and the four channels
   double mean_abs = 0.0;       // over finite pixels and the four channels
   double rmse = 0.0;
-  std::optional<double> psnr_db;     // 20 log10(255 / rmse); none when rmse = 0 (identical)
+  double psnr_db = kPsnrCapDb;       // min(kPsnrCapDb, 20 log10(255 / rmse))
   double p99_abs = 0.0;              // of the per-pixel error (largest channel)
-  std::uint64_t over_tolerance = 0;  // per-pixel error > warn (non-finite pixels count)
-  std::uint64_t over_fail = 0;       // per-pixel error > fail (non-finite pixels count)
+  std::uint64_t over_tolerance = 0;  // a channel's error > warn + its allowance (non-finite count)
+  std::uint64_t over_fail = 0;       // a channel's error > fail + its allowance (non-finite count)
   std::uint64_t nonfinite = 0;       // a colour channel NaN or Inf on either side
   std::array<double, 4> max_abs_rgba{};
-  PixelRef worst;  // largest per-pixel error (first on ties); none when all are equal
-  ErrorHistogram histogram{1.0 / 64.0, false};
+  // The pixel furthest over its tolerance when any is over (a non-finite one first), else
+  // the largest per-pixel error (first in row order on ties); none when all are equal.
+  PixelRef worst;
+  double worst_abs = 0.0;        // the error of the deciding channel there (units)
+  double worst_allowance = 0.0;  // that channel's allowance (units)
+  ErrorHistogram histogram{1.0 / 4096.0, false};
 };
 
 // NaN and Inf counts of one frame, per channel R G B A Z, over every pixel.
@@ -133,14 +147,15 @@ PairResult errorResult(std::string fixture, std::string expected, std::string ac
                        std::string message);
 
 // Per-pixel results, for images and diff.exr. Index y * width + x (image coordinates).
+// (The colour deltas diff.exr also holds come straight from the frames.)
 struct ClassMaps {
   int width = 0;
   int height = 0;
   std::vector<PixelClass> pixel_class;
-  std::vector<float> depth_steps;      // |dZ| in steps where compared (NaN: non-finite), else 0
-  std::vector<float> depth_tolerance;  // warn + slope allowance where compared, else 0
-  std::vector<float> shading_abs;      // largest channel error where compared (NaN: non-finite)
-  std::vector<float> delta_rgba;       // (actual - expected) * 255 per channel, 4 per pixel
+  std::vector<float> depth_steps;        // |dZ| in steps where compared (NaN: non-finite), else 0
+  std::vector<float> depth_tolerance;    // warn + slope allowance where compared, else 0
+  std::vector<float> shading_abs;        // largest channel error where compared (NaN: non-finite)
+  std::vector<float> shading_tolerance;  // warn + allowance of the deciding channel, else 0
 };
 
 // Compares `actual` with `expected`. `uncertainty` is the reference frame whose
@@ -153,7 +168,8 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
                          const Tolerances& tolerances, ClassMaps* maps = nullptr);
 
 // The defaults for a pair, from the frames' meta depth_format/color_format (d24 and
-// rgba32f when absent). Throws InputError when the two frames name different formats.
+// rgba32f when absent) and texture_filter/textured (the linear filtering allowance).
+// Throws InputError when the two frames name different formats.
 Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual);
 
 // Throws InputError naming both directories when the frames differ in size.

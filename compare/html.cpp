@@ -310,29 +310,35 @@ std::string pairSection(const PairResult& r, std::size_t k, const fs::path& repo
                  {"over fail", fmt::format("{}", d.over_fail)},
                  {"non-finite", fmt::format("{}", d.nonfinite)},
                  {"slope unknown", fmt::format("{}", d.slope_unknown)},
+                 {"slope from plane fit", fmt::format("{}", d.slope_fitted)},
+                 {"slope band (px)", number(d.band_px)},
                  {"format", toString(t.depth_format)},
                  {"thresholds warn / fail", fmt::format("{} / {} + {} x slope x band", t.depth.warn,
                                                         t.depth.fail, t.depth_slope_factor)},
                  {"worst", at(d.worst, r.height)},
                  {"worst steps / allowance",
                   fmt::format("{} / {}", number(d.worst_steps), number(d.worst_allowance))}});
-  out +=
-      rowsTable("shading", s.status,
-                {{"compared", fmt::format("{}", s.compared)},
-                 {"max abs (8-bit)", number(s.max_abs)},
-                 {"mean abs", number(s.mean_abs)},
-                 {"rmse", number(s.rmse)},
-                 {"psnr (dB)", s.psnr_db ? number(*s.psnr_db) : "identical"},
-                 {"p99", number(s.p99_abs)},
-                 {"over warn", fmt::format("{}", s.over_tolerance)},
-                 {"over fail", fmt::format("{}", s.over_fail)},
-                 {"non-finite", fmt::format("{}", s.nonfinite)},
-                 {"max R G B A",
-                  fmt::format("{} {} {} {}", number(s.max_abs_rgba[0]), number(s.max_abs_rgba[1]),
-                              number(s.max_abs_rgba[2]), number(s.max_abs_rgba[3]))},
-                 {"format", toString(t.color_format)},
-                 {"thresholds warn / fail", fmt::format("{} / {}", t.shading.warn, t.shading.fail)},
-                 {"worst", at(s.worst, r.height)}});
+  out += rowsTable(
+      "shading", s.status,
+      {{"compared", fmt::format("{}", s.compared)},
+       {"max abs (8-bit)", number(s.max_abs)},
+       {"mean abs", number(s.mean_abs)},
+       {"rmse", number(s.rmse)},
+       {"psnr (dB)", s.rmse > 0.0 ? number(s.psnr_db) : number(s.psnr_db) + " (identical)"},
+       {"p99", number(s.p99_abs)},
+       {"over warn", fmt::format("{}", s.over_tolerance)},
+       {"over fail", fmt::format("{}", s.over_fail)},
+       {"non-finite", fmt::format("{}", s.nonfinite)},
+       {"max R G B A",
+        fmt::format("{} {} {} {}", number(s.max_abs_rgba[0]), number(s.max_abs_rgba[1]),
+                    number(s.max_abs_rgba[2]), number(s.max_abs_rgba[3]))},
+       {"format", toString(t.color_format)},
+       {"thresholds warn / fail",
+        fmt::format("{:.4g} / {:.4g} + allowance", t.shading.warn, t.shading.fail)},
+       {"allowance", shadingAllowanceText(t, r.depth.band_px)},
+       {"worst", at(s.worst, r.height)},
+       {"worst error / allowance",
+        fmt::format("{} / {}", number(s.worst_abs), number(s.worst_allowance))}});
   const std::uint64_t nf_e = r.nonfinite_expected.total();
   const std::uint64_t nf_a = r.nonfinite_actual.total();
   if (nf_e || nf_a) {
@@ -503,7 +509,7 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       out += countCell(r.depth.over_tolerance);
       out += numCell(r.shading.max_abs);
       out += numCell(r.shading.mean_abs);
-      out += r.shading.psnr_db ? numCell(*r.shading.psnr_db) : cell("&infin;", "1e308", true);
+      out += numCell(r.shading.psnr_db);
       out += countCell(r.shading.over_tolerance);
     }
     out += "</tr>";

@@ -4,6 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <exception>
+#include <functional>
+#include <future>
 #include <string>
 
 #include <OpenImageIO/imagebuf.h>
@@ -13,7 +17,6 @@
 
 #include "compare/atomic_file.h"
 #include "fixtures/errors.h"
-#include "fixtures/frame_io.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -23,8 +26,24 @@ using OIIO::ImageBuf;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
-void writeImage(const fs::path& file, const ImageSpec& spec, TypeDesc format, const void* data,
+// PNGs for people: fast deflate (level 1) and one cheap row filter (SUB) write a 1080p
+// image several times faster than the defaults for files ~1.5x larger; these images are
+// looked at, not archived.
+constexpr int kPngCompressionLevel = 1;
+constexpr int kPngFilterSub = 16;
+// diff.exr: mostly zero rows (background, no error) that fast zip (level 1) shrinks to a
+// few percent, at ~0.1 us per pixel. Above ~1 M pixels that is the longest single task of
+// a comparison (0.24 s CPU at 1080p, five times the comparison itself), so large frames
+// are written uncompressed (36 bytes per pixel).
+constexpr const char* kDiffExrCompression = "zip:1";
+constexpr std::size_t kDiffExrCompressUpTo = std::size_t{1} << 20;
+
+void writeImage(const fs::path& file, ImageSpec spec, const TypeDesc& format, const void* data,
                 const fs::path& target) {
+  if (file.extension() == ".png") {
+    spec.attribute("png:compressionLevel", kPngCompressionLevel);
+    spec.attribute("png:filter", kPngFilterSub);
+  }
   auto out = OIIO::ImageOutput::create(file.string());
   if (!out || !out->open(file.string(), spec) || !out->write_image(format, data) || !out->close())
     throw InputError(fmt::format("{}: cannot write: {}", target.string(),
@@ -36,24 +55,59 @@ void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_
   writeImage(file, ImageSpec(w, h, 3, TypeDesc::UINT8), TypeDesc::UINT8, rgb.data(), target);
 }
 
+// v >= 0 rounded to nearest, halves up, as std::lround: v - trunc(v) is exact in float
+// (adding 0.5 first would round 0.49999997 up).
+inline int roundHalfUp(float v) {
+  const auto q = static_cast<int>(v);
+  return q + (v - static_cast<float>(q) >= 0.5f ? 1 : 0);
+}
+
+// v clamped to [0, 255] and rounded; NaN fails both comparisons and becomes 0.
+inline std::uint8_t toByte(float v) {
+  v = v > 0.0f ? v : 0.0f;
+  v = v < 255.0f ? v : 255.0f;
+  return static_cast<std::uint8_t>(roundHalfUp(v));
+}
+
+// The frame's colour as people see it: clamped to [0, 1], rounded, NaN as black (as
+// render's color.png, but from the frame that was compared).
+std::vector<std::uint8_t> colorRgb8(const Frame& frame) {
+  const std::size_t n = frame.pixelCount();
+  std::vector<std::uint8_t> rgb(n * 3);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = toByte(frame.color[i * 4 + c] * 255.0f);
+  return rgb;
+}
+
+// The picture of one frame: a link to (or copy of) a ready-made one, else encoded.
+void writePicture(const Frame& frame, const fs::path& ready, const fs::path& file,
+                  const fs::path& target) {
+  if (!ready.empty()) {
+    std::error_code ec;
+    fs::create_hard_link(ready, file, ec);
+    if (!ec) return;
+    if (fs::copy_file(ready, file, fs::copy_options::overwrite_existing, ec)) return;
+  }
+  writeRgb8(file, frame.width, frame.height, colorRgb8(frame), target);
+}
+
 float luminance(const float* c) {
   const float l = 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
   return std::isfinite(l) ? std::clamp(l, 0.0f, 1.0f) : 0.0f;
 }
 
+// The heat colour map sampled once (OpenImageIO's color_map), looked up per pixel.
+constexpr int kHeatLutSize = 1024;
+const std::vector<Rgb8>& heatLut() {
+  static const std::vector<Rgb8> lut = heatColorStops(kHeatLutSize);
+  return lut;
+}
+
 // Colours `values` (NaN = non-finite) of compared pixels through the heat colour map.
 std::vector<std::uint8_t> heatImage(const ClassMaps& maps, const std::vector<float>& values,
                                     double scale) {
-  const int w = maps.width;
-  const int h = maps.height;
-  const std::size_t n = static_cast<std::size_t>(w) * h;
-  std::vector<float> position(n, 0.0f);
-  for (std::size_t i = 0; i < n; ++i) position[i] = heatPosition(values[i], scale);
-  ImageBuf src(ImageSpec(w, h, 1, TypeDesc::FLOAT), position.data());
-  ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, kHeatColorMap);
-  std::vector<float> rgb(n * 3, 0.0f);
-  if (mapped.has_error() || !mapped.get_pixels(mapped.roi(), TypeDesc::FLOAT, rgb.data()))
-    throw InputError(fmt::format("color map '{}' failed: {}", kHeatColorMap, mapped.geterror()));
+  const std::vector<Rgb8>& lut = heatLut();
+  const std::size_t n = static_cast<std::size_t>(maps.width) * maps.height;
   std::vector<std::uint8_t> out(n * 3);
   for (std::size_t i = 0; i < n; ++i) {
     Rgb8 px;
@@ -62,13 +116,72 @@ std::vector<std::uint8_t> heatImage(const ClassMaps& maps, const std::vector<flo
     } else if (std::isnan(values[i])) {
       px = kNonFiniteColor;
     } else {
-      for (int c = 0; c < 3; ++c)
-        px[c] =
-            static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
+      px = lut[static_cast<std::size_t>(
+          roundHalfUp(heatPosition(values[i], scale) * static_cast<float>(kHeatLutSize - 1)))];
     }
     std::copy(px.begin(), px.end(), out.begin() + static_cast<std::ptrdiff_t>(i * 3));
   }
   return out;
+}
+
+// diff.exr: every float a tool might want, one channel each, written in bands of rows so
+// that the interleaved pixels never exist for the whole image.
+void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& maps,
+                  const PairResult& result, const fs::path& file, const fs::path& target) {
+  const int w = maps.width;
+  const int h = maps.height;
+  const std::vector<std::string> names = {
+      "id_class", "depth_steps", "depth_tolerance", "shading_abs", "shading_tolerance", "dR", "dG",
+      "dB",       "dA"};
+  const int nch = static_cast<int>(names.size());
+  ImageSpec spec(w, h, nch, TypeDesc::FLOAT);
+  spec.channelnames = names;
+  spec.attribute("compression", static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo
+                                    ? kDiffExrCompression
+                                    : "none");
+  spec.attribute("rastercheck:fixture", result.fixture);
+  spec.attribute("rastercheck:pair", result.expected + " vs " + result.actual);
+  auto out = OIIO::ImageOutput::create(file.string());
+  auto fail = [&] {
+    throw InputError(fmt::format("{}: cannot write: {}", target.string(),
+                                 out ? out->geterror() : OIIO::geterror()));
+  };
+  if (!out || !out->open(file.string(), spec)) fail();
+  constexpr int kBandRows = 32;  // a multiple of every EXR compression's block height
+  std::vector<float> band(static_cast<std::size_t>(w) * kBandRows * nch);
+  for (int y0 = 0; y0 < h; y0 += kBandRows) {
+    const int y1 = std::min(h, y0 + kBandRows);
+    for (std::size_t i = static_cast<std::size_t>(y0) * w, k = 0;
+         i < static_cast<std::size_t>(y1) * w; ++i, ++k) {
+      float* p = &band[k * nch];
+      p[0] = static_cast<float>(maps.pixel_class[i]);
+      p[1] = maps.depth_steps[i];
+      p[2] = maps.depth_tolerance[i];
+      p[3] = maps.shading_abs[i];
+      p[4] = maps.shading_tolerance[i];
+      for (int c = 0; c < 4; ++c)
+        p[5 + c] = (actual.color[i * 4 + c] - expected.color[i * 4 + c]) * 255.0f;
+    }
+    if (!out->write_scanlines(y0, y1, 0, TypeDesc::FLOAT, band.data())) fail();
+  }
+  if (!out->close()) fail();
+}
+
+// Runs the writers concurrently (each file is independent and most time is deflate), and
+// rethrows the first failure once all have finished.
+void runAll(std::vector<std::function<void()>> tasks) {
+  std::vector<std::future<void>> running;
+  running.reserve(tasks.size());
+  for (auto& t : tasks) running.push_back(std::async(std::launch::async, std::move(t)));
+  std::exception_ptr first;
+  for (auto& f : running) {
+    try {
+      f.get();
+    } catch (...) {
+      if (!first) first = std::current_exception();
+    }
+  }
+  if (first) std::rethrow_exception(first);
 }
 
 std::string safeName(const std::string& s) {
@@ -83,6 +196,23 @@ std::string safeName(const std::string& s) {
 }
 
 }  // namespace
+
+std::string colorDigest(const Frame& frame) {
+  // 64-bit FNV-1a over whole words: not cryptographic, only to notice a changed frame.
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  auto mix = [&](std::uint64_t w) { h = (h ^ w) * 0x100000001b3ull; };
+  mix(static_cast<std::uint64_t>(frame.width) << 32 | static_cast<std::uint32_t>(frame.height));
+  const std::size_t bytes = frame.color.size() * sizeof(float);
+  const auto* p = reinterpret_cast<const unsigned char*>(frame.color.data());
+  std::size_t k = 0;
+  for (; k + 8 <= bytes; k += 8) {
+    std::uint64_t w;
+    std::memcpy(&w, p + k, 8);
+    mix(w);
+  }
+  for (; k < bytes; ++k) mix(p[k]);
+  return fmt::format("{:016x}", h);
+}
 
 Rgb8 classColor(PixelClass c) {
   switch (c) {
@@ -129,67 +259,62 @@ std::vector<Rgb8> heatColorStops(int count) {
 }
 
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
-                     const fs::path& dir, PairResult& result) {
+                     const fs::path& dir, PairResult& result, const PairPictures& pictures) {
   const int w = maps.width;
   const int h = maps.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
   if (w <= 0 || h <= 0 || expected.width != w || expected.height != h || actual.width != w ||
       actual.height != h || maps.pixel_class.size() != n || maps.depth_steps.size() != n ||
       maps.depth_tolerance.size() != n || maps.shading_abs.size() != n ||
-      maps.delta_rgba.size() != n * 4)
+      maps.shading_tolerance.size() != n)
     throw InputError(fmt::format("{}: class maps do not match the frames ({}x{})", dir.string(),
                                  expected.width, expected.height));
 
   AtomicFileSet files;
   const fs::path expected_png = dir / "expected.png";
   const fs::path actual_png = dir / "actual.png";
-  writeColorPng(expected, files.stage(expected_png));
-  writeColorPng(actual, files.stage(actual_png));
-
-  // Visibility: classes in colour over a dim copy of the expected image for context.
-  std::vector<std::uint8_t> vis(n * 3);
-  for (std::size_t i = 0; i < n; ++i) {
-    Rgb8 px = classColor(maps.pixel_class[i]);
-    if (maps.pixel_class[i] == PixelClass::Match) {
-      const auto g =
-          static_cast<std::uint8_t>(std::lround(48.0f + 96.0f * luminance(&expected.color[i * 4])));
-      px = {g, g, g};
-    }
-    std::copy(px.begin(), px.end(), vis.begin() + static_cast<std::ptrdiff_t>(i * 3));
-  }
   const fs::path visibility_png = dir / "visibility.png";
-  writeRgb8(files.stage(visibility_png), w, h, vis, visibility_png);
-
+  const fs::path depth_png = dir / "depth_heat.png";
+  const fs::path shading_png = dir / "shading_heat.png";
+  const fs::path diff_exr = dir / "diff.exr";
+  // Staged names first (stage() is not thread-safe), then every file in parallel.
+  const fs::path tmp_expected = files.stage(expected_png);
+  const fs::path tmp_actual = files.stage(actual_png);
+  const fs::path tmp_visibility = files.stage(visibility_png);
+  const fs::path tmp_depth = files.stage(depth_png);
+  const fs::path tmp_shading = files.stage(shading_png);
+  const fs::path tmp_diff = files.stage(diff_exr);
   result.depth_heat_scale = std::max({result.depth.max_steps, result.tolerances.depth.fail, 1.0});
   result.shading_heat_scale =
       std::max({result.shading.max_abs, result.tolerances.shading.fail, 1.0});
-  const fs::path depth_png = dir / "depth_heat.png";
-  writeRgb8(files.stage(depth_png), w, h,
-            heatImage(maps, maps.depth_steps, result.depth_heat_scale), depth_png);
-  const fs::path shading_png = dir / "shading_heat.png";
-  writeRgb8(files.stage(shading_png), w, h,
-            heatImage(maps, maps.shading_abs, result.shading_heat_scale), shading_png);
+  heatLut();  // built once, before the threads that share it
 
-  // diff.exr: every float a tool might want, one channel each.
-  const std::vector<std::string> names = {
-      "id_class", "depth_steps", "depth_tolerance", "shading_abs", "dR", "dG", "dB", "dA"};
-  const int nch = static_cast<int>(names.size());
-  ImageSpec spec(w, h, nch, TypeDesc::FLOAT);
-  spec.channelnames = names;
-  spec.attribute("compression", "zip");
-  spec.attribute("rastercheck:fixture", result.fixture);
-  spec.attribute("rastercheck:pair", result.expected + " vs " + result.actual);
-  std::vector<float> diff(n * nch);
-  for (std::size_t i = 0; i < n; ++i) {
-    float* p = &diff[i * nch];
-    p[0] = static_cast<float>(maps.pixel_class[i]);
-    p[1] = maps.depth_steps[i];
-    p[2] = maps.depth_tolerance[i];
-    p[3] = maps.shading_abs[i];
-    for (int c = 0; c < 4; ++c) p[4 + c] = maps.delta_rgba[i * 4 + c];
-  }
-  const fs::path diff_exr = dir / "diff.exr";
-  writeImage(files.stage(diff_exr), spec, TypeDesc::FLOAT, diff.data(), diff_exr);
+  runAll({
+      [&] { writePicture(expected, pictures.expected, tmp_expected, expected_png); },
+      [&] { writePicture(actual, pictures.actual, tmp_actual, actual_png); },
+      [&] {
+        // Visibility: classes in colour over a dim copy of the expected image for context.
+        std::vector<std::uint8_t> vis(n * 3);
+        for (std::size_t i = 0; i < n; ++i) {
+          Rgb8 px = classColor(maps.pixel_class[i]);
+          if (maps.pixel_class[i] == PixelClass::Match) {
+            const std::uint8_t g = toByte(48.0f + 96.0f * luminance(&expected.color[i * 4]));
+            px = {g, g, g};
+          }
+          std::copy(px.begin(), px.end(), vis.begin() + static_cast<std::ptrdiff_t>(i * 3));
+        }
+        writeRgb8(tmp_visibility, w, h, vis, visibility_png);
+      },
+      [&] {
+        writeRgb8(tmp_depth, w, h, heatImage(maps, maps.depth_steps, result.depth_heat_scale),
+                  depth_png);
+      },
+      [&] {
+        writeRgb8(tmp_shading, w, h, heatImage(maps, maps.shading_abs, result.shading_heat_scale),
+                  shading_png);
+      },
+      [&] { writeDiffExr(expected, actual, maps, result, tmp_diff, diff_exr); },
+  });
 
   files.commit();
   result.images = {{"expected", expected_png},     {"actual", actual_png},
@@ -198,7 +323,7 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
 }
 
 fs::path pairDirectory(const fs::path& out_dir, const PairResult& result) {
-  return out_dir / safeName(result.fixture.empty() ? "fixture" : result.fixture) /
+  return out_dir / "pairs" / safeName(result.fixture.empty() ? "fixture" : result.fixture) /
          (safeName(result.expected) + "_vs_" + safeName(result.actual));
 }
 

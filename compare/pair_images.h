@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "compare/compare.h"
@@ -31,16 +32,29 @@ std::vector<Rgb8> heatColorStops(int count);
 // [0, 1]. Log-scaled so that one-step errors stay visible next to large ones.
 float heatPosition(float value, double scale);
 
-// Writes into `dir` (created if needed): expected.png, actual.png, visibility.png,
-// depth_heat.png, shading_heat.png and diff.exr (float channels id_class, depth_steps,
-// depth_tolerance, shading_abs, dR, dG, dB, dA), and records them in result.images and
-// the heat scales in result. Throws InputError when a file cannot be written; then none
-// of them is left behind.
-void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
-                     const std::filesystem::path& dir, PairResult& result);
+// Writes into `dir` (created if needed), all files concurrently: expected.png, actual.png,
+// visibility.png, depth_heat.png, shading_heat.png and diff.exr (float channels id_class,
+// depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG, dB, dA; see
+// docs/reports.md), and records them in result.images and the heat scales in result.
+// Throws InputError when a file cannot be written; then none of them is left behind.
+// A digest of a frame's size and colour buffer (16 hex digits). `render` records it in
+// frame.json ("color_digest"), so that a reader can tell whether the folder's color.png
+// still shows the colour in frame.exr.
+std::string colorDigest(const Frame& frame);
 
-// A folder for one pair's images under a report folder: <out>/<fixture>/<expected>_vs_
-// <actual>, every name reduced to [A-Za-z0-9._-].
+// Ready-made 8-bit pictures of the two frames (the frame folders' color.png, which
+// `render` writes from the same frame with the same conversion). When given, they are
+// linked (or copied) as expected.png/actual.png instead of encoding the frames again.
+struct PairPictures {
+  std::filesystem::path expected;
+  std::filesystem::path actual;
+};
+void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
+                     const std::filesystem::path& dir, PairResult& result,
+                     const PairPictures& pictures = {});
+
+// A folder for one pair's images under a report folder: <out>/pairs/<fixture>/<expected>
+// _vs_<actual>, every name reduced to [A-Za-z0-9._-] (fixture "a/b" becomes "a_b").
 std::filesystem::path pairDirectory(const std::filesystem::path& out_dir, const PairResult& result);
 
 }  // namespace rc

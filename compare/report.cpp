@@ -84,15 +84,28 @@ std::string depthText(const PairResult& r) {
   return s;
 }
 
+std::string shadingAllowanceText(const Tolerances& t, double slope_band_px) {
+  std::string s = fmt::format("{:.3g} x 255 x |C| + {:.3g} x {:.3g} px x |dC/dpx|",
+                              t.shading_relative, t.shading_slope_factor, slope_band_px);
+  if (t.texture_weight_error > 0.0 || t.texture_rounding_units > 0.0)
+    s += fmt::format(" + {:.3g} x 3x3 range + {:.3g} x max(1, |C|) (linear texture filtering)",
+                     t.texture_weight_error, t.texture_rounding_units);
+  return s;
+}
+
 std::string shadingText(const PairResult& r) {
   const ShadingStats& s = r.shading;
   std::string t = fmt::format(
-      "shading {}: max_abs {:.4g} (8-bit units; warn above {}, fail above {}), {} px over "
-      "warn, {} over fail",
-      toString(s.status), s.max_abs, r.tolerances.shading.warn, r.tolerances.shading.fail,
-      s.over_tolerance, s.over_fail);
+      "shading {}: {} px over tolerance ({} over fail; tolerance = warn {:.4g} / fail {:.4g} "
+      "8-bit units + allowance), max_abs {:.4g}, p99 {:.4g}",
+      toString(s.status), s.over_tolerance, s.over_fail, r.tolerances.shading.warn,
+      r.tolerances.shading.fail, s.max_abs, s.p99_abs);
   if (s.nonfinite) t += fmt::format(", {} px with non-finite colour", s.nonfinite);
   t += fmt::format("; worst {}", where(s.worst, r.height));
+  if (s.worst.valid())
+    t += std::isfinite(s.worst_abs)
+             ? fmt::format(": {:.4g} units, allowance {:.4g}", s.worst_abs, s.worst_allowance)
+             : std::string(": non-finite colour");
   return t;
 }
 
@@ -131,7 +144,17 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
             {"status", toString(r.status)},
             {"pixels", r.pixels}};
   if (r.status == Status::Error) {
+    // The contract's shape with nothing compared: every class "error", zero counts.
+    const char* e = toString(Status::Error);
     j["error"] = r.error;
+    j["visibility"] = {{"status", e},  {"mismatched", 0}, {"ambiguous", 0},      {"hard", 0},
+                       {"missing", 0}, {"extra", 0},      {"wrong_primitive", 0}};
+    j["depth"] = {{"status", e},    {"compared", 0},       {"max_steps", 0},  {"mean_steps", 0},
+                  {"p99_steps", 0}, {"over_tolerance", 0}, {"worst", nullptr}};
+    j["shading"] = {{"status", e},         {"compared", 0},   {"max_abs", 0},
+                    {"mean_abs", 0},       {"rmse", 0},       {"psnr_db", kPsnrCapDb},
+                    {"over_tolerance", 0}, {"worst", nullptr}};
+    j["images"] = json::object();
     return j;
   }
   const Tolerances& t = r.tolerances;
@@ -147,6 +170,10 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                      {"depth", thresholds(t.depth)},
                      {"shading", thresholds(t.shading)},
                      {"depth_slope_factor", num(t.depth_slope_factor)},
+                     {"shading_relative", num(t.shading_relative)},
+                     {"shading_slope_factor", num(t.shading_slope_factor)},
+                     {"texture_weight_error", num(t.texture_weight_error)},
+                     {"texture_rounding_units", num(t.texture_rounding_units)},
                      {"window_error_ulps", num(t.window_error_ulps)},
                      {"band_px_override", t.band_px ? num(*t.band_px) : json(nullptr)}};
   j["visibility"] = {{"status", toString(v.status)},
@@ -174,6 +201,8 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                 {"over_fail", d.over_fail},
                 {"nonfinite", d.nonfinite},
                 {"slope_unknown", d.slope_unknown},
+                {"slope_fitted", d.slope_fitted},
+                {"band_px", num(d.band_px)},
                 {"max_slope", num(d.max_slope)},
                 {"worst", pixel(d.worst)},
                 {"worst_window", windowPixel(d.worst, r.height)},
@@ -186,7 +215,7 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                   {"max_abs", num(s.max_abs)},
                   {"mean_abs", num(s.mean_abs)},
                   {"rmse", num(s.rmse)},
-                  {"psnr_db", s.psnr_db ? num(*s.psnr_db) : json(nullptr)},
+                  {"psnr_db", num(s.psnr_db)},
                   {"p99_abs", num(s.p99_abs)},
                   {"over_tolerance", s.over_tolerance},
                   {"over_fail", s.over_fail},
@@ -196,6 +225,8 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                     num(s.max_abs_rgba[3])}},
                   {"worst", pixel(s.worst)},
                   {"worst_window", windowPixel(s.worst, r.height)},
+                  {"worst_abs", s.worst.valid() ? num(s.worst_abs) : json(nullptr)},
+                  {"worst_allowance", s.worst.valid() ? num(s.worst_allowance) : json(nullptr)},
                   {"histogram", histogram(s.histogram, s.max_abs, "8-bit units")}};
   j["nonfinite"] = {{"expected", nonfinite(r.nonfinite_expected)},
                     {"actual", nonfinite(r.nonfinite_actual)}};
@@ -230,7 +261,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
 std::string describe(const PairResult& r) {
   std::string status = toString(r.status);
   for (char& ch : status) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  const std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
+  std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
   if (r.status == Status::Error) return head + ": " + r.error;
   // The classes that set the pair's status; at pass, nothing to say.
   std::vector<std::string> parts;

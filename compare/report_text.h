@@ -14,5 +14,7 @@ std::string where(const PixelRef& p, int height);
 std::string visibilityText(const PairResult& r);
 std::string depthText(const PairResult& r);
 std::string shadingText(const PairResult& r);
+// The shading allowance formula with the pair's numbers filled in.
+std::string shadingAllowanceText(const Tolerances& t, double slope_band_px);
 
 }  // namespace rc

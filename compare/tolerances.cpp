@@ -33,7 +33,7 @@ Status Thresholds::verdict(double measure) const {
   return Status::Pass;
 }
 
-Tolerances defaultTolerances(DepthFormat depth, ColorFormat color) {
+Tolerances defaultTolerances(DepthFormat depth, ColorFormat color, DrawnWith drawn) {
   Tolerances t;
   t.depth_format = depth;
   t.color_format = color;
@@ -47,17 +47,24 @@ Tolerances defaultTolerances(DepthFormat depth, ColorFormat color) {
       break;
     case DepthFormat::D24:
     case DepthFormat::D32F:
-      // A few float32 roundings of z (each ~1 step) plus the conversion rounding.
+      // A few float32 roundings of z near 1 (each up to one 2^-24 step) plus the
+      // conversion rounding: 4; fail where no plausible evaluation order reaches: 16.
       t.depth = {4.0, 16.0};
       break;
   }
+  t.shading_relative = kShadingRelative;
   if (color == ColorFormat::RGBA8) {
-    // Both sides round to nearest; values at a rounding boundary may go either way.
-    t.shading = {1.0, 2.0};
+    // Both sides round to nearest: a float difference below one unit rounds to at most
+    // one unit, so 2 units cannot come from rounding.
+    t.shading = {1.0, 1.0};
   } else {
-    // float32 lighting against the reference: well under one 8-bit unit on smooth
-    // surfaces; up to a few units where high exponents and interpolation meet.
-    t.shading = {1.0, 4.0};
+    // Above the float32 allowance: warn beyond 1/64 unit (absolute error of dot products
+    // near zero); fail beyond half a unit, where it changes an 8-bit image.
+    t.shading = {1.0 / 64.0, 0.5};
+  }
+  if (drawn.linear_textures) {
+    t.texture_weight_error = kTextureWeightError;
+    t.texture_rounding_units = kTextureRoundingUnits;
   }
   return t;
 }
@@ -94,6 +101,63 @@ void applyOverrides(Tolerances& tolerances, const ToleranceOverrides& overrides)
   if (overrides.depth_slope_factor) tolerances.depth_slope_factor = *overrides.depth_slope_factor;
 }
 
+void applyOverrides(Tolerances& tolerances, const CommandLineTolerances& overrides) {
+  applyOverrides(tolerances, overrides.thresholds);
+  const ExtraOverrides& x = overrides.extra;
+  checkValue(x.shading_relative, "shading.relative");
+  checkValue(x.shading_slope_factor, "shading.slope_factor");
+  checkValue(x.band_px, "visibility.band");
+  if (x.shading_relative) tolerances.shading_relative = *x.shading_relative;
+  if (x.shading_slope_factor) tolerances.shading_slope_factor = *x.shading_slope_factor;
+  if (x.band_px) tolerances.band_px = *x.band_px;
+}
+
+nlohmann::json toleranceJson(const ToleranceOverrides& o) {
+  nlohmann::json j = nlohmann::json::object();
+  auto pair = [&](const char* cls, const ClassThresholds& t) {
+    if (t.warn) j[cls]["warn"] = *t.warn;
+    if (t.fail) j[cls]["fail"] = *t.fail;
+  };
+  pair("visibility", o.visibility);
+  pair("depth", o.depth);
+  pair("shading", o.shading);
+  if (o.depth_slope_factor) j["depth"]["slope_factor"] = *o.depth_slope_factor;
+  return j;
+}
+
+ToleranceOverrides toleranceFromJson(const nlohmann::json& j, const std::string& source) {
+  auto bad = [&](const std::string& path, const std::string& what) {
+    return InputError(fmt::format("{}: tolerance{}: {}", source, path, what));
+  };
+  if (!j.is_object()) throw bad("", "must be an object");
+  ToleranceOverrides o;
+  auto number = [&](const nlohmann::json& v, const std::string& path) {
+    if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0.0)
+      throw bad(path, fmt::format("must be a finite number >= 0, got {}", v.dump()));
+    return v.get<double>();
+  };
+  for (const auto& [cls, value] : j.items()) {
+    ClassThresholds* t = cls == "visibility" ? &o.visibility
+                         : cls == "depth"    ? &o.depth
+                         : cls == "shading"  ? &o.shading
+                                             : nullptr;
+    if (!t) throw bad("." + cls, "unknown class (visibility, depth, shading)");
+    if (!value.is_object()) throw bad("." + cls, "must be an object");
+    for (const auto& [key, v] : value.items()) {
+      const std::string path = fmt::format(".{}.{}", cls, key);
+      if (key == "warn")
+        t->warn = number(v, path);
+      else if (key == "fail")
+        t->fail = number(v, path);
+      else if (cls == "depth" && key == "slope_factor")
+        o.depth_slope_factor = number(v, path);
+      else
+        throw bad(path, "unknown key");
+    }
+  }
+  return o;
+}
+
 double depthStepsPerUnit(DepthFormat format) {
   switch (format) {
     case DepthFormat::D16:
@@ -110,15 +174,20 @@ double snapMovePx(int subpixel_bits) {
   return std::sqrt(0.5) * std::ldexp(1.0, -std::clamp(subpixel_bits, 0, 30));
 }
 
+namespace {
+double windowErrorPx(const Tolerances& tolerances, const BandInputs& in) {
+  return tolerances.window_error_ulps * std::ldexp(1.0, -24) * std::max({in.width, in.height, 1});
+}
+}  // namespace
+
 double snapBandPx(const Tolerances& tolerances, const BandInputs& in) {
   if (tolerances.band_px) return *tolerances.band_px;
-  const double a = snapMovePx(in.expected_bits);
-  const double b = snapMovePx(in.actual_bits);
-  const double snap =
-      in.uncertainty_is_expected ? a + b : std::max(a, b) + snapMovePx(in.uncertainty_bits);
-  const double window =
-      tolerances.window_error_ulps * std::ldexp(1.0, -24) * std::max({in.width, in.height, 1});
-  return snap + window;
+  return std::max(snapMovePx(in.expected_bits), snapMovePx(in.actual_bits)) +
+         windowErrorPx(tolerances, in);
+}
+
+double slopeBandPx(const Tolerances& tolerances, const BandInputs& in) {
+  return snapMovePx(in.expected_bits) + snapMovePx(in.actual_bits) + windowErrorPx(tolerances, in);
 }
 
 }  // namespace rc

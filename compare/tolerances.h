@@ -6,6 +6,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "fixtures/scene.h"
 
 namespace rc {
@@ -29,24 +31,72 @@ struct Tolerances {
   Thresholds visibility;
   // Per-pixel |Za - Zb| in depth-format steps, on top of the pixel's slope allowance.
   Thresholds depth;
-  // Per-pixel error in 8-bit units: the largest of |Ca - Cb| * 255 over R, G, B, A.
+  // Per-pixel, per-channel |Ca - Cb| in 8-bit units, on top of the channel's shading
+  // allowance; a pixel's measure is its largest channel excess.
   Thresholds shading;
-  // Slope allowance of a pixel = factor * local depth slope (steps/px) * band (px): how far
-  // a triangle's stored depth moves when its vertices move by up to the band.
+  // Slope allowance of a pixel = factor * depth slope of its triangle (steps/px) * slope
+  // band (px): how far a triangle's stored depth moves when its vertices move by the band.
   double depth_slope_factor = 1.0;
+  // Shading allowance of a channel, in 8-bit units, with M = max(|Ca|, |Cb|), G the
+  // colour gradient (units/px) and R the colour range of the 3x3 neighbourhood (units):
+  //   255 * shading_relative * M              float32 evaluation of the lighting
+  //   + shading_slope_factor * G * band       attribute planes of snapped vertices
+  //   + texture_weight_error * R              linear filtering: quantised bilinear weights
+  //   + texture_rounding_units * max(1, M)    linear filtering: the 8-bit filtered texel
+  // (the texture terms are 0 unless a textured material is filtered linearly).
+  double shading_relative = 0.0;
+  double shading_slope_factor = 1.0;
+  double texture_weight_error = 0.0;
+  double texture_rounding_units = 0.0;
   // Float error of a float32 window transform, in ulps (2^-24) of the larger image side.
   double window_error_ulps = 16.0;
-  // When set, replaces the derived snap band (px); for experiments and odd backends.
+  // When set, replaces the derived visibility band (px); for experiments and odd backends.
   std::optional<double> band_px;
 };
 
-// The documented defaults for a pair rendered with these formats.
-Tolerances defaultTolerances(DepthFormat depth, ColorFormat color);
+// What a pair's frames say about how it was drawn, beyond the formats (frame.json).
+struct DrawnWith {
+  bool linear_textures = false;  // a textured material sampled with texture_filter linear
+};
+
+// The documented defaults for a pair rendered with these formats (docs/tolerances.md).
+Tolerances defaultTolerances(DepthFormat depth, ColorFormat color, DrawnWith drawn = {});
+
+// The relative error of float32 lighting at the GLSL 4.60 precisions (section 4.7.1): pow
+// through exp2(s log2 x) is the worst term, ~5.7e-7 per unit of shininess s, so 2^-10
+// covers exponents up to ~1700 (docs/tolerances.md).
+inline constexpr double kShadingRelative = 1.0 / 1024.0;
+// Linear filtering with weights of 8 fractional bits (llvmpipe; D3D's minimum subtexel
+// precision): each of the two weights off by up to 2^-8, each moving the filtered value by
+// up to that fraction of the footprint's contrast.
+inline constexpr double kTextureWeightError = 2.0 / 256.0;
+// The filtered texel kept as an 8-bit value: up to one step, times the light on it.
+inline constexpr double kTextureRoundingUnits = 1.0;
 
 // Replaces the thresholds the overrides set. A lone warn above the current fail (or a
 // lone fail below the current warn) moves the other threshold with it; warn > fail when
 // both are given, or a negative or non-finite value, throws InputError.
 void applyOverrides(Tolerances& tolerances, const ToleranceOverrides& overrides);
+
+// A fixture's "tolerance" block as JSON in the fixture's own shape (only the keys it
+// sets), as `render` records it in frame.json, and back. Reading throws InputError naming
+// `source` and the key for anything that is not a finite number >= 0.
+nlohmann::json toleranceJson(const ToleranceOverrides& overrides);
+ToleranceOverrides toleranceFromJson(const nlohmann::json& j, const std::string& source);
+
+// What the command line can set beyond a fixture's "tolerance" block (--tolerance
+// shading.relative=..., shading.slope_factor=..., visibility.band=...).
+struct ExtraOverrides {
+  std::optional<double> shading_relative;
+  std::optional<double> shading_slope_factor;
+  std::optional<double> band_px;
+};
+struct CommandLineTolerances {
+  ToleranceOverrides thresholds;
+  ExtraOverrides extra;
+};
+// The fixture-style part as above, then the extras (finite and >= 0, else InputError).
+void applyOverrides(Tolerances& tolerances, const CommandLineTolerances& overrides);
 
 // Depth-format steps per unit of [0,1] depth: 2^b - 1 for d16/d24; d32f counts steps of
 // 2^-24 (one float ulp just below 1).
@@ -55,19 +105,22 @@ double depthStepsPerUnit(DepthFormat format);
 // How far a vertex (and so an edge) moves when snapped to 2^-bits px: sqrt(2)/2 * 2^-bits.
 double snapMovePx(int subpixel_bits);
 
-// The visibility band of a pair in px: how far apart the two sides' versions of one edge
-// can lie, measured from the edges the uncertainty frame's edge_dist refers to.
-//   uncertainty is the expected frame: snap(a) + snap(b)
-//   uncertainty is a third frame u:    max(snap(a), snap(b)) + snap(u)
-// plus window_error_ulps * 2^-24 * max(width, height) for float window transforms.
+// The two bands of a pair, in px, from both sides' subpixel bits (docs/tolerances.md).
+// edge_dist is measured to the exact (unsnapped) edges; each side draws an edge within
+// snap(bits) of them, so the two sides can disagree about a pixel only within
+//   visibility band = max(snap(expected), snap(actual)) + window error
+// of an exact edge. A stored depth or an interpolated colour moves with the vertices of
+// its own side, so the two sides' planes can be apart by
+//   slope band = snap(expected) + snap(actual) + window error
+// (the uncertainty frame's own snapping is irrelevant to both). window error =
+// window_error_ulps * 2^-24 * max(width, height) for float32 window transforms.
 struct BandInputs {
   int expected_bits = 8;
   int actual_bits = 8;
-  int uncertainty_bits = 8;
-  bool uncertainty_is_expected = true;
   int width = 0;
   int height = 0;
 };
 double snapBandPx(const Tolerances& tolerances, const BandInputs& inputs);
+double slopeBandPx(const Tolerances& tolerances, const BandInputs& inputs);
 
 }  // namespace rc

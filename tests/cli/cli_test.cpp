@@ -1,14 +1,17 @@
-// The rastercheck command as a user meets it: help and version, exit codes 0/2/3,
-// one-line errors that name the file and JSON path, and no output left after a failure.
+// The rastercheck command as a user meets it: help and version, exit codes 0/1/2/3 of
+// render, compare and run, one-line errors that name the file and JSON path, no output
+// left after a failure, the closing summary and report path.
 #include <sys/wait.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "app/report_support.h"
 #include "fixtures/frame_io.h"
 
 namespace fs = std::filesystem;
@@ -131,4 +134,300 @@ TEST(Cli, ListShowsTheCatalog) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("shading/blinn_phong_sphere"), std::string::npos);
   EXPECT_NE(r.out.find("coverage/triangle_fan"), std::string::npos);
+}
+
+// ---- compare and run ----
+
+namespace {
+
+std::string crafted(const std::string& rel) {
+  return std::string(RC_SOURCE_DIR) + "/tests/compare/data/" + rel;
+}
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+int occurrences(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// Renders `fixture` with `backend` into dir/name and returns the folder.
+fs::path renderTo(const fs::path& dir, const std::string& name, const std::string& fixture,
+                  const std::string& backend) {
+  const fs::path out = dir / name;
+  const Result r = run("render " + fixture + " --backend " + backend + " --out " + out.string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  return out;
+}
+
+bool hasStagingLeftovers(const fs::path& dir) {
+  if (!fs::exists(dir)) return false;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.path().filename().string().find("staging") != std::string::npos ||
+        e.path().filename().string().find(".tmp-") != std::string::npos)
+      return true;
+  return false;
+}
+
+void expectReportFiles(const fs::path& out) {
+  for (const char* f : {"report.json", "junit.xml", "report.html"})
+    EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
+  EXPECT_FALSE(hasStagingLeftovers(out));
+}
+
+}  // namespace
+
+TEST(CliCompare, IdenticalFramesPassWithTheSummaryAndReportPath) {
+  const fs::path dir = scratch("cmp_pass");
+  const std::string fixture = catalog("coverage/triangle_fan.json");
+  const fs::path a = renderTo(dir, "a", fixture, "ref");
+  const fs::path b = renderTo(dir, "b", fixture, "ref:subpixel=8");
+  const fs::path out = dir / "report";
+  const Result r = run("compare " + a.string() + " " + b.string() + " --out " + out.string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("report: " + fs::absolute(out).string() + "/report.html"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("coverage/triangle_fan"), std::string::npos) << r.out;  // the table
+  EXPECT_NE(r.out.find("ref:subpixel=8"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 pairs: 1 pass"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.substr(r.out.size() - 5), "PASS\n") << r.out;
+  expectReportFiles(out);
+  EXPECT_TRUE(fs::is_directory(out / "pairs" / "coverage_triangle_fan"));
+}
+
+TEST(CliCompare, AFailingPairExitsOne) {
+  const fs::path dir = scratch("cmp_fail");
+  const std::string fixture = crafted("interpenetrating.json");
+  const fs::path a = renderTo(dir, "z", fixture, "ref");
+  const fs::path b = renderTo(dir, "p", fixture, "ref:painter");
+  const Result r =
+      run("compare " + a.string() + " " + b.string() + " --out " + (dir / "report").string());
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("FAIL compare-tests/interpenetrating ref vs ref:painter: visibility fail"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.substr(r.out.size() - 8), "FAILURE\n") << r.out;
+  expectReportFiles(dir / "report");
+}
+
+TEST(CliCompare, BadInputExitsTwoWithOneLineAndWritesNothing) {
+  const fs::path dir = scratch("cmp_bad");
+  const std::string fixture = catalog("coverage/triangle_fan.json");
+  const fs::path a = renderTo(dir, "a", fixture, "ref");
+  const fs::path out = dir / "report";
+  auto expectTwo = [&](const std::string& args, const std::string& mention) {
+    const Result r = run("compare " + args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+    EXPECT_EQ(lineCount(r.out), 1) << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("internal error"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  };
+  expectTwo(a.string() + " " + (dir / "nowhere").string() + " --out " + out.string(), "nowhere");
+  expectTwo(a.string() + " " + a.string() + " --out " + out.string() + " --tolerance depth.x=1",
+            "depth.x");
+  expectTwo(a.string() + " " + a.string() + " --out " + out.string() +
+                " --tolerance depth.warn=8 --tolerance depth.fail=4",
+            "warn");
+  // Frames of another size.
+  const fs::path big = renderTo(dir, "big", catalog("shading/teapot.json"), "ref");
+  expectTwo(a.string() + " " + big.string() + " --out " + out.string(), "differ in size");
+  // --out names a file: refused, and the file is left alone.
+  std::ofstream(dir / "file") << "keep";
+  const Result r =
+      run("compare " + a.string() + " " + a.string() + " --out " + (dir / "file").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_EQ(readFile(dir / "file"), "keep");
+}
+
+TEST(CliRun, ExitCodesZeroOneTwoThree) {
+  const fs::path dir = scratch("run_codes");
+  // 0: the reference against itself at the same precision.
+  Result r = run("run " + catalog("coverage/triangle_fan.json") +
+                 " --backends ref:subpixel=8 --out " + (dir / "pass").string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("report: " + fs::absolute(dir / "pass").string() + "/report.html"),
+            std::string::npos)
+      << r.out;
+  expectReportFiles(dir / "pass");
+  EXPECT_TRUE(fs::is_directory(dir / "pass" / "frames"));
+
+  // 1: painter's order cannot draw interpenetrating quads.
+  r = run("run " + crafted("interpenetrating.json") + " --backends ref:painter --out " +
+          (dir / "fail").string());
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("FAIL compare-tests/interpenetrating"), std::string::npos) << r.out;
+
+  // 3: a backend that cannot start; the report is still written, one error row, and the
+  // reason names the backend once.
+  r = run("run " + catalog("coverage/triangle_fan.json") + " --backends gl:egl-device:7 --out " +
+          (dir / "error").string());
+  if (r.code == 0) GTEST_SKIP() << "an EGL device 7 exists here";
+  EXPECT_EQ(r.code, 3) << r.out;
+  expectReportFiles(dir / "error");
+  const std::string error_line = r.out.substr(0, r.out.find('\n'));
+  EXPECT_EQ(error_line.rfind("ERROR coverage/triangle_fan ref vs gl:egl-device:7: ", 0), 0u)
+      << error_line;
+  EXPECT_EQ(occurrences(error_line, "gl:egl-device:7"), 1) << error_line;
+  EXPECT_EQ(occurrences(error_line, "coverage/triangle_fan"), 1) << error_line;
+  const std::string json = readFile(dir / "error" / "report.json");
+  EXPECT_NE(json.find("\"status\": \"error\""), std::string::npos);
+}
+
+TEST(CliRun, BadInputExitsTwoBeforeRenderingAndWritesNothing) {
+  const fs::path dir = scratch("run_bad");
+  const fs::path out = dir / "out";
+  auto expectTwo = [&](const std::string& args, const std::string& mention) {
+    const Result r = run("run " + args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+    EXPECT_EQ(lineCount(r.out), 1) << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("internal error"), std::string::npos) << r.out;
+  };
+  const fs::path bad = dir / "bad.json";
+  std::ofstream(bad) << R"({"format": "rastercheck-scene/1", "image": {"width": 8, "height": 8},
+    "camera": {"eye": [0, 0, 5]}, "objects": [{"mesh": {"generator": "cube"}}],
+    "state": {"shading": "glossy"}})";
+  expectTwo(bad.string() + " --backends ref:painter --out " + out.string(), "state.shading");
+  EXPECT_FALSE(fs::exists(out));
+  expectTwo(catalog("coverage/triangle_fan.json") + " --backends vulkan --out " + out.string(),
+            "vulkan");
+  EXPECT_FALSE(fs::exists(out));
+  expectTwo(catalog("coverage/triangle_fan.json") +
+                " --backends ref:painter --tolerance shading.warn=2 --tolerance shading.fail=1"
+                " --out " +
+                out.string(),
+            "shading");
+  EXPECT_FALSE(fs::exists(out));
+  std::ofstream(dir / "file") << "keep";
+  expectTwo(catalog("coverage/triangle_fan.json") + " --backends ref:painter --out " +
+                (dir / "file").string(),
+            "file");
+  EXPECT_EQ(readFile(dir / "file"), "keep");
+}
+
+TEST(CliRun, ARunReplacesWhatAnEarlierRunLeftAndNothingElse) {
+  const fs::path dir = scratch("run_replace");
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "notes.txt") << "mine";
+  Result r = run("run " + catalog("coverage/triangle_fan.json") +
+                 " --backends ref:subpixel=8 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::is_directory(out / "pairs" / "coverage_triangle_fan"));
+  const std::string first_report = readFile(out / "report.json");
+
+  // A run that fails on bad input leaves the earlier outputs as they were.
+  r = run("run " + catalog("coverage/jittered_grid.json") + " --backends vulkan --out " +
+          out.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_EQ(readFile(out / "report.json"), first_report);
+
+  // Another catalog: the first run's pairs and frames are gone, the user's file stays.
+  r = run("run " + catalog("coverage/jittered_grid.json") + " --backends ref:subpixel=8 --out " +
+          out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_FALSE(fs::exists(out / "pairs" / "coverage_triangle_fan"));
+  EXPECT_FALSE(fs::exists(out / "frames" / "coverage__triangle_fan"));
+  EXPECT_TRUE(fs::is_directory(out / "pairs" / "coverage_jittered_grid"));
+  EXPECT_EQ(readFile(out / "notes.txt"), "mine");
+  EXPECT_EQ(readFile(out / "report.json").find("triangle_fan"), std::string::npos);
+  EXPECT_FALSE(hasStagingLeftovers(out));
+}
+
+TEST(CliRun, SummaryTableListsEveryFixtureAndBackend) {
+  const fs::path dir = scratch("run_table");
+  const Result r = run("run " + catalog("coverage") +
+                       " --backends ref:subpixel=8,ref:subpixel=4 --out " + (dir / "out").string());
+  EXPECT_LE(r.code, 1) << r.out;
+  const std::size_t header = r.out.find("fixture ");
+  ASSERT_NE(header, std::string::npos) << r.out;
+  const std::string head_line = r.out.substr(header, r.out.find('\n', header) - header);
+  EXPECT_NE(head_line.find("ref:subpixel=8"), std::string::npos) << head_line;
+  EXPECT_NE(head_line.find("ref:subpixel=4"), std::string::npos) << head_line;
+  for (const char* f :
+       {"coverage/jittered_grid", "coverage/slivers_and_centres", "coverage/triangle_fan"})
+    EXPECT_NE(r.out.find(f, header), std::string::npos) << f << "\n" << r.out;
+  EXPECT_NE(r.out.find("v: hard visibility px"), std::string::npos);
+}
+
+TEST(CliCompare, PicturesAreReusedOnlyWhenTheyShowTheComparedFrames) {
+  const fs::path dir = scratch("cmp_pictures");
+  const std::string fixture = catalog("coverage/triangle_fan.json");
+  const fs::path a = renderTo(dir, "a", fixture, "ref");
+  const fs::path b = renderTo(dir, "b", fixture, "ref:subpixel=8");
+  // b's frame.exr changed after `render` (a fault injected into the colour only):
+  // frame.json still has the old digest, so b's color.png no longer shows the frame.
+  rc::Frame changed = rc::readFrameDir(b);
+  for (std::size_t i = 0; i < changed.pixelCount(); ++i)
+    if (changed.id[i] != 0) changed.color[i * 4] += 0.25f;
+  rc::writeFrameExr(changed, b / "frame.exr");
+  const fs::path out = dir / "report";
+  const Result r = run("compare " + a.string() + " " + b.string() + " --out " + out.string());
+  EXPECT_EQ(r.code, 1) << r.out;
+  const fs::path pair = out / "pairs" / "coverage_triangle_fan" / "ref_vs_ref_subpixel_8";
+  EXPECT_TRUE(fs::equivalent(pair / "expected.png", a / "color.png"));  // linked
+  EXPECT_FALSE(fs::equivalent(pair / "actual.png", b / "color.png"));   // encoded anew
+  EXPECT_NE(readFile(pair / "actual.png"), readFile(b / "color.png"));
+}
+
+TEST(SummaryTable, CompactForBigCatalogsListsOnlyWhatDidNotPass) {
+  rc::Report report;
+  for (int f = 0; f < 6; ++f) {
+    for (const char* backend : {"gl:a", "gl:b"}) {
+      rc::PairResult r;
+      r.fixture = "set/fixture" + std::to_string(f);
+      r.expected = "ref";
+      r.actual = backend;
+      if (f == 3 && std::string(backend) == "gl:b") {
+        r.status = rc::Status::Fail;
+        r.visibility.hard = 12;
+        r.depth.max_steps = 40;
+        r.shading.max_abs = 2.5;
+      }
+      report.results.push_back(r);
+    }
+  }
+  report.results.push_back(rc::errorResult("set/fixture5", "ref", "gl:b", "no driver"));
+  const std::string full = rc::summaryTable(report, 40);
+  for (int f = 0; f < 6; ++f)
+    EXPECT_NE(full.find("set/fixture" + std::to_string(f)), std::string::npos) << full;
+  EXPECT_NE(full.find("FAIL v12 d40 s2.5"), std::string::npos) << full;
+  const std::string compact = rc::summaryTable(report, 4);
+  EXPECT_EQ(compact.find("set/fixture0"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("set/fixture3"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("set/fixture5"), std::string::npos) << compact;  // the error row
+  EXPECT_NE(compact.find("ERROR"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("(all 6)"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("6 pass"), std::string::npos) << compact;  // gl:a
+  EXPECT_NE(compact.find("4 pass, 1 fail, 1 error"), std::string::npos) << compact;
+  EXPECT_NE(compact.find("(4 fixtures that pass on every backend not listed)"), std::string::npos)
+      << compact;
+}
+
+TEST(CliCompare, TheFixturesToleranceBlockAppliesAndTheCommandLineWins) {
+  const fs::path dir = scratch("cmp_tolerance");
+  // The interpenetrating quads with a visibility tolerance that forgives painter's order.
+  std::string text = readFile(crafted("interpenetrating.json"));
+  text.replace(text.rfind('}'), 1,
+               R"(, "tolerance": {"visibility": {"warn": 0, "fail": 100000}}})");
+  const fs::path fixture = dir / "forgiving.json";
+  std::ofstream(fixture) << text;
+  const fs::path a = renderTo(dir, "z", fixture.string(), "ref");
+  const fs::path b = renderTo(dir, "p", fixture.string(), "ref:painter");
+  // render recorded the block in frame.json: compare applies it without the fixture.
+  fs::remove(fixture);
+  Result r =
+      run("compare " + a.string() + " " + b.string() + " --out " + (dir / "report").string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.substr(r.out.size() - 8), "WARNING\n") << r.out;
+  r = run("compare " + a.string() + " " + b.string() + " --out " + (dir / "report").string() +
+          " --tolerance visibility.fail=10");
+  EXPECT_EQ(r.code, 1) << r.out;
 }

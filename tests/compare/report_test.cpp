@@ -74,9 +74,9 @@ class ReportTest : public ::testing::Test {
       report_->results.push_back(r);
     };
     add(ref, "synthetic/a", "gl:egl:llvmpipe");
-    Frame warn = ref;  // shading 2 units: above warn 1, below fail 4
+    Frame warn = ref;  // shading 0.3 units: above warn + allowance, below fail + allowance
     for (int y = kBy0; y < kBy1; ++y)
-      for (int x = kBx0; x < kBx1; ++x) warn.color[warn.index(x, y) * 4] += 2.0f / 255.0f;
+      for (int x = kBx0; x < kBx1; ++x) warn.color[warn.index(x, y) * 4] += 0.3f / 255.0f;
     add(warn, "synthetic/a", "gl:egl:softpipe");
     Frame fail = ref;
     for (int y = kBy0; y < kBy1; ++y)
@@ -144,10 +144,19 @@ TEST_F(ReportTest, JsonHoldsTheContractFields) {
   EXPECT_TRUE(wx >= kBx0 && wx < kBx1 && wy >= kBy0 && wy < kBy1);
   EXPECT_EQ(fail["visibility"]["worst_window"][0], wx);
   EXPECT_EQ(fail["visibility"]["worst_window"][1], kH - 1 - wy);
-  EXPECT_TRUE(j["results"][0]["shading"]["psnr_db"].is_null());  // identical: no finite PSNR
-  EXPECT_TRUE(j["results"][1]["shading"]["psnr_db"].is_number());
-  EXPECT_EQ(j["results"][3]["error"], "EGL: no display <&> \"here\"");
-  EXPECT_FALSE(j["results"][3].contains("visibility"));
+  EXPECT_EQ(j["results"][0]["shading"]["psnr_db"], kPsnrCapDb);  // identical: the cap
+  EXPECT_LT(j["results"][1]["shading"]["psnr_db"], kPsnrCapDb);
+  const nlohmann::json& error = j["results"][3];
+  EXPECT_EQ(error["error"], "EGL: no display <&> \"here\"");
+  // An error row has the contract's shape: every class "error", nothing compared.
+  for (const char* cls : {"visibility", "depth", "shading"}) {
+    EXPECT_EQ(error[cls]["status"], "error") << cls;
+    EXPECT_TRUE(error[cls]["worst"].is_null() || !error[cls].contains("worst")) << cls;
+  }
+  EXPECT_EQ(error["visibility"]["mismatched"], 0);
+  EXPECT_EQ(error["depth"]["compared"], 0);
+  EXPECT_EQ(error["shading"]["compared"], 0);
+  EXPECT_TRUE(error["images"].is_object() && error["images"].empty());
   // Image paths are relative to the report and resolve there.
   for (const auto& [kind, rel] : fail["images"].items()) {
     EXPECT_FALSE(fs::path(rel.get<std::string>()).is_absolute()) << kind;
@@ -184,7 +193,15 @@ TEST_F(ReportTest, JsonValidatesAgainstTheSchema) {
   std::ofstream(bad) << j.dump();
   EXPECT_NE(validate(bad), 0);
   j = nlohmann::json::parse(readText(*out_ / "report.json"));
-  j["results"][3]["visibility"] = j["results"][2]["visibility"];  // an error row has no classes
+  j["results"][3]["visibility"] = j["results"][2]["visibility"];  // an error row compared nothing
+  std::ofstream(bad) << j.dump();
+  EXPECT_NE(validate(bad), 0);
+  j = nlohmann::json::parse(readText(*out_ / "report.json"));
+  j["results"][3].erase("shading");  // ... but has every class
+  std::ofstream(bad) << j.dump();
+  EXPECT_NE(validate(bad), 0);
+  j = nlohmann::json::parse(readText(*out_ / "report.json"));
+  j["results"][0]["shading"]["psnr_db"] = nullptr;  // always a number
   std::ofstream(bad) << j.dump();
   EXPECT_NE(validate(bad), 0);
   fs::remove(bad);
@@ -306,29 +323,34 @@ TEST_F(ReportTest, ImagesShowTheClassesAndDiffExrHoldsTheNumbers) {
   auto diff = OIIO::ImageInput::open(fail.images.at("diff_exr").string());
   ASSERT_TRUE(diff);
   const OIIO::ImageSpec spec = diff->spec();
-  ASSERT_EQ(spec.nchannels, 8);
+  constexpr int kChannels = 9;
+  ASSERT_EQ(spec.nchannels, kChannels);
   const int id_class = spec.channelindex("id_class");
   const int depth_steps = spec.channelindex("depth_steps");
   const int shading_abs = spec.channelindex("shading_abs");
   const int d_r = spec.channelindex("dR");
   const int d_g = spec.channelindex("dG");
-  for (const char* name :
-       {"id_class", "depth_steps", "depth_tolerance", "shading_abs", "dR", "dG", "dB", "dA"})
+  const int shading_tolerance = spec.channelindex("shading_tolerance");
+  for (const char* name : {"id_class", "depth_steps", "depth_tolerance", "shading_abs",
+                           "shading_tolerance", "dR", "dG", "dB", "dA"})
     EXPECT_GE(spec.channelindex(name), 0) << name;
-  std::vector<float> px(static_cast<std::size_t>(kW) * kH * 8);
-  ASSERT_TRUE(diff->read_image(0, 0, 0, 8, OIIO::TypeDesc::FLOAT, px.data()));
-  EXPECT_EQ(px[in_block * 8 + id_class], static_cast<float>(PixelClass::MissingHard));
-  EXPECT_EQ(px[in_block * 8 + depth_steps], 0.0f);
+  std::vector<float> px(static_cast<std::size_t>(kW) * kH * kChannels);
+  ASSERT_TRUE(diff->read_image(0, 0, 0, kChannels, OIIO::TypeDesc::FLOAT, px.data()));
+  EXPECT_EQ(px[in_block * kChannels + id_class], static_cast<float>(PixelClass::MissingHard));
+  EXPECT_EQ(px[in_block * kChannels + depth_steps], 0.0f);
 
   const PairResult& warn = report_->results[1];
   auto wdiff = OIIO::ImageInput::open(warn.images.at("diff_exr").string());
-  ASSERT_TRUE(wdiff && wdiff->read_image(0, 0, 0, 8, OIIO::TypeDesc::FLOAT, px.data()));
-  EXPECT_EQ(px[in_block * 8 + id_class], static_cast<float>(PixelClass::Match));
-  EXPECT_NEAR(px[in_block * 8 + shading_abs], 2.0f, 1e-4);
-  EXPECT_NEAR(px[in_block * 8 + d_r], 2.0f, 1e-4);  // (actual - expected) * 255
-  EXPECT_EQ(px[in_block * 8 + d_g], 0.0f);
+  ASSERT_TRUE(wdiff && wdiff->read_image(0, 0, 0, kChannels, OIIO::TypeDesc::FLOAT, px.data()));
+  EXPECT_EQ(px[in_block * kChannels + id_class], static_cast<float>(PixelClass::Match));
+  EXPECT_NEAR(px[in_block * kChannels + shading_abs], 0.3f, 1e-4);
+  EXPECT_NEAR(px[in_block * kChannels + d_r], 0.3f, 1e-4);  // (actual - expected) * 255
+  EXPECT_EQ(px[in_block * kChannels + d_g], 0.0f);
+  // Over warn there, so its tolerance is kept: warn + allowance, below the error.
+  EXPECT_GT(px[in_block * kChannels + shading_tolerance], warn.tolerances.shading.warn);
+  EXPECT_LT(px[in_block * kChannels + shading_tolerance], 0.3f);
   EXPECT_DOUBLE_EQ(warn.shading_heat_scale,
-                   std::max(warn.shading.max_abs, warn.tolerances.shading.fail));
+                   std::max({warn.shading.max_abs, warn.tolerances.shading.fail, 1.0}));
 }
 
 TEST(ReportWrite, NothingIsLeftWhenAFileCannotBeWritten) {

@@ -85,16 +85,16 @@ TEST(SnapBand, HalfDiagonalOfTheSnapGridPerSide) {
   in.actual_bits = 4;
   in.width = 640;
   in.height = 480;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(8) + snapMovePx(4));
-  in.uncertainty_is_expected = false;
-  in.uncertainty_bits = 8;
-  in.expected_bits = 4;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(4) + snapMovePx(8));
-  in.expected_bits = 8;
+  // Coverage: each side within its own snap of the exact edge edge_dist is measured to.
+  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(4));
+  // Planes: each side's own plane moves with its own vertices.
+  EXPECT_DOUBLE_EQ(slopeBandPx(t, in), snapMovePx(8) + snapMovePx(4));
   in.actual_bits = 8;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), 2.0 * snapMovePx(8));
+  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(8));
+  EXPECT_DOUBLE_EQ(slopeBandPx(t, in), 2.0 * snapMovePx(8));
   t.window_error_ulps = 16.0;
-  EXPECT_DOUBLE_EQ(snapBandPx(t, in), 2.0 * snapMovePx(8) + 16.0 * 640.0 / 16777216.0);
+  EXPECT_DOUBLE_EQ(snapBandPx(t, in), snapMovePx(8) + 16.0 * 640.0 / 16777216.0);
+  EXPECT_DOUBLE_EQ(slopeBandPx(t, in), 2.0 * snapMovePx(8) + 16.0 * 640.0 / 16777216.0);
   t.band_px = 0.25;
   EXPECT_EQ(snapBandPx(t, in), 0.25);
 }
@@ -173,6 +173,55 @@ TEST(ErrorHistogram, AbsurdValuesLandInTheLastBin) {
   h.add(std::numeric_limits<double>::infinity());
   EXPECT_EQ(h.count(), 2u);
   EXPECT_EQ(h.percentile(0.5, 1e300), 1e300);
+}
+
+}  // namespace
+}  // namespace rc
+
+namespace rc {
+namespace {
+
+TEST(ToleranceJson, RoundTripsAndRejectsWhatIsNotANumber) {
+  ToleranceOverrides o;
+  o.depth.warn = 2.0;
+  o.shading.fail = 0.25;
+  o.depth_slope_factor = 1.5;
+  const nlohmann::json j = toleranceJson(o);
+  EXPECT_FALSE(j.contains("visibility"));  // only what is set
+  const ToleranceOverrides back = toleranceFromJson(j, "frame.json");
+  EXPECT_EQ(back.depth.warn, 2.0);
+  EXPECT_FALSE(back.depth.fail.has_value());
+  EXPECT_EQ(back.shading.fail, 0.25);
+  EXPECT_EQ(back.depth_slope_factor, 1.5);
+  EXPECT_FALSE(back.visibility.warn.has_value());
+  for (const char* bad :
+       {R"({"depth": {"warn": -1}})", R"({"depth": {"warn": "4"}})", R"({"colour": {}})",
+        R"({"shading": {"slope_factor": 1}})", R"({"depth": 4})", R"([])"}) {
+    try {
+      toleranceFromJson(nlohmann::json::parse(bad), "x/frame.json");
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("x/frame.json: tolerance"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(ToleranceDefaults, LinearTexturesGetTheFilteringAllowanceOnly) {
+  const Tolerances plain = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F);
+  DrawnWith drawn;
+  drawn.linear_textures = true;
+  const Tolerances textured = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F, drawn);
+  EXPECT_EQ(plain.texture_weight_error, 0.0);
+  EXPECT_EQ(plain.texture_rounding_units, 0.0);
+  EXPECT_EQ(textured.texture_weight_error, 2.0 / 256.0);
+  EXPECT_EQ(textured.texture_rounding_units, 1.0);
+  EXPECT_EQ(textured.shading.fail, plain.shading.fail);
+  EXPECT_EQ(plain.shading_relative, 1.0 / 1024.0);
+  // rgba8: one unit of rounding passes, two fail.
+  const Tolerances rgba8 = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);
+  EXPECT_EQ(rgba8.shading.verdict(1.0), Status::Pass);
+  EXPECT_EQ(rgba8.shading.verdict(2.0), Status::Fail);
 }
 
 }  // namespace

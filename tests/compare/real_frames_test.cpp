@@ -1,0 +1,368 @@
+// The comparator on real frames: catalog fixtures rendered by the reference in this
+// process, then one fault injected at a time (ids blanked or changed in a block, depth
+// offset by N steps, colour offset by N/255). Exactly the injected class must fail, with
+// the injected count, in the injected block, and every other number must stay where the
+// unmodified pair has it. Also ambiguity end to end on crafted geometry rendered two ways
+// (subpixel precision, painter's order). Expected counts come from the injection and the
+// band formula, never from running the comparator first.
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <optional>
+
+#include <gtest/gtest.h>
+
+#include "compare/compare.h"
+#include "fixtures/loader.h"
+#include "reference/reference_renderer.h"
+
+namespace rc {
+namespace {
+namespace fs = std::filesystem;
+
+constexpr double kD24 = 16777215.0;
+
+Frame render(const fs::path& fixture, ReferenceOptions options = {}, const char* backend = "ref") {
+  const Scene scene = loadScene(fixture);
+  Frame f = renderReference(scene, options);
+  f.meta["backend"] = backend;
+  f.meta["fixture"] = scene.name;
+  f.meta["depth_format"] = toString(scene.state.depth_format);
+  f.meta["color_format"] = toString(scene.state.color_format);
+  return f;
+}
+
+fs::path catalog(const char* rel) { return fs::path(RC_SOURCE_DIR) / "fixtures/scenes" / rel; }
+fs::path crafted(const char* rel) { return fs::path(RC_SOURCE_DIR) / "tests/compare/data" / rel; }
+
+struct Block {
+  int x0 = 0, y0 = 0, size = 0;
+  int count() const { return size * size; }
+  bool contains(PixelRef p) const {
+    return p.x >= x0 && p.x < x0 + size && p.y >= y0 && p.y < y0 + size;
+  }
+  template <typename F>
+  void each(F f) const {
+    for (int y = y0; y < y0 + size; ++y)
+      for (int x = x0; x < x0 + size; ++x) f(x, y);
+  }
+};
+
+// The first size x size block (scanning in steps of `size`) whose every pixel passes.
+std::optional<Block> findBlock(const Frame& f, int size,
+                               const std::function<bool(std::size_t)>& ok) {
+  for (int y0 = 0; y0 + size <= f.height; y0 += size) {
+    for (int x0 = 0; x0 + size <= f.width; x0 += size) {
+      Block b{x0, y0, size};
+      bool all = true;
+      b.each([&](int x, int y) { all = all && ok(f.index(x, y)); });
+      if (all) return b;
+    }
+  }
+  return std::nullopt;
+}
+
+class RealFramesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ref_ = render(catalog("shading/teapot.json"));
+    actual_ = ref_;
+    actual_.edge_dist.clear();
+    actual_.depth_gap.clear();
+    actual_.meta["backend"] = "ref+fault";
+    tol_ = tolerancesForFrames(ref_, actual_);
+    baseline_ = compareFrames(ref_, actual_, ref_, tol_);
+    // The band the comparator must use, from the formula (8 subpixel bits both sides).
+    band_ = snapMovePx(8) + 16.0 * std::ldexp(1.0, -24) * std::max(ref_.width, ref_.height);
+    slope_band_ = 2.0 * snapMovePx(8) + 16.0 * std::ldexp(1.0, -24) * ref_.width;
+  }
+  PairResult compare(ClassMaps* maps = nullptr) {
+    return compareFrames(ref_, actual_, ref_, tol_, maps);
+  }
+  // A drawn block away from every edge (edge_dist beyond the band).
+  Block interiorBlock(int size, const std::function<bool(std::size_t)>& extra = {}) {
+    const std::optional<Block> b = findBlock(ref_, size, [&](std::size_t i) {
+      return ref_.id[i] != 0 && ref_.edge_dist[i] > band_ && (!extra || extra(i));
+    });
+    EXPECT_TRUE(b.has_value()) << "no such block in " << ref_.meta["fixture"];
+    return b.value_or(Block{});
+  }
+  void expectVisibilityUnmoved(const PairResult& r) {
+    EXPECT_EQ(r.visibility.mismatched, 0u);
+    EXPECT_EQ(r.visibility.status, Status::Pass);
+    EXPECT_FALSE(r.visibility.worst.valid());
+  }
+  void expectDepthUnmoved(const PairResult& r) {
+    EXPECT_EQ(r.depth.max_steps, 0.0);
+    EXPECT_EQ(r.depth.over_tolerance, 0u);
+    EXPECT_EQ(r.depth.status, Status::Pass);
+  }
+  void expectShadingUnmoved(const PairResult& r) {
+    EXPECT_EQ(r.shading.max_abs, 0.0);
+    EXPECT_EQ(r.shading.over_tolerance, 0u);
+    EXPECT_EQ(r.shading.status, Status::Pass);
+  }
+
+  Frame ref_;
+  Frame actual_;
+  Tolerances tol_;
+  PairResult baseline_;
+  double band_ = 0.0;
+  double slope_band_ = 0.0;
+};
+
+TEST_F(RealFramesTest, AFrameComparedWithItselfGivesZeros) {
+  const PairResult& r = baseline_;
+  EXPECT_EQ(r.status, Status::Pass);
+  expectVisibilityUnmoved(r);
+  expectDepthUnmoved(r);
+  expectShadingUnmoved(r);
+  EXPECT_GT(r.depth.compared, 10000u);  // the teapot covers a good part of the frame
+  EXPECT_EQ(r.depth.compared, r.shading.compared);
+  EXPECT_EQ(r.shading.psnr_db, kPsnrCapDb);
+  EXPECT_EQ(r.nonfinite_expected.total() + r.nonfinite_actual.total(), 0u);
+  EXPECT_NEAR(r.visibility.band_px, band_, 1e-12);
+  EXPECT_NEAR(r.depth.band_px, slope_band_, 1e-12);
+}
+
+TEST_F(RealFramesTest, BlankedIdsAreExactlyThatManyHardMissingPixels) {
+  const Block b = interiorBlock(6);
+  b.each([&](int x, int y) {
+    const std::size_t i = actual_.index(x, y);
+    actual_.id[i] = 0;
+    actual_.depth[i] = 1.0f;
+    for (int c = 0; c < 4; ++c) actual_.color[i * 4 + c] = 0.0f;
+  });
+  ClassMaps maps;
+  const PairResult r = compare(&maps);
+  const auto n = static_cast<std::uint64_t>(b.count());
+  EXPECT_EQ(r.visibility.missing, n);
+  EXPECT_EQ(r.visibility.missing_hard, n);
+  EXPECT_EQ(r.visibility.hard, n);
+  EXPECT_EQ(r.visibility.mismatched, n);
+  EXPECT_EQ(r.visibility.extra + r.visibility.wrong_primitive, 0u);
+  EXPECT_EQ(r.visibility.status, Status::Fail);
+  EXPECT_TRUE(b.contains(r.visibility.worst))
+      << r.visibility.worst.x << "," << r.visibility.worst.y;
+  // Where: the class map marks the block and nothing else.
+  std::uint64_t marked = 0;
+  for (int y = 0; y < ref_.height; ++y)
+    for (int x = 0; x < ref_.width; ++x) {
+      const PixelClass c = maps.pixel_class[ref_.index(x, y)];
+      if (c != PixelClass::Match && c != PixelClass::Background) {
+        ++marked;
+        EXPECT_TRUE(b.contains({x, y})) << x << "," << y;
+        EXPECT_EQ(c, PixelClass::MissingHard);
+      }
+    }
+  EXPECT_EQ(marked, n);
+  // The other classes only lose the pixels that left the comparison.
+  EXPECT_EQ(r.depth.compared, baseline_.depth.compared - n);
+  expectDepthUnmoved(r);
+  expectShadingUnmoved(r);
+  EXPECT_EQ(r.status, Status::Fail);
+}
+
+TEST_F(RealFramesTest, ChangedIdsWithOneFragmentAreHardWrongPrimitives) {
+  // Far from any edge and no second surface within any possible depth tolerance: the
+  // largest allowance a d24 slope can give is the whole range per px times the band.
+  const double gap_bound = 2.0 * (tol_.depth.fail + slope_band_ * kD24);
+  const Block b = interiorBlock(5, [&](std::size_t i) { return ref_.depth_gap[i] > gap_bound; });
+  b.each([&](int x, int y) { actual_.id[actual_.index(x, y)] += 100000; });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(b.count());
+  EXPECT_EQ(r.visibility.wrong_primitive, n);
+  EXPECT_EQ(r.visibility.wrong_primitive_hard, n);
+  EXPECT_EQ(r.visibility.ambiguous, 0u);
+  EXPECT_EQ(r.visibility.missing + r.visibility.extra, 0u);
+  EXPECT_TRUE(b.contains(r.visibility.worst));
+  EXPECT_EQ(r.depth.compared, baseline_.depth.compared - n);
+  expectDepthUnmoved(r);
+  expectShadingUnmoved(r);
+}
+
+TEST_F(RealFramesTest, DepthOffsetFailsInExactlyItsBlock) {
+  // 50000 steps: beyond warn/fail plus any slope allowance a visible triangle can have
+  // here (that would need more than 8e6 steps/px).
+  constexpr int kN = 50000;
+  const Block b = interiorBlock(6);
+  b.each([&](int x, int y) {
+    const std::size_t i = actual_.index(x, y);
+    actual_.depth[i] = static_cast<float>((std::nearbyint(ref_.depth[i] * kD24) + kN) / kD24);
+  });
+  ClassMaps maps;
+  const PairResult r = compare(&maps);
+  const auto n = static_cast<std::uint64_t>(b.count());
+  EXPECT_EQ(r.depth.over_tolerance, n);
+  EXPECT_EQ(r.depth.over_fail, n);
+  EXPECT_EQ(r.depth.max_steps, kN);
+  EXPECT_EQ(r.depth.worst_steps, kN);
+  EXPECT_TRUE(b.contains(r.depth.worst)) << r.depth.worst.x << "," << r.depth.worst.y;
+  EXPECT_EQ(r.depth.status, Status::Fail);
+  EXPECT_EQ(r.depth.compared, baseline_.depth.compared);
+  EXPECT_DOUBLE_EQ(r.depth.mean_steps, kN * static_cast<double>(n) / r.depth.compared);
+  for (int y = 0; y < ref_.height; ++y)
+    for (int x = 0; x < ref_.width; ++x) {
+      const float steps = maps.depth_steps[ref_.index(x, y)];
+      EXPECT_EQ(steps, b.contains({x, y}) ? kN : 0.0f) << x << "," << y;
+    }
+  expectVisibilityUnmoved(r);
+  expectShadingUnmoved(r);
+  EXPECT_EQ(r.status, Status::Fail);
+
+  // Within warn (3 steps <= 4) the same block passes, and the numbers still say 3.
+  actual_ = ref_;
+  b.each([&](int x, int y) {
+    const std::size_t i = actual_.index(x, y);
+    actual_.depth[i] = static_cast<float>((std::nearbyint(ref_.depth[i] * kD24) + 3) / kD24);
+  });
+  const PairResult small = compare();
+  EXPECT_EQ(small.depth.max_steps, 3.0);
+  EXPECT_EQ(small.depth.over_tolerance, 0u);
+  EXPECT_EQ(small.status, Status::Pass);
+}
+
+TEST_F(RealFramesTest, ColourOffsetFailsInExactlyItsBlockAndChannel) {
+  constexpr float kN = 4.0f;  // 8-bit units, far above fail (0.5) + allowance
+  const Block b = interiorBlock(6);
+  b.each([&](int x, int y) { actual_.color[actual_.index(x, y) * 4 + 1] += kN / 255.0f; });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(b.count());
+  EXPECT_EQ(r.shading.over_tolerance, n);
+  EXPECT_EQ(r.shading.over_fail, n);
+  EXPECT_NEAR(r.shading.max_abs, kN, 1e-3);
+  EXPECT_NEAR(r.shading.max_abs_rgba[1], kN, 1e-3);
+  EXPECT_EQ(r.shading.max_abs_rgba[0], 0.0);
+  EXPECT_EQ(r.shading.max_abs_rgba[2], 0.0);
+  EXPECT_EQ(r.shading.max_abs_rgba[3], 0.0);
+  EXPECT_TRUE(b.contains(r.shading.worst)) << r.shading.worst.x << "," << r.shading.worst.y;
+  EXPECT_NEAR(r.shading.worst_abs, kN, 1e-3);
+  EXPECT_LT(r.shading.worst_allowance, 1.0);
+  const double values = 4.0 * static_cast<double>(r.shading.compared);
+  EXPECT_NEAR(r.shading.mean_abs, kN * static_cast<double>(n) / values, 1e-5);
+  EXPECT_EQ(r.shading.status, Status::Fail);
+  expectVisibilityUnmoved(r);
+  expectDepthUnmoved(r);
+}
+
+TEST_F(RealFramesTest, OneUnitInADarkCornerStillFailsAHundredthDoesNot) {
+  // Float32 lighting error is relative to the value; a whole 8-bit unit is not.
+  const Block b = interiorBlock(4);
+  b.each([&](int x, int y) { actual_.color[actual_.index(x, y) * 4] += 1.0f / 255.0f; });
+  EXPECT_EQ(compare().shading.over_fail, static_cast<std::uint64_t>(b.count()));
+  actual_ = ref_;
+  b.each([&](int x, int y) { actual_.color[actual_.index(x, y) * 4] += 0.01f / 255.0f; });
+  EXPECT_EQ(compare().shading.over_tolerance, 0u);
+}
+
+// ---- Ambiguity end to end ----
+
+TEST(Ambiguity, AnEdgeThroughPixelCentresIsAmbiguousBetweenSubpixelPrecisions) {
+  const fs::path fixture = crafted("edge_through_centres.json");
+  const Frame fine = render(fixture);
+  ReferenceOptions coarse_options;
+  coarse_options.subpixel_bits = 4;
+  const Frame coarse = render(fixture, coarse_options, "ref:subpixel=4");
+  const Tolerances tol = tolerancesForFrames(fine, coarse);
+  const PairResult r = compareFrames(fine, coarse, fine, tol);
+  // 4 bits move the diagonal and the left side onto a row and a column of centres.
+  EXPECT_GE(r.visibility.mismatched, 100u);
+  EXPECT_EQ(r.visibility.hard, 0u);
+  EXPECT_EQ(r.visibility.ambiguous, r.visibility.mismatched);
+  EXPECT_EQ(r.visibility.status, Status::Pass);
+  EXPECT_NEAR(r.visibility.band_px, snapMovePx(4) + 16.0 * std::ldexp(1.0, -24) * 64, 1e-12);
+  // The same pair with 8 bits on both sides: nothing to excuse.
+  EXPECT_EQ(compareFrames(fine, fine, fine, tol).visibility.mismatched, 0u);
+  // The band is what excuses them: with a band below their distance they are hard.
+  Tolerances narrow = tol;
+  narrow.band_px = 1e-4;
+  const PairResult n = compareFrames(fine, coarse, fine, narrow);
+  EXPECT_EQ(n.visibility.hard, r.visibility.mismatched);
+}
+
+TEST(Ambiguity, ACoplanarZFightIsAmbiguousByDepthGap) {
+  const fs::path fixture = crafted("coplanar_zfight.json");
+  const Frame zbuffer = render(fixture);
+  ReferenceOptions painter_options;
+  painter_options.force_painter = true;
+  const Frame painter = render(fixture, painter_options, "ref:painter");
+  const PairResult r =
+      compareFrames(zbuffer, painter, zbuffer, tolerancesForFrames(zbuffer, painter));
+  // The z-buffer keeps the first quad, painter's order the second, over the whole overlap.
+  EXPECT_GT(r.visibility.wrong_primitive, 1000u);
+  EXPECT_EQ(r.visibility.hard, 0u);
+  // Interior pixels are excused by the depth gap (0 steps), edge pixels by the band.
+  EXPECT_GT(r.visibility.ambiguous_by_depth_gap, r.visibility.wrong_primitive * 9 / 10);
+  EXPECT_EQ(r.status, Status::Pass);
+}
+
+TEST(Ambiguity, AClearOcclusionErrorIsHard) {
+  const fs::path fixture = crafted("interpenetrating.json");
+  const Frame zbuffer = render(fixture);
+  ReferenceOptions painter_options;
+  painter_options.force_painter = true;
+  const Frame painter = render(fixture, painter_options, "ref:painter");
+  const Tolerances tol = tolerancesForFrames(zbuffer, painter);
+  ClassMaps maps;
+  const PairResult r = compareFrames(zbuffer, painter, zbuffer, tol, &maps);
+  EXPECT_GT(r.visibility.wrong_primitive_hard, 200u);
+  EXPECT_EQ(r.visibility.status, Status::Fail);
+  // Every hard pixel is one the reference is sure about: away from edges, and the other
+  // surface much farther than the depth tolerance.
+  for (std::size_t i = 0; i < maps.pixel_class.size(); ++i) {
+    if (maps.pixel_class[i] != PixelClass::WrongHard) continue;
+    EXPECT_GT(zbuffer.edge_dist[i], r.visibility.band_px) << i;
+    EXPECT_GT(zbuffer.depth_gap[i], 2.0 * tol.depth.fail) << i;
+  }
+  EXPECT_GT(zbuffer.depth_gap[zbuffer.index(r.visibility.worst.x, r.visibility.worst.y)], 100.0f);
+}
+
+// ---- Depth slope on slivers ----
+
+TEST(SliverSlopes, PrimitivesWithoutNeighboursGetTheirPlaneFromAllTheirPixels) {
+  // A steep sliver (a long thin triangle seen nearly edge-on): 1-2 px wide, so its
+  // neighbourhood never shows it along both axes, but its pixels span a plane.
+  Frame f;
+  const float clear[4] = {0, 0, 0, 0};
+  f.allocate(64, 16, clear, 1.0f, true);
+  f.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
+  const double slope_x = 3000.0;  // steps per px
+  const double slope_y = 40000.0;
+  for (int x = 2; x < 60; ++x) {
+    for (int y = 7; y <= (x % 3 == 0 ? 8 : 7); ++y) {  // a ragged one- or two-pixel row
+      const std::size_t i = f.index(x, y);
+      f.id[i] = 7;
+      f.depth[i] = static_cast<float>(std::nearbyint(2e6 + slope_x * x + slope_y * y) / kD24);
+      f.color[i * 4] = 0.5f;
+      f.color[i * 4 + 3] = 1.0f;
+      f.edge_dist[i] = 0.3f;
+    }
+  }
+  Frame g = f;
+  g.edge_dist.clear();
+  g.depth_gap.clear();
+  // 60 steps off at one pixel: within the allowance of the true slope (|(3000, 40000)| x
+  // the band ~ 221 steps), far above what its row neighbours alone show (3000 x band).
+  const std::size_t probe = f.index(31, 7);
+  g.depth[probe] = static_cast<float>((std::nearbyint(f.depth[probe] * kD24) + 60) / kD24);
+  const Tolerances tol = tolerancesForFrames(f, g);
+  const PairResult r = compareFrames(f, g, f, tol);
+  EXPECT_EQ(r.depth.max_steps, 60.0);
+  EXPECT_EQ(r.depth.slope_fitted, 1u);
+  EXPECT_EQ(r.depth.over_tolerance, 0u);
+  EXPECT_NEAR(r.depth.worst_allowance, std::hypot(slope_x, slope_y) * r.depth.band_px,
+              0.01 * std::hypot(slope_x, slope_y) * r.depth.band_px);
+  // A lone pixel with nothing drawn around it has no slope: it may warn, never fail.
+  Frame lone = f;
+  std::fill(lone.id.begin(), lone.id.end(), 0u);
+  lone.id[probe] = 9;
+  Frame lone_g = g;
+  lone_g.id = lone.id;
+  const PairResult l = compareFrames(lone, lone_g, lone, tol);
+  EXPECT_EQ(l.depth.slope_unknown, 1u);
+  EXPECT_EQ(l.depth.status, Status::Warn);
+}
+
+}  // namespace
+}  // namespace rc
