@@ -57,7 +57,8 @@ std::string childFailure(const Job& job) {
 
 Frame renderInChild(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {
   std::vector<Job> jobs{renderJob(scene_file, spec, out_dir)};
-  runJobs(jobs, 1, [](std::size_t) {});
+  runJobs(
+      jobs, 1, [](std::size_t) {}, [](std::size_t) {});
   if (jobs[0].exit_code != 0) {
     const std::string why = childFailure(jobs[0]);
     // The child's own message usually names the spec already.
@@ -70,14 +71,6 @@ Frame renderBackend(const BackendSpec& backend, const Scene& scene, const fs::pa
                     const fs::path& out_dir) {
   if (backend.kind == BackendSpec::Kind::Reference) return renderWith(backend, scene);
   return renderInChild(scene_file, backend.text, out_dir);
-}
-
-Tolerances pairTolerances(const Frame& expected, const Frame& actual, const Scene& scene,
-                          const ToleranceOverrides& cli) {
-  Tolerances tol = tolerancesForFrames(expected, actual);
-  applyOverrides(tol, scene.tolerance);
-  applyOverrides(tol, cli);
-  return tol;
 }
 
 }  // namespace rc

@@ -48,9 +48,4 @@ Frame renderInChild(const std::filesystem::path& scene_file, const std::string& 
 Frame renderBackend(const BackendSpec& backend, const Scene& scene,
                     const std::filesystem::path& scene_file, const std::filesystem::path& out_dir);
 
-// The tolerances `compare` uses for this pair: the formats' defaults, then the scene's
-// "tolerance", then the command line.
-Tolerances pairTolerances(const Frame& expected, const Frame& actual, const Scene& scene,
-                          const ToleranceOverrides& cli);
-
 }  // namespace rc

@@ -16,6 +16,7 @@
 #include "app/backends.h"
 #include "app/commands.h"
 #include "app/debug_support.h"
+#include "app/report_support.h"
 #include "compare/compare.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
@@ -238,7 +239,7 @@ const char* classKey(PixelClass c) {
 }
 
 Json backendJson(const BackendSpec& spec, const Frame& reference, const Frame& frame,
-                 const Scene& scene, const ToleranceOverrides& cli, std::size_t i) {
+                 const Scene& scene, const CommandLineTolerances& cli, std::size_t i) {
   Json j = {{"backend", spec.text}};
   if (frame.meta.contains("renderer")) j["renderer"] = frame.meta["renderer"];
   j["subpixel_bits"] =
@@ -248,7 +249,7 @@ Json backendJson(const BackendSpec& spec, const Frame& reference, const Frame& f
                             num(frame.color[4 * i + 2]), num(frame.color[4 * i + 3])});
   j["depth"] = num(frame.depth[i]);
 
-  const Tolerances tol = pairTolerances(reference, frame, scene, cli);
+  const Tolerances tol = pairTolerances(reference, frame, scene.tolerance, cli);
   ClassMaps maps;
   const PairResult r = compareFrames(reference, frame, reference, tol, &maps);
   const PixelClass cls = maps.pixel_class[i];
@@ -269,14 +270,23 @@ Json backendJson(const BackendSpec& spec, const Frame& reference, const Frame& f
                   {"fail_above", num(fail_at)},
                   {"verdict", toString(depth_verdict)}};
     const double shading = maps.shading_abs[i];
-    c["shading"] = {
-        {"abs", num(shading)},
-        {"delta_rgba",
-         Json::array({num(maps.delta_rgba[4 * i]), num(maps.delta_rgba[4 * i + 1]),
-                      num(maps.delta_rgba[4 * i + 2]), num(maps.delta_rgba[4 * i + 3])})},
-        {"warn_above", num(tol.shading.warn)},
-        {"fail_above", num(tol.shading.fail)},
-        {"verdict", toString(tol.shading.verdict(shading))}};
+    // The pixel's thresholds carry its allowance (value, gradient, filtering) as the
+    // comparator computed it: warn + allowance there, fail + the same allowance.
+    const double shading_warn_at = maps.shading_tolerance[i];
+    const double shading_fail_at = tol.shading.fail + (shading_warn_at - tol.shading.warn);
+    const Status shading_verdict = !(shading <= shading_fail_at)   ? Status::Fail
+                                   : !(shading <= shading_warn_at) ? Status::Warn
+                                                                   : Status::Pass;
+    Json delta = Json::array();
+    for (int k = 0; k < 4; ++k)
+      delta.push_back(num((static_cast<double>(frame.color[4 * i + k]) -
+                           static_cast<double>(reference.color[4 * i + k])) *
+                          255.0));
+    c["shading"] = {{"abs", num(shading)},
+                    {"delta_rgba", delta},
+                    {"warn_above", num(shading_warn_at)},
+                    {"fail_above", num(shading_fail_at)},
+                    {"verdict", toString(shading_verdict)}};
   } else {
     c["depth"] = nullptr;
     c["shading"] = nullptr;
@@ -445,7 +455,7 @@ int explainCommand(const ExplainArgs& args) {
                     args.reference));
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));
-  ToleranceOverrides cli;
+  CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
   const glm::ivec2 pixel = parsePixel(args.pixel);
   const Scene scene = loadScene(args.scene);

@@ -22,6 +22,7 @@
 #include "app/backends.h"
 #include "app/commands.h"
 #include "app/debug_support.h"
+#include "app/report_support.h"
 #include "compare/compare.h"
 #include "compare/report.h"
 #include "fixtures/errors.h"
@@ -179,7 +180,7 @@ class Reducer {
         }
       }
       out.result = compareFrames(expected, actual, *uncertainty,
-                                 pairTolerances(expected, actual, scene, cli_));
+                                 pairTolerances(expected, actual, scene.tolerance, cli_));
       out.rendered = true;
     } catch (const BackendError& e) {
       out.error = e.what();
@@ -408,7 +409,7 @@ class Reducer {
   const std::vector<PrimitiveRef> prims_;
   const BackendSpec expected_;
   const BackendSpec actual_;
-  ToleranceOverrides cli_;
+  CommandLineTolerances cli_;
   ScratchDir scratch_;
   const Clock::time_point start_;
   const bool tty_;

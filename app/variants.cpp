@@ -57,7 +57,8 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
       jobs.push_back(renderJob(file, spec, dir / name));
     }
   }
-  runJobs(jobs, parallel, [](std::size_t) {});
+  runJobs(
+      jobs, parallel, [](std::size_t) {}, [](std::size_t) {});
 
   // ref:subpixel=N for every candidate N, once for all backends.
   std::map<int, Frame> reference;

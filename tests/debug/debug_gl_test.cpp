@@ -34,7 +34,15 @@ TEST(DebugGl, ExplainComparesEachGlBackendAtThePixel) {
     for (int c = 0; c < 4; ++c)
       EXPECT_EQ(static_cast<float>(b["color"][c].get<double>()), frame->color[4 * i + c]);
     EXPECT_EQ(b["class"]["visibility"], "match");
-    EXPECT_EQ(b["class"]["shading"]["verdict"], "pass");
+    // The verdict there follows from the error and the pixel's own thresholds (a driver
+    // may legally warn at 1/64 unit; it must not fail).
+    const json& shading = b["class"]["shading"];
+    const double err = shading["abs"].get<double>();
+    const char* expected_verdict = err > shading["fail_above"].get<double>()   ? "fail"
+                                   : err > shading["warn_above"].get<double>() ? "warn"
+                                                                               : "pass";
+    EXPECT_EQ(shading["verdict"], expected_verdict) << shading.dump();
+    EXPECT_NE(shading["verdict"], "fail") << shading.dump();
     EXPECT_EQ(b["class"]["depth"]["verdict"], "pass");
     // The depth error it reports is the one between the two frames.
     EXPECT_NEAR(b["class"]["depth"]["steps"].get<double>(),
@@ -119,13 +127,12 @@ void checkClassification(const json& report, const fs::path& dir, int exit_code,
     EXPECT_EQ(r["subpixel_bits"]["actual"], 4);
     EXPECT_EQ(r["visibility"]["hard"], 0) << r["visibility"].dump();
     ambiguous += r["visibility"]["ambiguous"].get<std::uint64_t>();
-    // Band of a pair classified by a third (reference) frame: max of the two sides' snap
-    // moves plus the reference's, plus 16 float ulps of the window transform.
+    // Visibility band (docs/tolerances.md): edge_dist is measured to the exact edges, so
+    // the larger of the two sides' snap moves, plus 16 float ulps of the window transform.
     const double snap4 = std::sqrt(2.0) / 2.0 / 16.0;
-    const double snap8 = std::sqrt(2.0) / 2.0 / 256.0;
     const int side = std::max(r["width"].get<int>(), r["height"].get<int>());
     EXPECT_NEAR(r["visibility"]["band_px"].get<double>(),
-                snap4 + snap8 + 16.0 * std::ldexp(1.0, -24) * side, 1e-12);
+                snap4 + 16.0 * std::ldexp(1.0, -24) * side, 1e-12);
   }
   EXPECT_EQ(softpipe_pairs, 4);
   // The drivers really disagree at edges (softpipe's tie-break differs): all excused.
