@@ -1,13 +1,19 @@
 // OSMesa context provider: see context.h. Compiled to a stub that always fails when
-// the build found no OSMesa (Mesa 25.1 removed it).
+// the build found no OSMesa (Mesa 25.1 removed it). libOSMesa is opened on first use
+// rather than linked: it pulls in the gallium drivers and LLVM, whose relocations would
+// otherwise cost every rastercheck process (reference renders, compare) tens of ms.
 #include "gl_backend/context.h"
 
 #include "fixtures/errors.h"
 
 #ifdef RC_HAVE_OSMESA
 #include <GL/osmesa.h>
+#include <dlfcn.h>
 
 #include <array>
+#include <mutex>
+#include <string>
+#include <type_traits>
 #endif
 
 namespace rc::gl {
@@ -15,7 +21,41 @@ namespace rc::gl {
 #ifdef RC_HAVE_OSMESA
 namespace {
 
-ProcAddress osmesaLoader(const char* name) { return OSMesaGetProcAddress(name); }
+// The four OSMesa entry points the provider uses, from the library found at configure
+// time (RC_OSMESA_SONAME). RTLD_LOCAL keeps its GL symbols out of the global scope.
+struct OsMesaApi {
+  decltype(&OSMesaCreateContextAttribs) create_context = nullptr;
+  decltype(&OSMesaDestroyContext) destroy_context = nullptr;
+  decltype(&OSMesaMakeCurrent) make_current = nullptr;
+  decltype(&OSMesaGetProcAddress) get_proc_address = nullptr;
+};
+
+const OsMesaApi& osmesa() {
+  static OsMesaApi api;
+  static std::string error;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    void* lib = ::dlopen(RC_OSMESA_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (lib == nullptr) {
+      const char* why = ::dlerror();
+      error = std::string("cannot load " RC_OSMESA_SONAME ": ") + (why ? why : "unknown error");
+      return;
+    }
+    auto symbol = [&](auto& fn, const char* name) {
+      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(::dlsym(lib, name));
+      if (fn == nullptr && error.empty())
+        error = std::string(RC_OSMESA_SONAME " does not export ") + name;
+    };
+    symbol(api.create_context, "OSMesaCreateContextAttribs");
+    symbol(api.destroy_context, "OSMesaDestroyContext");
+    symbol(api.make_current, "OSMesaMakeCurrent");
+    symbol(api.get_proc_address, "OSMesaGetProcAddress");
+  });
+  if (!error.empty()) throw BackendError(error);
+  return api;
+}
+
+ProcAddress osmesaLoader(const char* name) { return osmesa().get_proc_address(name); }
 
 class OsMesaContext final : public Context {
  public:
@@ -35,16 +75,16 @@ class OsMesaContext final : public Context {
                            OSMESA_CONTEXT_MINOR_VERSION,
                            3,
                            0};
-    context_ = OSMesaCreateContextAttribs(attribs, nullptr);
+    context_ = osmesa().create_context(attribs, nullptr);
     if (context_ == nullptr)
       throw BackendError("OSMesaCreateContextAttribs (OpenGL 3.3 core) failed");
   }
-  ~OsMesaContext() override { OSMesaDestroyContext(context_); }
+  ~OsMesaContext() override { osmesa().destroy_context(context_); }
 
   void makeCurrent() override {
     // OSMesa needs a colour buffer to become current; everything is drawn into the
     // backend's FBO, so a 1x1 one is enough.
-    if (OSMesaMakeCurrent(context_, pixel_.data(), GL_UNSIGNED_BYTE, 1, 1) == 0)
+    if (osmesa().make_current(context_, pixel_.data(), GL_UNSIGNED_BYTE, 1, 1) == 0)
       throw BackendError("OSMesaMakeCurrent failed");
   }
   // OSMesa cannot unbind a context (OSMesaMakeCurrent(NULL...) is not portable across
