@@ -4,6 +4,7 @@
 // there in the end with its uncertainty channels, and what each listed backend has there
 // with the comparator's class. The JSON document is built first and the text story is
 // told from it, so the two cannot disagree. docs/explain.md documents every key.
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <iostream>
@@ -259,8 +260,11 @@ Json backendJson(const BackendSpec& spec, const Frame& reference, const Frame& f
                         cls == PixelClass::WrongAmbiguous},
       {"band_px", num(r.visibility.band_px)}};
   if (cls == PixelClass::Match) {
+    // The comparator works out a pixel's allowance only where the error exceeds the base
+    // warn threshold (the maps hold 0 elsewhere); within it the pixel passes whatever the
+    // allowance, and the base threshold is what is reported.
     const double steps = maps.depth_steps[i];
-    const double warn_at = maps.depth_tolerance[i];
+    const double warn_at = std::max<double>(maps.depth_tolerance[i], tol.depth.warn);
     const double fail_at = tol.depth.fail + (warn_at - tol.depth.warn);
     const Status depth_verdict = !(steps <= fail_at)   ? Status::Fail
                                  : !(steps <= warn_at) ? Status::Warn
@@ -270,9 +274,9 @@ Json backendJson(const BackendSpec& spec, const Frame& reference, const Frame& f
                   {"fail_above", num(fail_at)},
                   {"verdict", toString(depth_verdict)}};
     const double shading = maps.shading_abs[i];
-    // The pixel's thresholds carry its allowance (value, gradient, filtering) as the
-    // comparator computed it: warn + allowance there, fail + the same allowance.
-    const double shading_warn_at = maps.shading_tolerance[i];
+    // Over the base warn, the pixel's thresholds carry its allowance (value, gradient,
+    // filtering) as the comparator computed it: warn + allowance, fail + the same.
+    const double shading_warn_at = std::max<double>(maps.shading_tolerance[i], tol.shading.warn);
     const double shading_fail_at = tol.shading.fail + (shading_warn_at - tol.shading.warn);
     const Status shading_verdict = !(shading <= shading_fail_at)   ? Status::Fail
                                    : !(shading <= shading_warn_at) ? Status::Warn
