@@ -18,6 +18,7 @@
 #include "fixtures/catalog.h"
 #include "fixtures/loader.h"
 #include "tests/conformance/conformance_support.h"
+#include "tests/support/command.h"
 
 namespace fs = std::filesystem;
 using namespace rc;
@@ -47,13 +48,9 @@ std::vector<std::string> errorsOf(const char* json) {
 
 // Runs a shell command; returns its exit code and puts stdout+stderr in `output`.
 int run(const std::string& cmd, std::string& output) {
-  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
-  if (p == nullptr) return -1;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) output.append(buf, n);
-  const int status = ::pclose(p);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const rc::test::CommandResult r = rc::test::runShell(cmd);
+  output += r.out;
+  return r.code;
 }
 
 }  // namespace

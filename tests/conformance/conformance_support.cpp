@@ -1,6 +1,8 @@
 // See conformance_support.h.
 #include "tests/conformance/conformance_support.h"
 
+#include "tests/support/command.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,6 +21,7 @@
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
 #include "fixtures/scene_writer.h"
+#include "tests/support/command.h"
 
 namespace rc::conformance {
 namespace fs = std::filesystem;
@@ -73,22 +76,16 @@ std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& s
                                    std::string& error, int& exit_code, const std::string& env) {
   static int counter = 0;
   const fs::path out = scratchRoot() / fmt::format("frame{}", counter++);
-  const std::string cmd =
-      fmt::format("{}{} render {} --backend {} --out {} 2>&1",
-                  env.empty() ? "" : "env " + shellQuote(env) + " ", RC_EXE,
-                  shellQuote(fixture.string()), shellQuote(spec), shellQuote(out.string()));
-  std::string output;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) {
-    error = "popen failed";
-    exit_code = -1;
+  const std::string cmd = fmt::format(
+      "{}{} render {} --backend {} --out {}", env.empty() ? "" : "env " + shellQuote(env) + " ",
+      RC_EXE, shellQuote(fixture.string()), shellQuote(spec), shellQuote(out.string()));
+  const test::CommandResult child = test::runShell(cmd);
+  std::string output = child.out;
+  exit_code = child.code;
+  if (exit_code == -1) {
+    error = "could not start a shell";
     return std::nullopt;
   }
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) output.append(buf, n);
-  const int status = ::pclose(p);
-  exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   std::optional<Frame> frame;
   if (exit_code != 0) {
     while (!output.empty() && output.back() == '\n') output.pop_back();

@@ -20,38 +20,19 @@
 
 #include "fixtures/frame.h"
 #include "fixtures/frame_io.h"
+#include "tests/support/command.h"
 
 namespace rc::debugtest {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Result {
-  int code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
+using Result = rc::test::CommandResult;  // stdout in `out`, stderr in `err`
 
 // Runs the rastercheck binary with `args` (a shell word list), capturing stdout and
 // stderr separately. `env` is prepended to the command ("VAR=value").
 inline Result run(const std::string& args, const std::string& env = "") {
-  static int counter = 0;
-  const fs::path err_file =
-      fs::temp_directory_path() /
-      ("rc_dbg_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-  const std::string cmd = env + " " RC_EXE " " + args + " 2>" + err_file.string();
-  Result r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err_file);
-  r.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  fs::remove(err_file);
-  return r;
+  return rc::test::runShell(env + " " RC_EXE " " + args, /*separate_err=*/true);
 }
 
 inline fs::path scratch(const std::string& name) {

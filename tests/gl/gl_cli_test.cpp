@@ -15,27 +15,16 @@
 #include <gtest/gtest.h>
 
 #include "fixtures/frame_io.h"
+#include "tests/support/command.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out;  // stdout and stderr together
-};
+using Result = rc::test::CommandResult;  // stdout and stderr together in `out`
 
 Result run(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + " " RC_EXE " " + args + " 2>&1";
-  Result r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return rc::test::runShell(env + " " RC_EXE " " + args);
 }
 
 const std::string kFixture =
