@@ -20,21 +20,32 @@ namespace fs = std::filesystem;
 int compareCommand(const CompareArgs& args) {
   CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
-  // The frames are independent files: read them concurrently (decompression dominates).
-  auto read = [](const fs::path& dir) {
-    return std::async(std::launch::async, [dir] { return readFrameDir(dir); });
+  // The frames are independent files: read them concurrently (decompression dominates),
+  // each with the check that its color.png can be reused (a digest of the whole frame).
+  struct Read {
+    Frame frame;
+    fs::path picture;
   };
-  std::future<Frame> expected_f = read(args.expected);
-  std::future<Frame> actual_f = read(args.actual);
-  std::future<Frame> third_f;
-  if (!args.uncertainty.empty()) third_f = read(args.uncertainty);
-  const Frame expected = expected_f.get();
-  const Frame actual = actual_f.get();
+  auto read = [](const fs::path& dir, bool picture) {
+    return std::async(std::launch::async, [dir, picture] {
+      Read r{readFrameDir(dir), {}};
+      if (picture) r.picture = readyPicture(dir, r.frame);
+      return r;
+    });
+  };
+  std::future<Read> expected_f = read(args.expected, true);
+  std::future<Read> actual_f = read(args.actual, true);
+  std::future<Read> third_f;
+  if (!args.uncertainty.empty()) third_f = read(args.uncertainty, false);
+  const Read expected_read = expected_f.get();
+  const Read actual_read = actual_f.get();
+  const Frame& expected = expected_read.frame;
+  const Frame& actual = actual_read.frame;
   checkSameSize(expected, actual, args.expected, args.actual);
   Frame third;
   const Frame* uncertainty = &expected;
   if (third_f.valid()) {
-    third = third_f.get();
+    third = third_f.get().frame;
     checkSameSize(expected, third, args.expected, args.uncertainty);
     uncertainty = &third;
   } else if (!expected.hasUncertainty() && actual.hasUncertainty()) {
@@ -47,8 +58,7 @@ int compareCommand(const CompareArgs& args) {
   Report report;
   report.tool_version = kVersion;
   report.command = "compare";
-  const PairPictures pictures{readyPicture(args.expected, expected),
-                              readyPicture(args.actual, actual)};
+  const PairPictures pictures{expected_read.picture, actual_read.picture};
   report.results.push_back(
       comparePair(expected, actual, *uncertainty, tolerances, folder.staging(), pictures));
   folder.commit(report);

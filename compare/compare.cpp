@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "compare/slopes.h"
+#include "fixtures/big_buffer.h"
 #include "fixtures/errors.h"
 
 namespace rc {
@@ -263,11 +264,11 @@ class Comparator {
       const std::size_t n = e_.pixelCount();
       maps->width = e_.width;
       maps->height = e_.height;
-      maps->pixel_class.assign(n, PixelClass::Background);
-      maps->depth_steps.assign(n, 0.0f);
-      maps->depth_tolerance.assign(n, 0.0f);
-      maps->shading_abs.assign(n, 0.0f);
-      maps->shading_tolerance.assign(n, 0.0f);
+      assignBig(maps->pixel_class, n, PixelClass::Background);
+      assignBig(maps->depth_steps, n, 0.0f);
+      assignBig(maps->depth_tolerance, n, 0.0f);
+      assignBig(maps->shading_abs, n, 0.0f);
+      assignBig(maps->shading_tolerance, n, 0.0f);
     }
     for (int y = 0; y < e_.height; ++y) {
       if (maps) {
