@@ -605,7 +605,7 @@ class Comparator {
     for (int c = 0; c < 4; ++c) {
       const double m = std::max(std::fabs(pa[c]), std::fabs(pb[c]));
       const double allow = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
-                           tol_.texture_weight_error * around.range[c] +
+                           (tol_.texture_weight_error + tol_.texel_choice) * around.range[c] +
                            tol_.texture_rounding_units * std::max(1.0, m);
       out.allowances[c] = allow;
       const double excess = d[c] - allow;
@@ -952,14 +952,15 @@ Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual) {
     cf = ColorFormat::RGBA8;
   else if (!color.empty() && color != "rgba32f")
     throw InputError(fmt::format("frame.json: unknown color_format '{}'", color));
-  // Linear filtering of a textured material (frame.json "texture_filter", "textured").
-  auto linearTextures = [](const Frame& f) {
+  // The filter of a textured material (frame.json "texture_filter", "textured").
+  auto texturedWith = [](const Frame& f, const char* filter) {
     const auto textured = f.meta.find("textured");
-    return metaString(f, "texture_filter") == "linear" && textured != f.meta.end() &&
+    return metaString(f, "texture_filter") == filter && textured != f.meta.end() &&
            textured->is_boolean() && textured->get<bool>();
   };
   DrawnWith drawn;
-  drawn.linear_textures = linearTextures(expected) || linearTextures(actual);
+  drawn.linear_textures = texturedWith(expected, "linear") || texturedWith(actual, "linear");
+  drawn.nearest_textures = texturedWith(expected, "nearest") || texturedWith(actual, "nearest");
   return defaultTolerances(df, cf, drawn);
 }
 

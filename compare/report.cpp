@@ -90,6 +90,9 @@ std::string shadingAllowanceText(const Tolerances& t, double slope_band_px) {
   if (t.texture_weight_error > 0.0 || t.texture_rounding_units > 0.0)
     s += fmt::format(" + {:.3g} x 3x3 range + {:.3g} x max(1, |C|) (linear texture filtering)",
                      t.texture_weight_error, t.texture_rounding_units);
+  if (t.texel_choice > 0.0)
+    s += fmt::format(" + {:.3g} x 3x3 range (nearest texture filtering: either texel at an edge)",
+                     t.texel_choice);
   return s;
 }
 
@@ -174,6 +177,7 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                      {"shading_slope_factor", num(t.shading_slope_factor)},
                      {"texture_weight_error", num(t.texture_weight_error)},
                      {"texture_rounding_units", num(t.texture_rounding_units)},
+                     {"texel_choice", num(t.texel_choice)},
                      {"window_error_ulps", num(t.window_error_ulps)},
                      {"band_px_override", t.band_px ? num(*t.band_px) : json(nullptr)}};
   j["visibility"] = {{"status", toString(v.status)},

@@ -66,6 +66,7 @@ Tolerances defaultTolerances(DepthFormat depth, ColorFormat color, DrawnWith dra
     t.texture_weight_error = kTextureWeightError;
     t.texture_rounding_units = kTextureRoundingUnits;
   }
+  if (drawn.nearest_textures) t.texel_choice = kTexelChoice;
   return t;
 }
 

@@ -43,11 +43,13 @@ struct Tolerances {
   //   + shading_slope_factor * G * band       attribute planes of snapped vertices
   //   + texture_weight_error * R              linear filtering: quantised bilinear weights
   //   + texture_rounding_units * max(1, M)    linear filtering: the 8-bit filtered texel
-  // (the texture terms are 0 unless a textured material is filtered linearly).
+  //   + texel_choice * R                      nearest filtering: either texel at an edge
+  // (the texture terms are 0 unless a textured material is drawn with that filter).
   double shading_relative = 0.0;
   double shading_slope_factor = 1.0;
   double texture_weight_error = 0.0;
   double texture_rounding_units = 0.0;
+  double texel_choice = 0.0;
   // Float error of a float32 window transform, in ulps (2^-24) of the larger image side.
   double window_error_ulps = 16.0;
   // When set, replaces the derived visibility band (px); for experiments and odd backends.
@@ -56,7 +58,8 @@ struct Tolerances {
 
 // What a pair's frames say about how it was drawn, beyond the formats (frame.json).
 struct DrawnWith {
-  bool linear_textures = false;  // a textured material sampled with texture_filter linear
+  bool linear_textures = false;   // a textured material sampled with texture_filter linear
+  bool nearest_textures = false;  // a textured material sampled with texture_filter nearest
 };
 
 // The documented defaults for a pair rendered with these formats (docs/tolerances.md).
@@ -72,6 +75,9 @@ inline constexpr double kShadingRelative = 1.0 / 1024.0;
 inline constexpr double kTextureWeightError = 2.0 / 256.0;
 // The filtered texel kept as an 8-bit value: up to one step, times the light on it.
 inline constexpr double kTextureRoundingUnits = 1.0;
+// Nearest filtering: a texture coordinate within float32 rounding of a texel edge selects
+// either texel, and both colours lie in the 3x3 neighbourhood's range.
+inline constexpr double kTexelChoice = 1.0;
 
 // Replaces the thresholds the overrides set. A lone warn above the current fail (or a
 // lone fail below the current warn) moves the other threshold with it; warn > fail when

@@ -610,5 +610,46 @@ TEST(CompareEdgeCases, DegenerateFramesNeverCrash) {
   EXPECT_EQ(r.status, Status::Fail);
 }
 
+// Nearest texture filtering: at a texel edge the driver may take the texel on the other
+// side (float32 texture coordinates within rounding of the edge). That colour is in the
+// pixel's 3x3 neighbourhood, so it passes when the frames say nearest-filtered textures
+// were drawn; the same change fails without that, and a colour no neighbour has fails
+// either way.
+TEST(TexelChoice, TheNeighbouringTexelPassesOnlyForNearestTextures) {
+  testing::Rect r;
+  r.x0 = 0;
+  r.y0 = 0;
+  r.x1 = 16;
+  r.y1 = 8;
+  Frame ref = testing::renderRects(16, 8, {r});
+  for (int y = 0; y < 8; ++y)  // two texels: 0.2 left of x = 8, 0.8 from it
+    for (int x = 0; x < 16; ++x)
+      for (int c = 0; c < 3; ++c) ref.color[ref.index(x, y) * 4 + c] = x < 8 ? 0.2f : 0.8f;
+  Frame gl = ref;
+  gl.edge_dist.clear();
+  gl.depth_gap.clear();
+  gl.meta["backend"] = "gl:test";
+  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 4) * 4 + c] = 0.2f;  // the left texel
+
+  auto compareWith = [&](const char* filter, bool textured) {
+    for (Frame* f : {&ref, &gl}) {
+      f->meta["texture_filter"] = filter;
+      f->meta["textured"] = textured;
+    }
+    return compareFrames(ref, gl, ref, tolerancesForFrames(ref, gl));
+  };
+  EXPECT_EQ(compareWith("nearest", true).shading.status, Status::Pass);
+  EXPECT_EQ(compareWith("nearest", false).shading.status, Status::Fail);
+  EXPECT_EQ(compareWith("linear", true).shading.status, Status::Fail);
+
+  // Inside a texel (x = 12: every neighbour 0.8) a different colour is an error.
+  for (int c = 0; c < 3; ++c) gl.color[gl.index(12, 4) * 4 + c] = 0.5f;
+  const PairResult inside = compareWith("nearest", true);
+  EXPECT_EQ(inside.shading.status, Status::Fail);
+  EXPECT_EQ(inside.shading.over_fail, 1u);
+  EXPECT_EQ(inside.shading.worst.x, 12);
+  EXPECT_EQ(inside.shading.worst.y, 4);
+}
+
 }  // namespace
 }  // namespace rc
