@@ -93,7 +93,7 @@ std::string createContext(const rc::GlSpec& spec) {
   ctx->makeCurrent();
   rc::gl::Functions gl;
   gl.load(ctx->loader());
-  const std::string renderer = reinterpret_cast<const char*>(gl.GetString(GL_RENDERER));
+  std::string renderer = reinterpret_cast<const char*>(gl.GetString(GL_RENDERER));
   ctx->release();
   return renderer;
 }

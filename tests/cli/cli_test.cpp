@@ -149,7 +149,7 @@ int occurrences(const std::string& text, const std::string& what) {
 // Renders `fixture` with `backend` into dir/name and returns the folder.
 fs::path renderTo(const fs::path& dir, const std::string& name, const std::string& fixture,
                   const std::string& backend) {
-  const fs::path out = dir / name;
+  fs::path out = dir / name;
   const Result r = run("render " + fixture + " --backend " + backend + " --out " + out.string());
   EXPECT_EQ(r.code, 0) << r.out;
   return out;

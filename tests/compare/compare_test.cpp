@@ -521,7 +521,9 @@ void expectSameResults(const PairResult& fast, const PairResult& general) {
 class FastPathTest : public ::testing::TestWithParam<std::tuple<DepthFormat, ColorFormat>> {};
 
 TEST_P(FastPathTest, VectorAndGeneralPathsAgree) {
-  const auto [depth_format, color_format] = GetParam();
+  // Plain variables, not a structured binding: the lambda below captures them.
+  const DepthFormat depth_format = std::get<0>(GetParam());
+  const ColorFormat color_format = std::get<1>(GetParam());
   constexpr int kOddW = 251;
   constexpr int kOddH = 97;
   Frame ref = testing::renderRects(kOddW, kOddH, testing::defaultRects(kOddW, kOddH));

@@ -312,7 +312,7 @@ TEST_F(ReportTest, ImagesShowTheClassesAndDiffExrHoldsTheNumbers) {
   auto visibility = OIIO::ImageInput::open(fail.images.at("visibility").string());
   ASSERT_TRUE(visibility);
   EXPECT_EQ(visibility->spec().width, kW);
-  std::vector<std::uint8_t> rgb(kW * kH * 3);
+  std::vector<std::uint8_t> rgb(static_cast<std::size_t>(kW) * kH * 3);
   ASSERT_TRUE(visibility->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data()));
   const std::size_t in_block = static_cast<std::size_t>(kBy0) * kW + kBx0;
   const Rgb8 hard = classColor(PixelClass::MissingHard);
