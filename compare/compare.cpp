@@ -605,17 +605,82 @@ class Comparator {
     for (int c = 0; c < 4; ++c) {
       const double m = std::max(std::fabs(pa[c]), std::fabs(pb[c]));
       const double allow = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
-                           (tol_.texture_weight_error + tol_.texel_choice) * around.range[c] +
+                           tol_.texture_weight_error * around.range[c] +
                            tol_.texture_rounding_units * std::max(1.0, m);
       out.allowances[c] = allow;
-      const double excess = d[c] - allow;
+    }
+    // Nearest texture filtering: at a texel edge either texel may be sampled. Magnified,
+    // the other texel is what the reference shows at an adjacent pixel; minified, it is
+    // within the colour range around the pixel, and such a pixel stands alone (a fault
+    // that shifts a region's colour moves its neighbours too).
+    if (neighbourhood && tol_.texel_choice > 0.0) {
+      if (otherTexel(x, y, pb, out.allowances)) {
+        for (int c = 0; c < 4; ++c) out.allowances[c] = std::max<double>(out.allowances[c], d[c]);
+      } else if (aloneInItsNeighbourhood(x, y)) {
+        for (int c = 0; c < 4; ++c)
+          out.allowances[c] += tol_.texel_choice * static_cast<double>(around.range[c]);
+      }
+    }
+    for (int c = 0; c < 4; ++c) {
+      const double excess = d[c] - out.allowances[c];
       if (excess > out.excess) {
         out.excess = excess;
         out.channel = c;
-        out.allowance = allow;
+        out.allowance = out.allowances[c];
       }
     }
     return out;
+  }
+
+  // Whether `actual` (the pixel's colour on the actual side) is, within texel_choice units
+  // plus the pixel's own allowances and the warn level, the expected colour of a drawn
+  // 8-neighbour that differs from the expected colour here by more than twice that in
+  // some channel: a texel edge the two sides sampled on different sides of
+  // (docs/tolerances.md, shading (e)).
+  // Whether no 8-neighbour showing the same primitive on both sides differs by more than
+  // warn plus the relative allowance (the neighbour-free part of its allowance).
+  bool aloneInItsNeighbourhood(int x, int y) const {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nx = x + dx;
+        const int ny = y + dy;
+        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= e_.width || ny >= e_.height) continue;
+        const std::size_t j = e_.index(nx, ny);
+        if (e_.id[j] == 0 || e_.id[j] != a_.id[j]) continue;
+        const float* ca = &e_.color[j * 4];
+        const float* cb = &a_.color[j * 4];
+        for (int c = 0; c < 4; ++c) {
+          const double m = std::max(std::fabs(ca[c]), std::fabs(cb[c]));
+          if (!(colorError(ca[c], cb[c]) <= tol_.shading.warn + shade_relative_units_ * m))
+            return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  bool otherTexel(int x, int y, const float* actual, const std::array<double, 4>& allow) const {
+    const float* here = &e_.color[e_.index(x, y) * 4];
+    std::array<double, 4> slack{};
+    for (int c = 0; c < 4; ++c) slack[c] = tol_.texel_choice + allow[c] + tol_.shading.warn;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nx = x + dx;
+        const int ny = y + dy;
+        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= e_.width || ny >= e_.height) continue;
+        const std::size_t j = e_.index(nx, ny);
+        if (e_.id[j] == 0) continue;
+        const float* there = &e_.color[j * 4];
+        bool matches = true;
+        bool edge = false;
+        for (int c = 0; c < 4; ++c) {
+          matches = matches && colorError(actual[c], there[c]) <= slack[c];
+          edge = edge || colorError(here[c], there[c]) > 2.0 * slack[c];
+        }
+        if (matches && edge) return true;
+      }
+    }
+    return false;
   }
 
   // The pixel's largest channel error is over warn: check it against its allowance.
@@ -624,7 +689,12 @@ class Comparator {
     // The terms without neighbours are a lower bound of the allowance: often enough.
     if (!maps_ && shadingExcess(x, y, i, d, false).excess <= warn) return;
     const ShadingExcess s = shadingExcess(x, y, i, d, true);
-    if (maps_) maps_->shading_tolerance[i] = static_cast<float>(warn + s.allowance);
+    if (maps_) {
+      // The threshold the pixel's largest channel error is held to: exceeding it by k is
+      // exceeding warn by k in the deciding channel (the channels' allowances differ).
+      const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
+      maps_->shading_tolerance[i] = static_cast<float>(warn + (e - s.excess));
+    }
     if (s.excess <= warn) return;
     ++r_.shading.over_tolerance;
     if (s.excess > tol_.shading.fail) ++r_.shading.over_fail;

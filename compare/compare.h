@@ -152,10 +152,12 @@ struct ClassMaps {
   int width = 0;
   int height = 0;
   std::vector<PixelClass> pixel_class;
-  std::vector<float> depth_steps;        // |dZ| in steps where compared (NaN: non-finite), else 0
-  std::vector<float> depth_tolerance;    // warn + slope allowance where compared, else 0
-  std::vector<float> shading_abs;        // largest channel error where compared (NaN: non-finite)
-  std::vector<float> shading_tolerance;  // warn + allowance of the deciding channel, else 0
+  std::vector<float> depth_steps;      // |dZ| in steps where compared (NaN: non-finite), else 0
+  std::vector<float> depth_tolerance;  // warn + slope allowance where compared, else 0
+  std::vector<float> shading_abs;      // largest channel error where compared (NaN: non-finite)
+  // Where shading_abs exceeds warn: the threshold it is held to (warn + its largest
+  // channel error - that pixel's largest channel excess over its allowance), else 0.
+  std::vector<float> shading_tolerance;
 };
 
 // Compares `actual` with `expected`. `uncertainty` is the reference frame whose

@@ -91,8 +91,10 @@ std::string shadingAllowanceText(const Tolerances& t, double slope_band_px) {
     s += fmt::format(" + {:.3g} x 3x3 range + {:.3g} x max(1, |C|) (linear texture filtering)",
                      t.texture_weight_error, t.texture_rounding_units);
   if (t.texel_choice > 0.0)
-    s += fmt::format(" + {:.3g} x 3x3 range (nearest texture filtering: either texel at an edge)",
-                     t.texel_choice);
+    s += fmt::format(
+        "; nearest texture filtering: an adjacent pixel's colour (+/- {:.3g}) across a "
+        "texel edge, or + {:.3g} x 3x3 range where the neighbours agree",
+        t.texel_choice, t.texel_choice);
   return s;
 }
 

@@ -43,8 +43,11 @@ struct Tolerances {
   //   + shading_slope_factor * G * band       attribute planes of snapped vertices
   //   + texture_weight_error * R              linear filtering: quantised bilinear weights
   //   + texture_rounding_units * max(1, M)    linear filtering: the 8-bit filtered texel
-  //   + texel_choice * R                      nearest filtering: either texel at an edge
-  // (the texture terms are 0 unless a textured material is drawn with that filter).
+  // (the texture terms are 0 unless a textured material is filtered linearly). With nearest
+  // filtering (texel_choice > 0), where either texel may be sampled at a texel edge: a
+  // pixel whose actual colour is, within texel_choice units plus that allowance and warn,
+  // the expected colour of an adjacent pixel across a texel edge is allowed its whole
+  // error; else a pixel whose neighbours all agree gets texel_choice * R more.
   double shading_relative = 0.0;
   double shading_slope_factor = 1.0;
   double texture_weight_error = 0.0;
@@ -76,7 +79,8 @@ inline constexpr double kTextureWeightError = 2.0 / 256.0;
 // The filtered texel kept as an 8-bit value: up to one step, times the light on it.
 inline constexpr double kTextureRoundingUnits = 1.0;
 // Nearest filtering: a texture coordinate within float32 rounding of a texel edge selects
-// either texel, and both colours lie in the 3x3 neighbourhood's range.
+// either texel; the other texel is what the reference shows next door. Units of slack
+// when matching the actual colour to a neighbour's (lighting varies across one pixel).
 inline constexpr double kTexelChoice = 1.0;
 
 // Replaces the thresholds the overrides set. A lone warn above the current fail (or a

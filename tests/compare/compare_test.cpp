@@ -613,10 +613,10 @@ TEST(CompareEdgeCases, DegenerateFramesNeverCrash) {
 }
 
 // Nearest texture filtering: at a texel edge the driver may take the texel on the other
-// side (float32 texture coordinates within rounding of the edge). That colour is in the
-// pixel's 3x3 neighbourhood, so it passes when the frames say nearest-filtered textures
-// were drawn; the same change fails without that, and a colour no neighbour has fails
-// either way.
+// side (float32 texture coordinates within rounding of the edge). That colour is what
+// the reference shows next door, so it passes when the frames say nearest-filtered
+// textures were drawn; the same change fails without that, and a colour no neighbour
+// has fails either way, also right at the edge.
 TEST(TexelChoice, TheNeighbouringTexelPassesOnlyForNearestTextures) {
   testing::Rect r;
   r.x0 = 0;
@@ -651,6 +651,31 @@ TEST(TexelChoice, TheNeighbouringTexelPassesOnlyForNearestTextures) {
   EXPECT_EQ(inside.shading.over_fail, 1u);
   EXPECT_EQ(inside.shading.worst.x, 12);
   EXPECT_EQ(inside.shading.worst.y, 4);
+
+  // An injected offset of 10 units on a 4x4 block across the texel edge: every pixel of
+  // the block fails, the flipped pixel still passes.
+  gl = ref;
+  gl.edge_dist.clear();
+  gl.depth_gap.clear();
+  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 4) * 4 + c] = 0.2f;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 6; x < 10; ++x) gl.color[gl.index(x, y) * 4] += 10.0f / 255.0f;
+  const PairResult block = compareWith("nearest", true);
+  EXPECT_EQ(block.shading.over_fail, 16u);
+  EXPECT_EQ(block.visibility.mismatched, 0u);
+  EXPECT_EQ(block.depth.over_tolerance, 0u);
+
+  // Minified textures: the other texel is no neighbour's colour but lies within the
+  // range around the pixel. Alone at an edge it passes; the same change on two adjacent
+  // pixels (a region moved, not one sample) fails on both.
+  gl = ref;
+  gl.edge_dist.clear();
+  gl.depth_gap.clear();
+  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 2) * 4 + c] = 0.3f;
+  EXPECT_EQ(compareWith("nearest", true).shading.status, Status::Pass);
+  EXPECT_EQ(compareWith("nearest", false).shading.status, Status::Fail);
+  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 3) * 4 + c] = 0.3f;
+  EXPECT_EQ(compareWith("nearest", true).shading.over_fail, 2u);
 }
 
 }  // namespace
