@@ -632,55 +632,43 @@ class Comparator {
     return out;
   }
 
+  // Whether no 8-neighbour showing the same primitive on both sides differs by more than
+  // warn plus the relative allowance (the neighbour-free part of its allowance).
+  bool aloneInItsNeighbourhood(int x, int y) const {
+    return detail::forEachNeighbour(e_, x, y, [&](std::size_t j, int, int) {
+      if (e_.id[j] == 0 || e_.id[j] != a_.id[j]) return true;
+      const float* ca = &e_.color[j * 4];
+      const float* cb = &a_.color[j * 4];
+      for (int c = 0; c < 4; ++c) {
+        const double m = std::max(std::fabs(ca[c]), std::fabs(cb[c]));
+        if (!(colorError(ca[c], cb[c]) <= tol_.shading.warn + shade_relative_units_ * m))
+          return false;
+      }
+      return true;
+    });
+  }
+
   // Whether `actual` (the pixel's colour on the actual side) is, within texel_choice units
   // plus the pixel's own allowances and the warn level, the expected colour of a drawn
   // 8-neighbour that differs from the expected colour here by more than twice that in
   // some channel: a texel edge the two sides sampled on different sides of
   // (docs/tolerances.md, shading (e)).
-  // Whether no 8-neighbour showing the same primitive on both sides differs by more than
-  // warn plus the relative allowance (the neighbour-free part of its allowance).
-  bool aloneInItsNeighbourhood(int x, int y) const {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int nx = x + dx;
-        const int ny = y + dy;
-        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= e_.width || ny >= e_.height) continue;
-        const std::size_t j = e_.index(nx, ny);
-        if (e_.id[j] == 0 || e_.id[j] != a_.id[j]) continue;
-        const float* ca = &e_.color[j * 4];
-        const float* cb = &a_.color[j * 4];
-        for (int c = 0; c < 4; ++c) {
-          const double m = std::max(std::fabs(ca[c]), std::fabs(cb[c]));
-          if (!(colorError(ca[c], cb[c]) <= tol_.shading.warn + shade_relative_units_ * m))
-            return false;
-        }
-      }
-    }
-    return true;
-  }
-
   bool otherTexel(int x, int y, const float* actual, const std::array<double, 4>& allow) const {
     const float* here = &e_.color[e_.index(x, y) * 4];
     std::array<double, 4> slack{};
     for (int c = 0; c < 4; ++c) slack[c] = tol_.texel_choice + allow[c] + tol_.shading.warn;
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int nx = x + dx;
-        const int ny = y + dy;
-        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= e_.width || ny >= e_.height) continue;
-        const std::size_t j = e_.index(nx, ny);
-        if (e_.id[j] == 0) continue;
-        const float* there = &e_.color[j * 4];
-        bool matches = true;
-        bool edge = false;
-        for (int c = 0; c < 4; ++c) {
-          matches = matches && colorError(actual[c], there[c]) <= slack[c];
-          edge = edge || colorError(here[c], there[c]) > 2.0 * slack[c];
-        }
-        if (matches && edge) return true;
+    // Searching stops (forEachNeighbour returns false) at the first matching neighbour.
+    return !detail::forEachNeighbour(e_, x, y, [&](std::size_t j, int, int) {
+      if (e_.id[j] == 0) return true;
+      const float* there = &e_.color[j * 4];
+      bool matches = true;
+      bool edge = false;
+      for (int c = 0; c < 4; ++c) {
+        matches = matches && colorError(actual[c], there[c]) <= slack[c];
+        edge = edge || colorError(here[c], there[c]) > 2.0 * slack[c];
       }
-    }
-    return false;
+      return !(matches && edge);
+    });
   }
 
   // The pixel's largest channel error is over warn: check it against its allowance.

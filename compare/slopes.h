@@ -77,4 +77,19 @@ struct ColourNeighbourhood {
 };
 ColourNeighbourhood colourNeighbourhood(const Frame& f, int x, int y);
 
+// Calls fn(index, dx, dy) for each of the up to 8 neighbours of (x, y) inside the frame,
+// row by row; stops early and returns false when fn returns false.
+template <class Fn>
+bool forEachNeighbour(const Frame& f, int x, int y, Fn&& fn) {
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = x + dx;
+      const int ny = y + dy;
+      if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= f.width || ny >= f.height) continue;
+      if (!fn(f.index(nx, ny), dx, dy)) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace rc::detail
