@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "app/paths.h"
-#include "compare/compare.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 
@@ -39,7 +38,7 @@ Job renderJob(const fs::path& scene_file, const std::string& spec, const fs::pat
              log};
 }
 
-std::string childFailure(const Job& job) {
+std::string childFailure(const Job& job, const std::vector<std::string>& also_strip) {
   std::ifstream in(job.log);
   std::string line;
   std::string last;
@@ -50,6 +49,9 @@ std::string childFailure(const Job& job) {
        {"rastercheck: backend error: ", "rastercheck: error: ", "rastercheck: internal error: "}) {
     if (last.rfind(prefix, 0) == 0) last = last.substr(std::string(prefix).size());
   }
+  for (const std::string& prefix : also_strip) {
+    if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
+  }
   if (!job.signal_name.empty())
     return fmt::format("crashed ({}){}", job.signal_name, last.empty() ? "" : ": " + last);
   return last.empty() ? fmt::format("exited with code {}", job.exit_code) : last;
@@ -57,8 +59,7 @@ std::string childFailure(const Job& job) {
 
 Frame renderInChild(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {
   std::vector<Job> jobs{renderJob(scene_file, spec, out_dir)};
-  runJobs(
-      jobs, 1, [](std::size_t) {}, [](std::size_t) {});
+  runJobs(jobs, 1);
   if (jobs[0].exit_code != 0) {
     const std::string why = childFailure(jobs[0]);
     // The child's own message usually names the spec already.

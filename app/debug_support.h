@@ -1,16 +1,16 @@
 // What `explain`, `reduce` and the variant probes share: scratch folders, rendering a
 // fixture file with a backend in a child process (`rastercheck render`, as `run` does,
-// so a driver crash costs one render and each child picks its own GL driver), and the
-// tolerances `compare` would use for a pair.
+// so a driver crash costs one render and each child picks its own GL driver), and why
+// such a child failed.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "app/backends.h"
 #include "app/subprocess.h"
-#include "compare/tolerances.h"
 #include "fixtures/frame.h"
 #include "fixtures/scene.h"
 
@@ -35,8 +35,9 @@ Job renderJob(const std::filesystem::path& scene_file, const std::string& spec,
               const std::filesystem::path& out_dir);
 
 // Why a finished job failed, in one line: the child's last error line without our
-// prefixes, or how it died.
-std::string childFailure(const Job& job);
+// prefixes (and then without `also_strip`, e.g. the "<fixture>: <spec>: " a report row
+// already names), or how it died.
+std::string childFailure(const Job& job, const std::vector<std::string>& also_strip = {});
 
 // Renders in a child process and reads the frame back. Throws BackendError (one line,
 // naming the spec) when the child fails.

@@ -18,6 +18,7 @@
 
 #include "app/backends.h"
 #include "app/commands.h"
+#include "app/debug_support.h"
 #include "app/paths.h"
 #include "app/report_support.h"
 #include "app/subprocess.h"
@@ -40,25 +41,6 @@ struct FixtureEntry {
   ToleranceOverrides tolerance;
 };
 
-// The last meaningful line a failed child printed, without our own prefixes and without
-// the "<fixture>: <spec>: " the render command puts in front (the report row names both).
-std::string childError(const Job& job, const std::string& fixture, const std::string& spec) {
-  std::ifstream in(job.log);
-  std::string line;
-  std::string last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  for (const std::string& prefix :
-       {std::string("rastercheck: backend error: "), std::string("rastercheck: error: "),
-        std::string("rastercheck: internal error: "), fixture + ": ", spec + ": "}) {
-    if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
-  }
-  if (!job.signal_name.empty())
-    return fmt::format("crashed ({}){}", job.signal_name, last.empty() ? "" : ": " + last);
-  return last.empty() ? fmt::format("exited with code {}", job.exit_code) : last;
-}
-
 // One status line on a terminal, redrawn in place; nothing when stderr is not a tty.
 class Progress {
  public:
@@ -80,20 +62,6 @@ class Progress {
   bool tty_;
   std::size_t width_ = 0;
 };
-
-// The tolerances each pair of this fixture will use, computed now so that a malformed
-// block or a warn above fail stops the run before anything is rendered.
-void checkTolerances(const Scene& scene, const CommandLineTolerances& cli) {
-  try {
-    DrawnWith drawn;
-    drawn.linear_textures = scene.state.texture_filter == TextureFilter::Linear;
-    Tolerances t = defaultTolerances(scene.state.depth_format, scene.state.color_format, drawn);
-    applyOverrides(t, scene.tolerance);
-    applyOverrides(t, cli);
-  } catch (const InputError& e) {
-    throw InputError(fmt::format("{}: {}", scene.source.string(), e.what()));
-  }
-}
 
 }  // namespace
 
@@ -126,7 +94,6 @@ int runCommand(const RunArgs& args) {
   std::set<std::string> slugs;
   for (const fs::path& file : findFixtures(inputs)) {
     const Scene scene = loadScene(file);
-    checkTolerances(scene, cli);
     std::string slug = fixtureSlug(scene.name);
     for (int k = 2; !slugs.insert(slug).second; ++k)
       slug = fixtureSlug(scene.name) + "~" + std::to_string(k);
@@ -136,21 +103,15 @@ int runCommand(const RunArgs& args) {
 
   ReportFolder folder(args.out);
   const fs::path frames_dir = folder.staging() / "frames";
-  const std::string self = selfExecutable().string();
-  std::vector<Job> jobs;
-  std::vector<std::size_t> fixture_of;  // per job
+  std::vector<Job> jobs;  // fixture-major: job i renders fixture i / N with spec i % N
   std::map<std::pair<std::size_t, std::string>, std::size_t> job_of;
   for (std::size_t f = 0; f < fixtures.size(); ++f) {
     const fs::path dir = frames_dir / fixtures[f].slug;
     fs::create_directories(dir, ec);
     if (ec) throw InputError(fmt::format("{}: cannot create: {}", dir.string(), ec.message()));
     for (const std::string& spec : render_specs) {
-      const fs::path out = dir / fixtureSlug(spec);
       job_of[{f, spec}] = jobs.size();
-      fixture_of.push_back(f);
-      jobs.push_back(
-          Job{{self, "render", fixtures[f].file.string(), "--backend", spec, "--out", out.string()},
-              dir / (fixtureSlug(spec) + ".log")});
+      jobs.push_back(renderJob(fixtures[f].file, spec, dir / fixtureSlug(spec)));
     }
   }
 
@@ -175,11 +136,11 @@ int runCommand(const RunArgs& args) {
   runJobs(
       jobs, parallel,
       [&](std::size_t i) {
-        running[fixture_of[i]].insert(render_specs[i % render_specs.size()]);
+        running[i / render_specs.size()].insert(render_specs[i % render_specs.size()]);
         showRender();
       },
       [&](std::size_t i) {
-        const std::size_t f = fixture_of[i];
+        const std::size_t f = i / render_specs.size();
         running[f].erase(render_specs[i % render_specs.size()]);
         --left[f];
         showRender();
@@ -213,12 +174,13 @@ int runCommand(const RunArgs& args) {
       if (against_job.exit_code != 0) {
         report.results.push_back(
             errorResult(fx.name, against.text, b.text,
-                        against.text + ": " + childError(against_job, fx.name, against.text)));
+                        against.text + ": " +
+                            childFailure(against_job, {fx.name + ": ", against.text + ": "})));
         continue;
       }
       if (job.exit_code != 0) {
-        report.results.push_back(
-            errorResult(fx.name, against.text, b.text, childError(job, fx.name, b.text)));
+        report.results.push_back(errorResult(fx.name, against.text, b.text,
+                                             childFailure(job, {fx.name + ": ", b.text + ": "})));
         continue;
       }
       try {

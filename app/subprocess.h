@@ -19,7 +19,8 @@ struct Job {
 // Runs the jobs in order, at most `parallel` at a time, calling on_start(index) as each
 // starts and on_done(index) as each finishes (from the calling thread; either may be
 // empty). Throws BackendError when a child cannot be started.
-void runJobs(std::vector<Job>& jobs, int parallel, const std::function<void(std::size_t)>& on_start,
-             const std::function<void(std::size_t)>& on_done);
+void runJobs(std::vector<Job>& jobs, int parallel,
+             const std::function<void(std::size_t)>& on_start = {},
+             const std::function<void(std::size_t)>& on_done = {});
 
 }  // namespace rc

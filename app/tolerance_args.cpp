@@ -53,6 +53,9 @@ void parseToleranceArgs(const std::vector<std::string>& args, CommandLineToleran
       throw InputError(fmt::format("--tolerance {}: unknown class or key (keys: {})", arg, kKeys));
     }
   }
+  // A warn above its fail is refused now, before any command renders or reads anything.
+  Tolerances check;
+  applyOverrides(check, out);
 }
 
 }  // namespace rc

@@ -57,8 +57,7 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
       jobs.push_back(renderJob(file, spec, dir / name));
     }
   }
-  runJobs(
-      jobs, parallel, [](std::size_t) {}, [](std::size_t) {});
+  runJobs(jobs, parallel);
 
   // ref:subpixel=N for every candidate N, once for all backends.
   std::map<int, Frame> reference;

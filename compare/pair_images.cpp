@@ -17,6 +17,7 @@
 
 #include "compare/atomic_file.h"
 #include "fixtures/errors.h"
+#include "fixtures/frame_io.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -69,26 +70,16 @@ inline std::uint8_t toByte(float v) {
   return static_cast<std::uint8_t>(roundHalfUp(v));
 }
 
-// The frame's colour as people see it: clamped to [0, 1], rounded, NaN as black (as
-// render's color.png, but from the frame that was compared).
-std::vector<std::uint8_t> colorRgb8(const Frame& frame) {
-  const std::size_t n = frame.pixelCount();
-  std::vector<std::uint8_t> rgb(n * 3);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = toByte(frame.color[i * 4 + c] * 255.0f);
-  return rgb;
-}
-
 // The picture of one frame: a link to (or copy of) a ready-made one, else encoded.
-void writePicture(const Frame& frame, const fs::path& ready, const fs::path& file,
-                  const fs::path& target) {
+void writePicture(const Frame& frame, const fs::path& ready, const fs::path& file) {
   if (!ready.empty()) {
     std::error_code ec;
     fs::create_hard_link(ready, file, ec);
     if (!ec) return;
     if (fs::copy_file(ready, file, fs::copy_options::overwrite_existing, ec)) return;
   }
-  writeRgb8(file, frame.width, frame.height, colorRgb8(frame), target);
+  // Encoded as render's color.png is, from the frame that was compared.
+  writeColorPng(frame, file, FrameEncoding{"none", kPngCompressionLevel, kPngFilterSub});
 }
 
 float luminance(const float* c) {
@@ -290,8 +281,8 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
   heatLut();  // built once, before the threads that share it
 
   runAll({
-      [&] { writePicture(expected, pictures.expected, tmp_expected, expected_png); },
-      [&] { writePicture(actual, pictures.actual, tmp_actual, actual_png); },
+      [&] { writePicture(expected, pictures.expected, tmp_expected); },
+      [&] { writePicture(actual, pictures.actual, tmp_actual); },
       [&] {
         // Visibility: classes in colour over a dim copy of the expected image for context.
         std::vector<std::uint8_t> vis(n * 3);

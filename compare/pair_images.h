@@ -32,11 +32,6 @@ std::vector<Rgb8> heatColorStops(int count);
 // [0, 1]. Log-scaled so that one-step errors stay visible next to large ones.
 float heatPosition(float value, double scale);
 
-// Writes into `dir` (created if needed), all files concurrently: expected.png, actual.png,
-// visibility.png, depth_heat.png, shading_heat.png and diff.exr (float channels id_class,
-// depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG, dB, dA; see
-// docs/reports.md), and records them in result.images and the heat scales in result.
-// Throws InputError when a file cannot be written; then none of them is left behind.
 // A digest of a frame's size and colour buffer (16 hex digits). `render` records it in
 // frame.json ("color_digest"), so that a reader can tell whether the folder's color.png
 // still shows the colour in frame.exr.
@@ -49,6 +44,12 @@ struct PairPictures {
   std::filesystem::path expected;
   std::filesystem::path actual;
 };
+
+// Writes into `dir` (created if needed), all files concurrently: expected.png, actual.png,
+// visibility.png, depth_heat.png, shading_heat.png and diff.exr (float channels id_class,
+// depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG, dB, dA; see
+// docs/reports.md), and records them in result.images and the heat scales in result.
+// Throws InputError when a file cannot be written; then none of them is left behind.
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
                      const std::filesystem::path& dir, PairResult& result,
                      const PairPictures& pictures = {});

@@ -47,17 +47,12 @@ std::optional<double> surfaceDepthSlope(const Frame& u, const DepthScale& scale,
   if (u.id[i] == 0 || !finite(u.depth[i])) return std::nullopt;
   const double z0 = scale(u.depth[i]);
   std::optional<double> s;
-  for (int dy = -1; dy <= 1; ++dy) {
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int nx = x + dx;
-      const int ny = y + dy;
-      if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= u.width || ny >= u.height) continue;
-      const std::size_t j = u.index(nx, ny);
-      if (u.id[j] == 0 || !finite(u.depth[j])) continue;
-      const double dist = dx != 0 && dy != 0 ? kDiagonal : 1.0;
-      s = std::max(s.value_or(0.0), std::fabs(scale(u.depth[j]) - z0) / dist);
-    }
-  }
+  forEachNeighbour(u, x, y, [&](std::size_t j, int dx, int dy) {
+    if (u.id[j] == 0 || !finite(u.depth[j])) return true;
+    const double dist = dx != 0 && dy != 0 ? kDiagonal : 1.0;
+    s = std::max(s.value_or(0.0), std::fabs(scale(u.depth[j]) - z0) / dist);
+    return true;
+  });
   return s;
 }
 
@@ -177,28 +172,23 @@ ColourNeighbourhood colourNeighbourhood(const Frame& f, int x, int y) {
   std::array<float, 4> same{};  // gradient to same-primitive 4-neighbours
   std::array<float, 4> any{};   // gradient to any drawn 8-neighbour
   bool found_same = false;
-  for (int dy = -1; dy <= 1; ++dy) {
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int nx = x + dx;
-      const int ny = y + dy;
-      if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= f.width || ny >= f.height) continue;
-      const std::size_t j = f.index(nx, ny);
-      if (f.id[j] == 0) continue;
-      const float* n = &f.color[j * 4];
-      if (!finite(n[0]) || !finite(n[1]) || !finite(n[2]) || !finite(n[3])) continue;
-      const bool diagonal = dx != 0 && dy != 0;
-      const bool same_4 = !diagonal && f.id[j] == f.id[i];
-      found_same = found_same || same_4;
-      const float inv_dist = diagonal ? 1.0f / 1.41421356f : 1.0f;
-      for (int k = 0; k < 4; ++k) {
-        const float diff = std::fabs(n[k] - c[k]) * 255.0f;
-        if (same_4) same[k] = std::max(same[k], diff);
-        any[k] = std::max(any[k], diff * inv_dist);
-        lo[k] = std::min(lo[k], n[k]);
-        hi[k] = std::max(hi[k], n[k]);
-      }
+  forEachNeighbour(f, x, y, [&](std::size_t j, int dx, int dy) {
+    if (f.id[j] == 0) return true;
+    const float* n = &f.color[j * 4];
+    if (!finite(n[0]) || !finite(n[1]) || !finite(n[2]) || !finite(n[3])) return true;
+    const bool diagonal = dx != 0 && dy != 0;
+    const bool same_4 = !diagonal && f.id[j] == f.id[i];
+    found_same = found_same || same_4;
+    const float inv_dist = diagonal ? 1.0f / 1.41421356f : 1.0f;
+    for (int k = 0; k < 4; ++k) {
+      const float diff = std::fabs(n[k] - c[k]) * 255.0f;
+      if (same_4) same[k] = std::max(same[k], diff);
+      any[k] = std::max(any[k], diff * inv_dist);
+      lo[k] = std::min(lo[k], n[k]);
+      hi[k] = std::max(hi[k], n[k]);
     }
-  }
+    return true;
+  });
   out.gradient = found_same ? same : any;
   for (int k = 0; k < 4; ++k) out.range[k] = (hi[k] - lo[k]) * 255.0f;
   return out;

@@ -113,19 +113,6 @@ void applyOverrides(Tolerances& tolerances, const CommandLineTolerances& overrid
   if (x.band_px) tolerances.band_px = *x.band_px;
 }
 
-nlohmann::json toleranceJson(const ToleranceOverrides& o) {
-  nlohmann::json j = nlohmann::json::object();
-  auto pair = [&](const char* cls, const ClassThresholds& t) {
-    if (t.warn) j[cls]["warn"] = *t.warn;
-    if (t.fail) j[cls]["fail"] = *t.fail;
-  };
-  pair("visibility", o.visibility);
-  pair("depth", o.depth);
-  pair("shading", o.shading);
-  if (o.depth_slope_factor) j["depth"]["slope_factor"] = *o.depth_slope_factor;
-  return j;
-}
-
 ToleranceOverrides toleranceFromJson(const nlohmann::json& j, const std::string& source) {
   auto bad = [&](const std::string& path, const std::string& what) {
     return InputError(fmt::format("{}: tolerance{}: {}", source, path, what));

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fixtures/scene.h"
+#include "fixtures/scene_writer.h"
 
 namespace rc {
 
@@ -88,10 +89,9 @@ inline constexpr double kTexelChoice = 1.0;
 // both are given, or a negative or non-finite value, throws InputError.
 void applyOverrides(Tolerances& tolerances, const ToleranceOverrides& overrides);
 
-// A fixture's "tolerance" block as JSON in the fixture's own shape (only the keys it
-// sets), as `render` records it in frame.json, and back. Reading throws InputError naming
-// `source` and the key for anything that is not a finite number >= 0.
-nlohmann::json toleranceJson(const ToleranceOverrides& overrides);
+// A fixture's "tolerance" block back from frame.json, where `render` records it with
+// toleranceJson() (fixtures/scene_writer.h). Throws InputError naming `source` and the key
+// for anything that is not a finite number >= 0.
 ToleranceOverrides toleranceFromJson(const nlohmann::json& j, const std::string& source);
 
 // What the command line can set beyond a fixture's "tolerance" block (--tolerance

@@ -38,11 +38,6 @@ bool TriangleCoverage::covers(int px, int py) const {
   return true;
 }
 
-bool TriangleCoverage::rowSpan(int py, int& x_begin, int& x_end) const {
-  return col_end_ - col_begin_ <= kScanWidth ? rowSpanByScan(py, x_begin, x_end)
-                                             : rowSpanByDivision(py, x_begin, x_end);
-}
-
 bool TriangleCoverage::rowSpanByDivision(int py, int& x_begin, int& x_end) const {
   std::int64_t lo = col_begin_;
   std::int64_t hi = col_end_;  // exclusive
@@ -63,21 +58,9 @@ bool TriangleCoverage::rowSpanByDivision(int py, int& x_begin, int& x_end) const
 }
 
 bool TriangleCoverage::rowSpanByScan(int py, int& x_begin, int& x_end) const {
-  std::int64_t e[3];
-  for (int i = 0; i < 3; ++i) e[i] = edges_[i].a * col_begin_ + edges_[i].b * py + edges_[i].c;
-  int px = col_begin_;
-  while (px < col_end_ && !(e[0] > 0 && e[1] > 0 && e[2] > 0)) {
-    for (int i = 0; i < 3; ++i) e[i] += edges_[i].a;
-    ++px;
-  }
-  if (px == col_end_) return false;
-  x_begin = px;
-  while (px < col_end_ && e[0] > 0 && e[1] > 0 && e[2] > 0) {
-    for (int i = 0; i < 3; ++i) e[i] += edges_[i].a;
-    ++px;
-  }
-  x_end = px;
-  return true;
+  return scanRow(edges_[0].a * col_begin_ + edges_[0].b * py + edges_[0].c,
+                 edges_[1].a * col_begin_ + edges_[1].b * py + edges_[1].c,
+                 edges_[2].a * col_begin_ + edges_[2].b * py + edges_[2].c, x_begin, x_end);
 }
 
 }  // namespace rc::ref

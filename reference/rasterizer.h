@@ -86,24 +86,9 @@ class TriangleCoverage {
     std::int64_t r1 = e1.a * col_begin_ + e1.b * row_begin_ + e1.c;
     std::int64_t r2 = e2.a * col_begin_ + e2.b * row_begin_ + e2.c;
     for (int py = row_begin_; py < row_end_; ++py, r0 += e0.b, r1 += e1.b, r2 += e2.b) {
-      std::int64_t f0 = r0;
-      std::int64_t f1 = r1;
-      std::int64_t f2 = r2;
-      int px = col_begin_;
-      while (px < col_end_ && !(f0 > 0 && f1 > 0 && f2 > 0)) {
-        f0 += e0.a;
-        f1 += e1.a;
-        f2 += e2.a;
-        ++px;
-      }
-      const int begin = px;
-      while (px < col_end_ && f0 > 0 && f1 > 0 && f2 > 0) {
-        f0 += e0.a;
-        f1 += e1.a;
-        f2 += e2.a;
-        ++px;
-      }
-      if (px > begin) fn(py, begin, px);
+      int lo = 0;
+      int hi = 0;
+      if (scanRow(r0, r1, r2, lo, hi)) fn(py, lo, hi);
     }
   }
 
@@ -111,12 +96,36 @@ class TriangleCoverage {
   // compute faster (tests hold them equal).
   bool covers(int px, int py) const;
 
-  // Span of one row: exact integer division for wide triangles, a scan for narrow ones.
-  bool rowSpan(int py, int& x_begin, int& x_end) const;
+  // Span of one row: exact integer division (wide triangles), or a scan from col_begin_
+  // (narrow ones; forEachSpan steps the same scan from row to row).
   bool rowSpanByDivision(int py, int& x_begin, int& x_end) const;
   bool rowSpanByScan(int py, int& x_begin, int& x_end) const;
 
  private:
+  // The covered run of a row whose three edge values at (col_begin_, row) are f0..f2,
+  // stepping them by a along the row.
+  bool scanRow(std::int64_t f0, std::int64_t f1, std::int64_t f2, int& x_begin, int& x_end) const {
+    const std::int64_t a0 = edges_[0].a;
+    const std::int64_t a1 = edges_[1].a;
+    const std::int64_t a2 = edges_[2].a;
+    int px = col_begin_;
+    while (px < col_end_ && !(f0 > 0 && f1 > 0 && f2 > 0)) {
+      f0 += a0;
+      f1 += a1;
+      f2 += a2;
+      ++px;
+    }
+    x_begin = px;
+    while (px < col_end_ && f0 > 0 && f1 > 0 && f2 > 0) {
+      f0 += a0;
+      f1 += a1;
+      f2 += a2;
+      ++px;
+    }
+    x_end = px;
+    return x_end > x_begin;
+  }
+
   // Triangles at most this many pixels wide are scanned (cheaper than three 64-bit
   // divisions per row).
   static constexpr int kScanWidth = 16;

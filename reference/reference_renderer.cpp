@@ -92,19 +92,6 @@ struct TriangleContext {
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
 };
 
-// The depth key of a fragment at clamped window depth z01 (fragment_ops.h depthKey, with
-// the format fixed at compile time for the span loops).
-template <DepthFormat kFormat>
-inline std::uint32_t depthKeyOf(double z01) {
-  if constexpr (kFormat == DepthFormat::D16) {
-    return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 65535.0));
-  } else if constexpr (kFormat == DepthFormat::D24) {
-    return static_cast<std::uint32_t>(roundHalfEvenNonNegative(z01 * 16777215.0));
-  } else {
-    return std::bit_cast<std::uint32_t>(static_cast<float>(z01));
-  }
-}
-
 // Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
 // a pixel; transformed vertices: 96 bytes each, Gouraud colours: 48), kept per thread
 // between renders so that rendering many frames does not page-fault fresh memory each
@@ -463,7 +450,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       const double dx = interp.dx(px + 0.5);
       const std::size_t index = row_index + static_cast<std::size_t>(px - clip_.x0);
       const double z = clampDepth(interp.depthAt(row, dx));
-      const std::uint32_t key = depthKeyOf<kFormat>(z);
+      const std::uint32_t key = depthKey(z, kFormat);  // kFormat constant: the switch folds
       const bool pass = always || key < depth[index];
       if constexpr (kGaps) {
         if (pass) {

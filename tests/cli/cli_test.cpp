@@ -1,9 +1,7 @@
 // The rastercheck command as a user meets it: help and version, exit codes 0/1/2/3 of
 // render, compare and run, one-line errors that name the file and JSON path, no output
 // left after a failure, the closing summary and report path.
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>

@@ -2,9 +2,7 @@
 // synthetic run folder whose every number is known: the tables must show exactly those
 // numbers, tags must come from the frames' fixture files or else the catalog, and a
 // malformed report must be refused with its file and JSON path.
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -83,13 +81,6 @@ bool hasLine(const std::string& text, const std::string& line) {
   return text.find("\n" + line + "\n") != std::string::npos;
 }
 
-// Runs a shell command; returns its exit code and puts stdout+stderr in `output`.
-int run(const std::string& cmd, std::string& output) {
-  const rc::test::CommandResult r = rc::test::runShell(cmd);
-  output += r.out;
-  return r.code;
-}
-
 }  // namespace
 
 TEST(Accuracy, TablesShowTheReportsNumbers) {
@@ -154,18 +145,16 @@ TEST(Accuracy, MalformedReportsAreRefusedWithTheirPath) {
 TEST(Accuracy, CommandWritesTheFileOrExits2) {
   const fs::path root = conformance::scratchRoot() / "accuracy_cli";
   const Synthetic s = makeRun(root);
-  std::string out;
   const fs::path md = root / "accuracy.md";
-  EXPECT_EQ(run(fmt::format("'{}' accuracy '{}' --catalog '{}' --out '{}'", RC_EXE, s.run.string(),
-                            s.catalog.string(), md.string()),
-                out),
-            0)
-      << out;
+  const rc::test::CommandResult written =
+      rc::test::runShell(fmt::format("'{}' accuracy '{}' --catalog '{}' --out '{}'", RC_EXE,
+                                     s.run.string(), s.catalog.string(), md.string()));
+  EXPECT_EQ(written.code, 0) << written.out;
   std::ifstream in(md);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_TRUE(hasLine(text, "| `t/b` | fail: visibility 12 hard px at (3,4) [window 3,5] |"));
-  out.clear();
-  EXPECT_EQ(run(fmt::format("'{}' accuracy '{}'", RC_EXE, (root / "nowhere").string()), out), 2)
-      << out;
-  EXPECT_NE(out.find("report.json: cannot be read"), std::string::npos) << out;
+  const rc::test::CommandResult missing =
+      rc::test::runShell(fmt::format("'{}' accuracy '{}'", RC_EXE, (root / "nowhere").string()));
+  EXPECT_EQ(missing.code, 2) << missing.out;
+  EXPECT_NE(missing.out.find("report.json: cannot be read"), std::string::npos) << missing.out;
 }

@@ -2,10 +2,8 @@
 // validator catches each kind of mistake), the catalog covers every required tag with at
 // least 40 described fixtures, and fixtures/README.md is what
 // scripts/gen-fixture-readme.sh makes of the catalog today.
-#include <sys/wait.h>
 
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -44,13 +42,6 @@ std::string joinLines(const std::vector<std::string>& lines) {
 std::vector<std::string> errorsOf(const char* json) {
   const std::set<std::string> fixtures = {"depth/zfight_d16", "texture/checker"};
   return parseExpectations(nlohmann::json::parse(json), fixtures, knownBackends()).errors;
-}
-
-// Runs a shell command; returns its exit code and puts stdout+stderr in `output`.
-int run(const std::string& cmd, std::string& output) {
-  const rc::test::CommandResult r = rc::test::runShell(cmd);
-  output += r.out;
-  return r.code;
 }
 
 }  // namespace
@@ -135,10 +126,9 @@ TEST(Catalog, CoversEveryRequiredTagWithDescribedFixtures) {
 }
 
 TEST(Catalog, ReadmeIsCurrent) {
-  std::string output;
-  const std::string cmd = fmt::format("RASTERCHECK='{}' '{}/scripts/gen-fixture-readme.sh' --check",
-                                      RC_EXE, RC_SOURCE_DIR);
-  EXPECT_EQ(run(cmd, output), 0) << output;
+  const rc::test::CommandResult r = rc::test::runShell(fmt::format(
+      "RASTERCHECK='{}' '{}/scripts/gen-fixture-readme.sh' --check", RC_EXE, RC_SOURCE_DIR));
+  EXPECT_EQ(r.code, 0) << r.out;
 }
 
 // --- Fixture design: the scenes show what their descriptions say, with the reference.

@@ -1,12 +1,8 @@
 // See conformance_support.h.
 #include "tests/conformance/conformance_support.h"
 
-#include "tests/support/command.h"
-
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>

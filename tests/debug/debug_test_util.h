@@ -3,11 +3,9 @@
 // up to the colour, its final entry is what frame.exr holds).
 #pragma once
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>

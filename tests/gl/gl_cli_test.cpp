@@ -2,10 +2,8 @@
 // (or `rastercheck run`) meets it: a shader that does not compile and a platform that
 // is not there exit 3 with one line naming the fixture; RASTERCHECK_GL_FAULT reaches the
 // child, is recorded in frame.json and warned about once; a bad fault list exits 2.
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
@@ -80,6 +78,7 @@ bool requireGl() {
 }
 
 TEST(GlCli, ShaderCompileErrorExitsThreeNamingTheFixture) {
+  int ran = 0;  // specs whose driver started: with none, nothing was checked
   for (const std::string& spec : specs()) {
     const fs::path out = scratch("shader") / "frame";
     const Result r = run(renderArgs(spec, out), "RASTERCHECK_GL_FAULT=shader_compile_error");
@@ -88,6 +87,7 @@ TEST(GlCli, ShaderCompileErrorExitsThreeNamingTheFixture) {
       if (requireGl()) ADD_FAILURE() << "RASTERCHECK_REQUIRE_GL=1 but " << spec << ": " << r.out;
       continue;
     }
+    ++ran;
     // One warning line (a fault is injected), then the one error line.
     const std::vector<std::string> all = lines(r.out);
     const auto error = std::find_if(all.begin(), all.end(), [](const std::string& l) {
@@ -102,6 +102,7 @@ TEST(GlCli, ShaderCompileErrorExitsThreeNamingTheFixture) {
     EXPECT_FALSE(fs::exists(out)) << "no half-written output";
     fs::remove_all(out.parent_path());
   }
+  if (ran == 0) GTEST_SKIP() << "no GL driver starts here";
 }
 
 TEST(GlCli, UnavailablePlatformExitsThreeNamingTheFixture) {
@@ -135,6 +136,7 @@ TEST(GlCli, UnknownFaultExitsTwoBeforeWriting) {
 }
 
 TEST(GlCli, InjectedFaultIsRecordedAndWarnedOnce) {
+  int ran = 0;  // specs whose driver started: with none, nothing was checked
   for (const std::string& spec : specs()) {
     const fs::path dir = scratch("fault");
     const Result clean = run(renderArgs(spec, dir / "clean"));
@@ -144,6 +146,7 @@ TEST(GlCli, InjectedFaultIsRecordedAndWarnedOnce) {
       fs::remove_all(dir);
       continue;
     }
+    ++ran;
     const Result r =
         run(renderArgs(spec, dir / "faulted"), "RASTERCHECK_GL_FAULT=drop_primitive=1");
     ASSERT_EQ(r.code, 0) << spec << ": " << r.out;
@@ -169,6 +172,7 @@ TEST(GlCli, InjectedFaultIsRecordedAndWarnedOnce) {
     EXPECT_EQ(has, 0u) << spec;
     fs::remove_all(dir);
   }
+  if (ran == 0) GTEST_SKIP() << "no GL driver starts here";
 }
 
 }  // namespace

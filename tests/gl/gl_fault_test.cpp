@@ -123,7 +123,13 @@ double depthSlack(const Frame& f, int x, int y, double steps) {
   return 1.0 + 2.0 * std::ldexp(1.0, -bits) * slopeSteps(f, x, y, steps);
 }
 
-class GlFault : public GlTest {};
+class GlFault : public GlTest {
+ protected:
+  static Frame renderFaulted(const Scene& s, const Faults& f) {
+    FaultScope scope(f);
+    return render(s);
+  }
+};
 
 TEST_F(GlFault, DropPrimitiveRemovesThatTriangleOnly) {
   const Scene s = faultScene();
@@ -131,11 +137,7 @@ TEST_F(GlFault, DropPrimitiveRemovesThatTriangleOnly) {
   constexpr std::uint32_t kDropped = 3;  // the front quad's first triangle
   Faults f;
   f.drop_primitive = kDropped;
-  Frame faulted;
-  {
-    FaultScope scope(f);
-    faulted = render(s);
-  }
+  const Frame faulted = renderFaulted(s, f);
   std::size_t was_there = 0;
   for (std::size_t i = 0; i < clean.pixelCount(); ++i) {
     ASSERT_NE(faulted.id[i], kDropped) << "pixel " << i;
@@ -158,11 +160,7 @@ TEST_F(GlFault, LightScaleScalesEveryLitColour) {
   const Frame clean = render(s);
   Faults f;
   f.light_scale = 2.0;
-  Frame faulted;
-  {
-    FaultScope scope(f);
-    faulted = render(s);
-  }
+  const Frame faulted = renderFaulted(s, f);
   std::size_t lit_pixels = 0;
   for (std::size_t i = 0; i < clean.pixelCount(); ++i) {
     EXPECT_EQ(faulted.id[i], clean.id[i]);
@@ -191,11 +189,7 @@ TEST_P(GlFaultDepth, DepthBiasMovesStoredDepthByWholeSteps) {
   constexpr int kSteps = 40;
   Faults f;
   f.depth_bias_steps = kSteps;
-  Frame faulted;
-  {
-    FaultScope scope(f);
-    faulted = render(s);
-  }
+  const Frame faulted = renderFaulted(s, f);
   const int bits = depthBits(GetParam());
   const double steps = bits > 0 ? std::ldexp(1.0, bits) - 1.0 : std::ldexp(1.0, 24);
   std::size_t covered = 0, exact = 0;
@@ -233,11 +227,7 @@ TEST_F(GlFault, NoInverseTransposeChangesOnlyNonUniformlyScaledNormals) {
   {
     const Scene s = faultScene({0.3, 0.15, 0.3});
     const Frame clean = render(s);
-    Frame faulted;
-    {
-      FaultScope scope(f);
-      faulted = render(s);
-    }
+    const Frame faulted = renderFaulted(s, f);
     std::size_t changed = 0;
     for (std::size_t i = 0; i < clean.pixelCount(); ++i) {
       ASSERT_EQ(faulted.id[i], clean.id[i]);
@@ -254,11 +244,7 @@ TEST_F(GlFault, NoInverseTransposeChangesOnlyNonUniformlyScaledNormals) {
   {
     const Scene s = faultScene({0.3, 0.3, 0.3});
     const Frame clean = render(s);
-    Frame faulted;
-    {
-      FaultScope scope(f);
-      faulted = render(s);
-    }
+    const Frame faulted = renderFaulted(s, f);
     for (std::size_t i = 0; i < clean.pixelCount(); ++i) {
       ASSERT_EQ(faulted.id[i], clean.id[i]);
       EXPECT_TRUE(sameColor(faulted, clean, i, 1e-5)) << "pixel " << i;
@@ -272,11 +258,7 @@ TEST_F(GlFault, ShiftXMovesTheImageRight) {
   constexpr int kShift = 5;
   Faults f;
   f.shift_x_px = kShift;
-  Frame faulted;
-  {
-    FaultScope scope(f);
-    faulted = render(s);
-  }
+  const Frame faulted = renderFaulted(s, f);
   std::size_t covered = 0, same_depth = 0;
   double max_dz = 0.0;
   for (int y = 0; y < kSize; ++y) {
