@@ -16,7 +16,7 @@ int accuracyCommand(const AccuracyArgs& args) {
   std::vector<std::filesystem::path> catalogs = args.catalogs;
   if (catalogs.empty()) catalogs.push_back(defaultCatalogDir());
   AccuracyData data = readAccuracyRuns(args.runs, catalogs);
-  if (!args.expectations.empty()) data.known = readKnownDifferences(args.expectations);
+  if (!args.expectations.empty()) data.known = readExpectations(args.expectations);
   const std::string command = args.command.empty() ? "`rastercheck accuracy`" : args.command;
   const std::string md = accuracyMarkdown(data, command);
   if (args.out.empty()) {

@@ -89,6 +89,7 @@ Frame renderWith(const BackendSpec& backend, const Scene& scene) {
   m["textured"] = std::any_of(scene.materials.begin(), scene.materials.end(),
                               [](const Material& mat) { return mat.texture != nullptr; });
   m["tolerance"] = toleranceJson(scene.tolerance);
+  m["state"] = stateJson(scene.state);     // what expected failures are scoped by
   m["color_digest"] = colorDigest(frame);  // tells `compare` color.png shows this frame
   if (!m.contains("subpixel_bits")) m["subpixel_bits"] = backend.reference.subpixel_bits;
   m["time_ms"] = ms;

@@ -63,6 +63,9 @@ int runCli(int argc, char** argv) {
   run_cmd->add_option("--out,-o", run.out, "Report folder")->required();
   run_cmd->add_option("--tolerance,-t", run.tolerance, "As for compare; repeatable");
   run_cmd->add_option("--jobs,-j", run.jobs, "Renders at a time (default: one per core)");
+  run_cmd->add_option("--expectations", run.expectations,
+                      "Known driver differences to mark as known failures: a file, or 'none' "
+                      "(default: fixtures/expectations.json)");
   run_cmd->add_flag("!--no-variants", run.variants,
                     "Skip the variant probes (subpixel precision, tie-break, depth rounding) "
                     "of each GL backend");
@@ -109,7 +112,7 @@ int runCli(int argc, char** argv) {
   accuracy_cmd->add_option("--catalog", accuracy.catalogs,
                            "Fixture folders to find tags by name (default: the catalog)");
   accuracy_cmd->add_option("--expectations", accuracy.expectations,
-                           "Known differences to list (tests/conformance/expectations.json)");
+                           "Known differences to list (fixtures/expectations.json)");
   accuracy_cmd->add_option("--command", accuracy.command,
                            "How the document says it was made (Markdown)");
 

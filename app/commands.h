@@ -48,6 +48,9 @@ struct RunArgs {
   std::vector<std::string> tolerance;
   int jobs = 0;          // 0: one per core
   bool variants = true;  // probe each GL backend's variants (app/variants.h)
+  // Known driver differences to mark (compare/expectations.h): a file, "none", or empty
+  // for the default (defaultExpectationsFile()).
+  std::string expectations;
 };
 int runCommand(const RunArgs& args);
 

@@ -424,6 +424,22 @@ std::string story(const Json& doc) {
                                  : "",
                    doc["depth_gap"].is_null() ? std::string("none (fewer than two fragments)")
                                               : fmtNum(doc["depth_gap"]) + " steps");
+  s += fmt::format("  depth_slope {} steps/px, gap_slope {} steps/px\n", fmtNum(doc["depth_slope"]),
+                   fmtNum(doc["gap_slope"]));
+  if (doc["clear_gap"].is_number())
+    s += fmt::format(
+        "  clear_gap {} steps (slope {}): how close the pixel came to the other side of "
+        "drawn or background\n",
+        fmtNum(doc["clear_gap"]), fmtNum(doc["clear_slope"]));
+  if (doc["texel_alt"].is_number() && doc["texel_alt"].get<double>() > 0.0)
+    s += fmt::format(
+        "  texel_dist {} px: a texel boundary that close may be sampled on either side; "
+        "texel_alt {} units is the colour change the other texel makes\n",
+        fmtNum(doc["texel_dist"]), fmtNum(doc["texel_alt"]));
+  if (doc["blend_count"].is_number() && doc["blend_count"].get<double>() > 0.0)
+    s += fmt::format("  blend_count {} blended fragments, blend_gap {} steps, blend_slope {}\n",
+                     fmtNum(doc["blend_count"]), fmtNum(doc["blend_gap"]),
+                     fmtNum(doc["blend_slope"]));
   if (!doc["backends"].empty()) s += "backends:\n";
   for (const auto& [spec, b] : doc["backends"].items()) {
     if (b.contains("error")) {
@@ -575,8 +591,10 @@ int explainCommand(const ExplainArgs& args) {
                              num(frame.color[4 * i + 2]), num(frame.color[4 * i + 3])})},
       {"depth", num(frame.depth[i])},
       {"fragment", final_fragment}};
-  doc["edge_dist"] = num(frame.edge_dist[i]);
-  doc["depth_gap"] = num(frame.depth_gap[i]);
+  // Every uncertainty channel at the pixel, by its frame.exr name (edge_dist, depth_gap,
+  // depth_slope, ...).
+  for (int c = 0; c < kUncertaintyChannels; ++c)
+    doc[kUncertaintyChannelInfo[c].name] = num((*frame.uncertainty()[c])[i]);
 
   // Each backend renders its own frame (GL in a child process) and is compared with the
   // reference frame as `compare` would.

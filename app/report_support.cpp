@@ -158,6 +158,7 @@ std::string cellText(const PairResult& r) {
   if (r.status != Status::Pass)
     std::transform(status.begin(), status.end(), status.begin(),
                    [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  if (!r.known.empty()) status = "known";  // a failure an expectation covers
   return fmt::format("{:<4} v{} d{:g} s{:.3g}", status, r.visibility.hard, r.depth.max_steps,
                      r.shading.max_abs);
 }
@@ -241,10 +242,15 @@ void printSummary(const Report& report, const fs::path& out_dir, std::ostream& o
   }
   if (!report.results.empty()) os << '\n' << summaryTable(report) << '\n';
   const ReportSummary s = report.summary();
-  os << fmt::format("{} pairs: {} pass, {} warn, {} fail, {} error\n", s.total(), s.pass, s.warn,
-                    s.fail, s.error);
+  os << fmt::format("{} pairs: {} pass, {} warn, {} fail{}, {} error\n", s.total(), s.pass, s.warn,
+                    s.fail, s.known_fail ? fmt::format(" ({} known)", s.known_fail) : std::string(),
+                    s.error);
   os << "report: " << (fs::absolute(out_dir) / "report.html").lexically_normal().string() << '\n';
-  os << (s.error ? "ERROR" : s.fail ? "FAILURE" : s.warn ? "WARNING" : "PASS") << '\n';
+  os << (s.error                 ? "ERROR"
+         : s.fail > s.known_fail ? "FAILURE"
+         : s.fail || s.warn      ? "WARNING"
+                                 : "PASS")
+     << '\n';
 }
 
 }  // namespace rc

@@ -24,6 +24,7 @@
 #include "app/subprocess.h"
 #include "app/variants.h"
 #include "app/version.h"
+#include "compare/expectations.h"
 #include "compare/report.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
@@ -68,6 +69,12 @@ class Progress {
 int runCommand(const RunArgs& args) {
   CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
+  Expectations known;
+  if (args.expectations != "none") {
+    const fs::path file =
+        args.expectations.empty() ? defaultExpectationsFile() : fs::path(args.expectations);
+    if (!args.expectations.empty() || fs::exists(file)) known = readExpectations(file);
+  }
   if (args.backends.empty()) throw InputError("run: --backends needs at least one SPEC");
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));
@@ -210,6 +217,7 @@ int runCommand(const RunArgs& args) {
     }
   }
   progress.clear();
+  applyExpectations(known, report);
   folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);

@@ -316,20 +316,6 @@ AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
   return data;
 }
 
-std::vector<KnownDifference> readKnownDifferences(const fs::path& file) {
-  const json doc = readJsonFile(file);
-  const ReportReader r(file);
-  const json& list = r.member(doc, "expectations", "");
-  if (!list.is_array()) r.fail("expectations", "must be an array");
-  std::vector<KnownDifference> out;
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const std::string path = fmt::format("expectations[{}]", i);
-    out.push_back({r.text(list[i], "fixture", path), r.text(list[i], "backend", path),
-                   r.text(list[i], "class", path), r.text(list[i], "reason", path)});
-  }
-  return out;
-}
-
 std::string accuracyMarkdown(const AccuracyData& data, const std::string& command) {
   std::string md;
   auto line = [&md](const std::string& s = "") { md += s + "\n"; };
@@ -475,15 +461,21 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
   }
 
   line();
-  line("## Known differences the conformance suite expects");
+  line("## Known differences (fixtures/expectations.json)");
   line();
-  if (data.known.empty()) {
-    line("None: tests/conformance/expectations.json lists no expected failure.");
+  if (data.known.entries.empty()) {
+    line("None: fixtures/expectations.json lists no expected failure.");
   } else {
-    line("| fixture | backend | class | reason |");
-    line("|---|---|---|---|");
-    for (const KnownDifference& k : data.known)
-      line(fmt::format("| `{}` | `{}` | {} | {} |", k.fixture, k.backend, k.cls, cell(k.reason)));
+    line("| id | fixture | backend | driver version | state | class | reason |");
+    line("|---|---|---|---|---|---|---|");
+    for (const Expectation& k : data.known.entries) {
+      std::string state;
+      for (const auto& [key, value] : k.state)
+        state += fmt::format("{}{} {}", state.empty() ? "" : ", ", key, value);
+      line(fmt::format("| {} | `{}` | `{}` | {} | {} | {} | {} |", k.id, k.fixture, k.backend,
+                       k.driver_version.empty() ? "any" : "`" + k.driver_version + "`",
+                       state.empty() ? "any" : state, k.cls, cell(k.reason)));
+    }
   }
   return md;
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "compare/compare.h"
+#include "compare/expectations.h"
 #include "compare/tolerances.h"
 
 namespace rc {
@@ -54,18 +55,10 @@ struct AccuracyPair {
   std::optional<PixelRef> shading_worst;
 };
 
-// A known difference the conformance suite expects (tests/conformance/expectations.json).
-struct KnownDifference {
-  std::string fixture;
-  std::string backend;
-  std::string cls;
-  std::string reason;
-};
-
 struct AccuracyData {
   std::vector<std::string> sources;  // the run folders, as given
   std::vector<AccuracyPair> pairs;   // sorted by expected, actual, fixture
-  std::vector<KnownDifference> known;
+  Expectations known;                // fixtures/expectations.json, listed in the document
 };
 
 // Reads report.json from each run folder. A fixture's tags come from the fixture file
@@ -74,9 +67,6 @@ struct AccuracyData {
 // Throws InputError naming the file and JSON path on a missing or malformed report.
 AccuracyData readAccuracyRuns(const std::vector<std::filesystem::path>& runs,
                               const std::vector<std::filesystem::path>& catalogs);
-
-// Reads an expectations file ({"expectations": [{fixture, backend, class, reason}]}).
-std::vector<KnownDifference> readKnownDifferences(const std::filesystem::path& file);
 
 // The Markdown document. `command` (Markdown) is printed as the way to regenerate it.
 std::string accuracyMarkdown(const AccuracyData& data, const std::string& command);

@@ -58,10 +58,12 @@ void checkBuffers(const Frame& f, const char* role, bool need_color) {
   if ((need_color && f.color.size() != n * 4) || f.depth.size() != n || f.id.size() != n)
     throw InputError(fmt::format("{}: frame buffers do not match its size {}x{}",
                                  frameLabel(f, role), f.width, f.height));
-  if (!f.edge_dist.empty() && f.edge_dist.size() != n)
-    throw InputError(fmt::format("{}: edge_dist does not match its size", frameLabel(f, role)));
-  if (!f.depth_gap.empty() && f.depth_gap.size() != n)
-    throw InputError(fmt::format("{}: depth_gap does not match its size", frameLabel(f, role)));
+  const bool unc = f.hasUncertainty();
+  for (int c = 0; c < kUncertaintyChannels; ++c) {
+    if (f.uncertainty()[c]->size() != (unc ? n : 0))
+      throw InputError(fmt::format("{}: {} does not match its size", frameLabel(f, role),
+                                   kUncertaintyChannelInfo[c].name));
+  }
 }
 
 // Four pixels at a time with GCC/Clang vector extensions: portable, and 128-bit so that
@@ -255,6 +257,7 @@ class Comparator {
     band_ = r.visibility.band_px;
     depth_slope_band_ = tol.depth_slope_factor * r.depth.band_px;
     shade_slope_band_ = tol.shading_slope_factor * r.depth.band_px;
+    texel_band_ = r.depth.band_px;
     shade_relative_units_ = 255.0 * tol.shading_relative;
   }
 
@@ -515,65 +518,37 @@ class Comparator {
 
   // ---- Depth: slope allowance (docs/tolerances.md) ----
 
-  // The depth slope (steps/px) of the uncertainty frame's primitive at pixel i, from its
-  // neighbourhood when that shows the primitive along both axes, else also from the
-  // primitive's fitted plane (fits_ must hold it) or, when the primitive's pixels do not
-  // span a plane, from the surface around it. nullopt: unknown. `fitted` says whether the
-  // fit was used.
-  std::optional<double> resolvedSlope(std::size_t i, bool* fitted = nullptr) const {
-    const int x = static_cast<int>(i % u_.width);
-    const int y = static_cast<int>(i / u_.width);
-    const detail::LocalSlope local = detail::localDepthSlope(u_, scale_, x, y);
-    if (local.complete()) return local.magnitude();
-    std::optional<double> s;
-    auto take = [&](double v) { s = std::max(s.value_or(0.0), v); };
-    if (local.any()) take(local.magnitude());
-    const detail::PlaneFits::Fit* fit = u_.id[i] != 0 ? fits_.find(u_.id[i]) : nullptr;
-    if (fit && fit->pixels >= 2) {
-      take(fit->slope);
-      if (fitted) *fitted = true;
-    }
-    if (!fit || !fit->plane) {
-      if (const std::optional<double> surface = detail::surfaceDepthSlope(u_, scale_, x, y))
-        take(*surface);
-    }
-    return s;
+  // The depth slope (steps/px) the reference recorded for the fragment whose depth it
+  // stored at pixel i; 0 without uncertainty channels (nothing is excused then).
+  double depthSlope(std::size_t i) const {
+    const double s = have_uncertainty_ ? static_cast<double>(u_.depth_slope[i]) : 0.0;
+    return std::isnan(s) ? 0.0 : s;
   }
 
-  // dz is over warn: decide now when the neighbourhood settles it, else defer to finish().
-  __attribute__((noinline)) void depthOverBase(int x, int y, std::size_t i, double dz) {
-    const detail::LocalSlope local = detail::localDepthSlope(u_, scale_, x, y);
-    if (local.complete()) {
-      applyDepth(i, dz, local.magnitude(), false);
-      return;
-    }
-    // The local magnitude is a lower bound of the slope: within its allowance, done.
-    if (!maps_ && local.any() && dz <= tol_.depth.warn + depth_slope_band_ * local.magnitude()) {
-      r_.depth.max_slope = std::max(r_.depth.max_slope, local.magnitude());
-      return;
-    }
-    pending_depth_.push_back({i, dz});
-    if (u_.id[i] != 0) fits_.request(u_.id[i]);
+  // Whether the fragments blended under the top one at pixel i may legally differ: a
+  // blended pixel near a polygon edge (another fragment may or may not cover it) or with
+  // a blended fragment's depth test within the tolerance of flipping. Its depth and colour
+  // are then not held to their tolerances (docs/tolerances.md, "Blended pixels").
+  bool blendUncertain(std::size_t i) const {
+    if (!have_uncertainty_ || !(u_.blend_count[i] > 0.0f)) return false;
+    return static_cast<double>(u_.edge_dist[i]) <= band_ ||
+           static_cast<double>(u_.blend_gap[i]) <=
+               2.0 * (tol_.depth.fail + depth_slope_band_ * u_.blend_slope[i]);
   }
 
-  void applyDepth(std::size_t i, double dz, std::optional<double> slope, bool fitted) {
+  // dz is over warn: check it against the pixel's slope allowance.
+  __attribute__((noinline)) void depthOverBase(int, int, std::size_t i, double dz) {
     DepthStats& d = r_.depth;
-    if (fitted) ++d.slope_fitted;
-    if (maps_)
-      maps_->depth_tolerance[i] =
-          static_cast<float>(tol_.depth.warn + depth_slope_band_ * slope.value_or(0.0));
-    if (!slope) {
-      // Nothing tells how steep this primitive is: its legal error is unbounded, so it
-      // can warn but not fail.
-      ++d.slope_unknown;
-      ++d.over_tolerance;
-      depth_worst_.offer(dz - tol_.depth.warn, i, dz, 0.0);
-      return;
-    }
-    d.max_slope = std::max(d.max_slope, *slope);
-    const double allow = depth_slope_band_ * *slope;
+    const double slope = depthSlope(i);  // NaN excuses nothing
+    const double allow = depth_slope_band_ * slope;
+    if (maps_) maps_->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allow);
+    d.max_slope = std::max(d.max_slope, slope);
     const double excess = dz - (tol_.depth.warn + allow);
     if (excess <= 0.0) return;
+    if (blendUncertain(i)) {
+      ++d.blend_uncertain;
+      return;
+    }
     ++d.over_tolerance;
     if (dz > tol_.depth.fail + allow) ++d.over_fail;
     depth_worst_.offer(excess, i, dz, allow);
@@ -589,9 +564,10 @@ class Comparator {
   // ---- Shading: relative, gradient and texture allowances (docs/tolerances.md) ----
 
   struct ShadingExcess {
-    double excess = -kInf;   // max over channels of error - allowance
-    int channel = 0;         // the channel that gives it
-    double allowance = 0.0;  // that channel's allowance
+    double excess = -kInf;                // max over channels of error - allowance
+    int channel = 0;                      // the channel that gives it
+    double allowance = 0.0;               // that channel's allowance
+    double excess_without_texel = -kInf;  // the same without the texel-choice term
     std::array<double, 4> allowances{};
   };
   // With `neighbourhood` false, only the terms that need no neighbours (a lower bound).
@@ -602,24 +578,22 @@ class Comparator {
     detail::ColourNeighbourhood around;
     if (neighbourhood) around = detail::colourNeighbourhood(e_, x, y);
     ShadingExcess out;
+    // What the reference knows at the pixel: with nearest filtering, a sample within the
+    // band of a texel boundary may take the texel across it (texel_alt, RGB only); in
+    // rgba8 every blended fragment may round differently (blend_count).
+    double texel = 0.0;
+    double blends = 0.0;
+    if (have_uncertainty_) {
+      if (tol_.texel_choice > 0.0 && static_cast<double>(u_.texel_dist[i]) <= texel_band_)
+        texel = tol_.texel_choice * u_.texel_alt[i];
+      blends = tol_.blend_rounding_units * u_.blend_count[i];
+    }
     for (int c = 0; c < 4; ++c) {
       const double m = std::max(std::fabs(pa[c]), std::fabs(pb[c]));
-      const double allow = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
-                           tol_.texture_weight_error * around.range[c] +
-                           tol_.texture_rounding_units * std::max(1.0, m);
-      out.allowances[c] = allow;
-    }
-    // Nearest texture filtering: at a texel edge either texel may be sampled. Magnified,
-    // the other texel is what the reference shows at an adjacent pixel; minified, it is
-    // within the colour range around the pixel, and such a pixel stands alone (a fault
-    // that shifts a region's colour moves its neighbours too).
-    if (neighbourhood && tol_.texel_choice > 0.0) {
-      if (otherTexel(x, y, pb, out.allowances)) {
-        for (int c = 0; c < 4; ++c) out.allowances[c] = std::max<double>(out.allowances[c], d[c]);
-      } else if (aloneInItsNeighbourhood(x, y)) {
-        for (int c = 0; c < 4; ++c)
-          out.allowances[c] += tol_.texel_choice * static_cast<double>(around.range[c]);
-      }
+      out.allowances[c] = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
+                          tol_.texture_weight_error * around.range[c] +
+                          tol_.texture_rounding_units * std::max(1.0, m) + blends +
+                          (c < 3 ? texel : 0.0);
     }
     for (int c = 0; c < 4; ++c) {
       const double excess = d[c] - out.allowances[c];
@@ -628,54 +602,21 @@ class Comparator {
         out.channel = c;
         out.allowance = out.allowances[c];
       }
+      const double without = excess + (c < 3 ? texel : 0.0);
+      out.excess_without_texel = std::max(out.excess_without_texel, without);
     }
     return out;
-  }
-
-  // Whether no 8-neighbour showing the same primitive on both sides differs by more than
-  // warn plus the relative allowance (the neighbour-free part of its allowance).
-  bool aloneInItsNeighbourhood(int x, int y) const {
-    return detail::forEachNeighbour(e_, x, y, [&](std::size_t j, int, int) {
-      if (e_.id[j] == 0 || e_.id[j] != a_.id[j]) return true;
-      const float* ca = &e_.color[j * 4];
-      const float* cb = &a_.color[j * 4];
-      for (int c = 0; c < 4; ++c) {
-        const double m = std::max(std::fabs(ca[c]), std::fabs(cb[c]));
-        if (!(colorError(ca[c], cb[c]) <= tol_.shading.warn + shade_relative_units_ * m))
-          return false;
-      }
-      return true;
-    });
-  }
-
-  // Whether `actual` (the pixel's colour on the actual side) is, within texel_choice units
-  // plus the pixel's own allowances and the warn level, the expected colour of a drawn
-  // 8-neighbour that differs from the expected colour here by more than twice that in
-  // some channel: a texel edge the two sides sampled on different sides of
-  // (docs/tolerances.md, shading (e)).
-  bool otherTexel(int x, int y, const float* actual, const std::array<double, 4>& allow) const {
-    const float* here = &e_.color[e_.index(x, y) * 4];
-    std::array<double, 4> slack{};
-    for (int c = 0; c < 4; ++c) slack[c] = tol_.texel_choice + allow[c] + tol_.shading.warn;
-    // Searching stops (forEachNeighbour returns false) at the first matching neighbour.
-    return !detail::forEachNeighbour(e_, x, y, [&](std::size_t j, int, int) {
-      if (e_.id[j] == 0) return true;
-      const float* there = &e_.color[j * 4];
-      bool matches = true;
-      bool edge = false;
-      for (int c = 0; c < 4; ++c) {
-        matches = matches && colorError(actual[c], there[c]) <= slack[c];
-        edge = edge || colorError(here[c], there[c]) > 2.0 * slack[c];
-      }
-      return !(matches && edge);
-    });
   }
 
   // The pixel's largest channel error is over warn: check it against its allowance.
   __attribute__((noinline)) void shadingOver(int x, int y, std::size_t i, const float* d) {
     const double warn = tol_.shading.warn;
-    // The terms without neighbours are a lower bound of the allowance: often enough.
-    if (!maps_ && shadingExcess(x, y, i, d, false).excess <= warn) return;
+    // The terms without neighbours are a lower bound of the allowance: often enough (unless
+    // the texel term is needed: then whether the rest covers it decides the count).
+    if (!maps_) {
+      const ShadingExcess lower = shadingExcess(x, y, i, d, false);
+      if (lower.excess <= warn && lower.excess_without_texel <= warn) return;
+    }
     const ShadingExcess s = shadingExcess(x, y, i, d, true);
     if (maps_) {
       // The threshold the pixel's largest channel error is held to: exceeding it by k is
@@ -683,7 +624,14 @@ class Comparator {
       const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
       maps_->shading_tolerance[i] = static_cast<float>(warn + (e - s.excess));
     }
-    if (s.excess <= warn) return;
+    if (s.excess <= warn) {
+      if (s.excess_without_texel > warn) ++r_.shading.texel_choice;
+      return;
+    }
+    if (blendUncertain(i)) {
+      ++r_.shading.blend_uncertain;
+      return;
+    }
     ++r_.shading.over_tolerance;
     if (s.excess > tol_.shading.fail) ++r_.shading.over_fail;
     shade_worst_.offer(s.excess, i, d[s.channel], s.allowance);
@@ -698,32 +646,21 @@ class Comparator {
 
   // ---- Visibility ----
 
-  static constexpr PixelClass kDeferred = PixelClass::Background;
-
-  __attribute__((noinline)) PixelClass classifyMismatch(int x, int y, std::size_t i,
-                                                        std::uint32_t a, std::uint32_t b) {
+  __attribute__((noinline)) PixelClass classifyMismatch(int, int, std::size_t i, std::uint32_t a,
+                                                        std::uint32_t b) {
     const double edge = have_uncertainty_ ? static_cast<double>(u_.edge_dist[i]) : kInf;
     bool ambiguous = edge <= band_;  // false for NaN
     bool by_gap = false;
-    if (!ambiguous && a != 0 && b != 0 && have_uncertainty_) {
-      // Each surface's stored depth may be off by its tolerance, fail + slope allowance,
-      // in either direction; two fragments closer than the sum may swap. The surfaces
-      // are taken to share the winner's slope (docs/tolerances.md).
-      const double gap = u_.depth_gap[i];
-      const double flat = 2.0 * tol_.depth.fail;
-      if (gap <= flat) {
-        by_gap = true;
-      } else if (gap < kInf) {
-        const detail::LocalSlope local = detail::localDepthSlope(u_, scale_, x, y);
-        const double lower = flat + 2.0 * depth_slope_band_ * local.magnitude();
-        if (gap <= lower) {
-          by_gap = true;
-        } else if (!local.complete()) {
-          pending_wrong_.push_back({i, edge, gap});
-          if (u_.id[i] != 0) fits_.request(u_.id[i]);
-          return kDeferred;
-        }
-      }
+    if (!ambiguous && have_uncertainty_) {
+      // Each fragment's stored depth may be off by its tolerance, fail + slope allowance,
+      // in either direction; two fragments closer than the sum may swap. The slope is the
+      // steeper fragment's of the comparisons that decided the pixel (gap_slope). Against
+      // the clear depth (missing, extra: primitive or background), only the fragment's
+      // own tolerance: the clear value is exact on both sides.
+      by_gap = a != 0 && b != 0 ? static_cast<double>(u_.depth_gap[i]) <=
+                                      2.0 * (tol_.depth.fail + depth_slope_band_ * u_.gap_slope[i])
+                                : static_cast<double>(u_.clear_gap[i]) <=
+                                      tol_.depth.fail + depth_slope_band_ * u_.clear_slope[i];
       ambiguous = by_gap;
     }
     return record(i, a, b, ambiguous, by_gap, edge);
@@ -749,32 +686,9 @@ class Comparator {
     return {static_cast<int>(i % e_.width), static_cast<int>(i / e_.width)};
   }
 
-  // Deferred pixels: one pass fits the planes of their primitives, then each is decided.
-  void resolveDeferred() {
-    // The largest error's allowance is reported even when nothing is over.
-    if (!depth_worst_.any && depth_max_ > 0.0 && pending_depth_.empty()) {
-      const PixelRef p = pixelAt(depth_max_at_);
-      if (!detail::localDepthSlope(u_, scale_, p.x, p.y).complete() && u_.id[depth_max_at_] != 0)
-        fits_.request(u_.id[depth_max_at_]);
-    }
-    if (fits_.pending()) fits_.build(u_, scale_);
-    for (const PendingDepth& p : pending_depth_) {
-      bool fitted = false;
-      const std::optional<double> slope = resolvedSlope(p.index, &fitted);
-      applyDepth(p.index, p.dz, slope, fitted);
-    }
-    for (const PendingMismatch& p : pending_wrong_) {
-      const double slope = resolvedSlope(p.index).value_or(0.0);
-      const bool by_gap = p.gap <= 2.0 * (tol_.depth.fail + depth_slope_band_ * slope);
-      const PixelClass cls = record(p.index, 1, 2, by_gap, by_gap, p.edge);  // wrong_primitive
-      if (maps_) maps_->pixel_class[p.index] = cls;
-    }
-  }
-
   void finish() {
     depth_hot_.flush();
     shade_hot_.flush();
-    resolveDeferred();
 
     VisibilityStats& v = r_.visibility;
     auto count = [&](PixelClass c) { return class_counts_[static_cast<int>(c)]; };
@@ -807,7 +721,7 @@ class Comparator {
     } else if (depth_max_ > 0.0) {  // all equal: no worst pixel
       d.worst = pixelAt(depth_max_at_);
       d.worst_steps = depth_max_;
-      d.worst_allowance = depth_slope_band_ * resolvedSlope(depth_max_at_).value_or(0.0);
+      d.worst_allowance = depth_slope_band_ * depthSlope(depth_max_at_);
     }
     d.status = d.over_fail ? Status::Fail : d.over_tolerance ? Status::Warn : Status::Pass;
 
@@ -842,16 +756,6 @@ class Comparator {
     r_.status = worse(v.status, worse(d.status, s.status));
   }
 
-  struct PendingDepth {
-    std::size_t index;
-    double dz;
-  };
-  struct PendingMismatch {
-    std::size_t index;
-    double edge;
-    double gap;
-  };
-
   const Frame& e_;
   const Frame& a_;
   const Frame& u_;
@@ -863,6 +767,7 @@ class Comparator {
   double band_ = 0.0;
   double depth_slope_band_ = 0.0;  // depth_slope_factor * slope band
   double shade_slope_band_ = 0.0;  // shading_slope_factor * slope band
+  double texel_band_ = 0.0;        // the slope band: how far a texture sample may move (px)
   double shade_relative_units_ = 0.0;
 
   std::uint64_t class_counts_[kPixelClassCount] = {};
@@ -883,9 +788,6 @@ class Comparator {
   HotBins depth_hot_{r_.depth.histogram};
   HotBins shade_hot_{r_.shading.histogram};
 
-  detail::PlaneFits fits_;
-  std::vector<PendingDepth> pending_depth_;
-  std::vector<PendingMismatch> pending_wrong_;
   ClassMaps* maps_ = nullptr;
 };
 
@@ -952,6 +854,15 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
   if (r.fixture.empty()) r.fixture = metaString(actual, "fixture");
   r.expected = metaString(expected, "backend");
   r.actual = metaString(actual, "backend");
+  for (const Frame* f : {&expected, &actual}) {
+    const auto st = f->meta.find("state");
+    if (st != f->meta.end() && st->is_object()) {
+      r.state = *st;
+      break;
+    }
+  }
+  r.expected_driver = metaString(expected, "gl_version");
+  r.actual_driver = metaString(actual, "gl_version");
   r.width = expected.width;
   r.height = expected.height;
   r.pixels = expected.pixelCount();
@@ -1018,7 +929,6 @@ Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual) {
   };
   DrawnWith drawn;
   drawn.linear_textures = texturedWith(expected, "linear") || texturedWith(actual, "linear");
-  drawn.nearest_textures = texturedWith(expected, "nearest") || texturedWith(actual, "nearest");
   return defaultTolerances(df, cf, drawn);
 }
 

@@ -53,7 +53,7 @@ struct VisibilityStats {
   std::uint64_t missing_hard = 0;
   std::uint64_t extra_hard = 0;
   std::uint64_t wrong_primitive_hard = 0;
-  std::uint64_t ambiguous_by_depth_gap = 0;  // wrong_primitive excused only by depth_gap
+  std::uint64_t ambiguous_by_depth_gap = 0;  // mismatches excused only by depth_gap
   double band_px = 0.0;                      // edge_dist at or below this is ambiguous
   bool uncertainty_available = false;        // false: no edge_dist/depth_gap, all are hard
   PixelRef worst;                // the hard mismatch farthest from any edge (first on ties)
@@ -69,13 +69,11 @@ struct DepthStats {
   std::uint64_t over_tolerance = 0;  // |dZ| > warn + allowance (non-finite pixels count)
   std::uint64_t over_fail = 0;       // |dZ| > fail + allowance (non-finite pixels count)
   std::uint64_t nonfinite = 0;       // Z NaN or Inf on either side
-  // Pixels over warn whose slope is unknown (a primitive seen at one pixel with no drawn
-  // neighbour): they warn but cannot fail, since their legal error is unbounded.
-  std::uint64_t slope_unknown = 0;
-  // Pixels over warn whose slope came from the primitive's plane fitted over all its
-  // pixels (their neighbourhood did not show the primitive along both axes).
-  std::uint64_t slope_fitted = 0;
-  double band_px = 0.0;  // the slope band: allowance = factor * slope * band
+  // Pixels over their tolerance that were not counted because the fragments blended under
+  // the top one may legally differ there (near an edge, or a depth tie; the reference's
+  // blend_count, edge_dist, blend_gap).
+  std::uint64_t blend_uncertain = 0;
+  double band_px = 0.0;  // the slope band: allowance = factor * depth_slope * band
   // The pixel furthest over its tolerance when any is over, else the largest error (first
   // in row order on ties); none when every compared depth is equal.
   PixelRef worst;
@@ -100,6 +98,12 @@ struct ShadingStats {
   std::uint64_t over_tolerance = 0;  // a channel's error > warn + its allowance (non-finite count)
   std::uint64_t over_fail = 0;       // a channel's error > fail + its allowance (non-finite count)
   std::uint64_t nonfinite = 0;       // a colour channel NaN or Inf on either side
+  // Pixels over warn plus the rest of their allowance that the texel choice allowance (a
+  // nearest-filtered sample within the band of a texel boundary) brought within it.
+  std::uint64_t texel_choice = 0;
+  // Pixels over their tolerance not counted because the fragments blended under the top
+  // one may legally differ (see DepthStats::blend_uncertain).
+  std::uint64_t blend_uncertain = 0;
   std::array<double, 4> max_abs_rgba{};
   // The pixel furthest over its tolerance when any is over (a non-finite one first), else
   // the largest per-pixel error (first in row order on ties); none when all are equal.
@@ -117,10 +121,25 @@ struct NonFiniteCounts {
 };
 inline constexpr std::array<const char*, 5> kFrameChannels = {"R", "G", "B", "A", "Z"};
 
+// An expected failure a pair's failing class is covered by (compare/expectations.h).
+struct KnownFailure {
+  std::string id;
+  std::string cls;
+  std::string reason;
+};
+
 struct PairResult {
   std::string fixture;
   std::string expected;  // backend specs, e.g. "ref", "gl:egl:llvmpipe"
   std::string actual;
+  // The fixture's render state (frame.json "state": the fixture's state block with every
+  // default filled in) and each side's GL version string ("" for the reference): what
+  // expected failures are scoped by.
+  nlohmann::json state = nlohmann::json::object();
+  std::string expected_driver;
+  std::string actual_driver;
+  // Non-empty when the pair failed only in classes known to fail (applyExpectations()).
+  std::vector<KnownFailure> known;
   Status status = Status::Pass;
   std::string error;  // status Error: why the pair could not be compared
   int width = 0;

@@ -21,6 +21,7 @@ struct ReportSummary {
   std::uint64_t warn = 0;
   std::uint64_t fail = 0;
   std::uint64_t error = 0;
+  std::uint64_t known_fail = 0;  // of `fail`, those an expectation covers
   std::uint64_t total() const { return pass + warn + fail + error; }
 };
 
@@ -36,7 +37,8 @@ struct Report {
 };
 
 // Exit status of a command that produced this report: 3 when any row is an error (a
-// backend could not run), else 1 when any comparison failed, else 0 (warnings pass).
+// backend could not run), else 1 when any comparison failed that no expectation covers,
+// else 0 (warnings and known failures pass).
 int exitCodeFor(const Report& report);
 
 // report.json content. Image paths are written relative to report_dir (the folder the

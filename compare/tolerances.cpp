@@ -57,6 +57,7 @@ Tolerances defaultTolerances(DepthFormat depth, ColorFormat color, DrawnWith dra
     // Both sides round to nearest: a float difference below one unit rounds to at most
     // one unit, so 2 units cannot come from rounding.
     t.shading = {1.0, 1.0};
+    t.blend_rounding_units = kBlendRoundingUnits;
   } else {
     // Above the float32 allowance: warn beyond 1/64 unit (absolute error of dot products
     // near zero); fail beyond half a unit, where it changes an 8-bit image.
@@ -66,7 +67,9 @@ Tolerances defaultTolerances(DepthFormat depth, ColorFormat color, DrawnWith dra
     t.texture_weight_error = kTextureWeightError;
     t.texture_rounding_units = kTextureRoundingUnits;
   }
-  if (drawn.nearest_textures) t.texel_choice = kTexelChoice;
+  // Only where the reference's texel_alt says a nearest-filtered sample lies near a texel
+  // boundary; zero everywhere else.
+  t.texel_choice = kTexelChoice;
   return t;
 }
 

@@ -44,16 +44,17 @@ struct Tolerances {
   //   + shading_slope_factor * G * band       attribute planes of snapped vertices
   //   + texture_weight_error * R              linear filtering: quantised bilinear weights
   //   + texture_rounding_units * max(1, M)    linear filtering: the 8-bit filtered texel
-  // (the texture terms are 0 unless a textured material is filtered linearly). With nearest
-  // filtering (texel_choice > 0), where either texel may be sampled at a texel edge: a
-  // pixel whose actual colour is, within texel_choice units plus that allowance and warn,
-  // the expected colour of an adjacent pixel across a texel edge is allowed its whole
-  // error; else a pixel whose neighbours all agree gets texel_choice * R more.
+  // (the texture terms are 0 unless a textured material is filtered linearly), and from
+  // the reference's channels at the pixel:
+  //   + texel_choice * texel_alt   nearest filtering, where texel_dist <= the slope band:
+  //                                the sample may take the texel across the boundary (RGB)
+  //   + blend_rounding_units * blend_count   rgba8: each blended fragment's 8-bit rounding
   double shading_relative = 0.0;
   double shading_slope_factor = 1.0;
   double texture_weight_error = 0.0;
   double texture_rounding_units = 0.0;
   double texel_choice = 0.0;
+  double blend_rounding_units = 0.0;
   // Float error of a float32 window transform, in ulps (2^-24) of the larger image side.
   double window_error_ulps = 16.0;
   // When set, replaces the derived visibility band (px); for experiments and odd backends.
@@ -62,8 +63,7 @@ struct Tolerances {
 
 // What a pair's frames say about how it was drawn, beyond the formats (frame.json).
 struct DrawnWith {
-  bool linear_textures = false;   // a textured material sampled with texture_filter linear
-  bool nearest_textures = false;  // a textured material sampled with texture_filter nearest
+  bool linear_textures = false;  // a textured material sampled with texture_filter linear
 };
 
 // The documented defaults for a pair rendered with these formats (docs/tolerances.md).
@@ -79,10 +79,13 @@ inline constexpr double kShadingRelative = 1.0 / 1024.0;
 inline constexpr double kTextureWeightError = 2.0 / 256.0;
 // The filtered texel kept as an 8-bit value: up to one step, times the light on it.
 inline constexpr double kTextureRoundingUnits = 1.0;
-// Nearest filtering: a texture coordinate within float32 rounding of a texel edge selects
-// either texel; the other texel is what the reference shows next door. Units of slack
-// when matching the actual colour to a neighbour's (lighting varies across one pixel).
+// Nearest filtering: a texture coordinate within the band of a texel boundary selects
+// either texel; the whole colour change the reference computed for the other texel
+// (texel_alt) is allowed.
 inline constexpr double kTexelChoice = 1.0;
+// rgba8 blending: per blended fragment, 8-bit source and alpha (up to 1 unit together)
+// and the two rounded products (up to 1 unit): 2 units, carried forward by (1 - alpha).
+inline constexpr double kBlendRoundingUnits = 2.0;
 
 // Replaces the thresholds the overrides set. A lone warn above the current fail (or a
 // lone fail below the current warn) moves the other threshold with it; warn > fail when

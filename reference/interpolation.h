@@ -11,6 +11,8 @@
 // extrapolate, as GL does. It does not rasterize, shade or quantize.
 #pragma once
 
+#include <cmath>
+
 #include <glm/glm.hpp>
 
 #include "reference/viewport.h"
@@ -53,6 +55,22 @@ class FragmentInterpolator {
     return glm::dvec3((r.num[0] + num_[0].ddx * dx) * inv, (r.num[1] + num_[1].ddx * dx) * inv,
                       (r.num[2] + num_[2].ddx * dx) * inv);
   }
+
+  // Depth gradient magnitude |grad z| of the plane (window-z units per px).
+  double depthSlope() const { return std::hypot(z_.ddx, z_.ddy); }
+
+  // The screen-space derivatives of the perspective-correct barycentrics `b` (as
+  // barycentricAt(r, dx) returned them): d/dx in [0], d/dy in [1]. From B = N / D with N
+  // and D affine: dB/dx = (dN/dx - B dD/dx) / D.
+  void barycentricGradient(const Row& r, double dx, const glm::dvec3& b, glm::dvec3 out[2]) const {
+    const double inv = 1.0 / (r.inv_w + inv_w_.ddx * dx);
+    for (int k = 0; k < 3; ++k) {
+      out[0][k] = (num_[k].ddx - b[k] * inv_w_.ddx) * inv;
+      out[1][k] = (num_[k].ddy - b[k] * inv_w_.ddy) * inv;
+    }
+  }
+  // 1 / w at the fragment (the perspective-correct denominator).
+  double invWAt(const Row& r, double dx) const { return r.inv_w + inv_w_.ddx * dx; }
 
   // Window z at window point (x, y), not clamped.
   double depth(double x, double y) const { return depthAt(depthRow(y), dx(x)); }

@@ -2,10 +2,12 @@
 // drawPasses(). See reference_renderer.h and docs/reference.md.
 #include "reference/reference_renderer.h"
 
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "fixtures/errors.h"
 #include "fixtures/scene_logic.h"
@@ -90,6 +92,17 @@ struct TriangleContext {
   LitColor flat;
   bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  // Of the fan triangle being drawn (uncertainty channels only):
+  float depth_slope = 0.0f;   // |grad z| in depth-format steps per px
+  bool texel_choice = false;  // textured, nearest filter: record texel_dist / texel_alt
+  glm::dvec2 uq_max{0.0};     // largest |u / w|, |v / w| over its three vertices
+};
+
+// What a drawn fragment adds to the texel channels (frame.h): nothing unless it samples a
+// nearest-filtered texture near a texel boundary.
+struct TexelNote {
+  float dist = 1.0f;  // px
+  float alt = 0.0f;   // 8-bit units, weighted as the fragment's colour is in the pixel
 };
 
 // Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
@@ -99,7 +112,7 @@ struct TriangleContext {
 // carry over: every render refills what it reads.
 struct Scratch {
   std::vector<std::uint32_t> depth;
-  DepthGapTracker gaps;
+  UncertaintyTracker gaps;
   std::vector<std::vector<TransformedVertex>> vertices;  // per object
   std::vector<std::vector<LitColor>> gouraud;            // per object, Gouraud only
 };
@@ -123,6 +136,7 @@ class Renderer {
         depth_format_(scene.state.depth_format),
         color_format_(scene.state.color_format),
         snap_scale_(std::ldexp(1.0, options.subpixel_bits)),
+        depth_steps_(depthStepsPerUnit(scene.state.depth_format)),
         camera_(cameraTransform(scene)),
         lighting_(sceneLighting(scene)),
         volume_(clipVolume(scene.width, scene.height, guardLimitPx(options.subpixel_bits))),
@@ -153,9 +167,15 @@ class Renderer {
   template <Shading kShading>
   void traceSpans(const TriangleContext& t, const TriangleCoverage& coverage,
                   const FragmentInterpolator& interp);
+  // The texel note needs the interpolator at the fragment (interp, row, dx); without
+  // `note` they are not read.
   template <Shading kShading>
-  glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b,
-                           ShadingTerms* terms) const;
+  glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b, ShadingTerms* terms,
+                           TexelNote* note = nullptr, const FragmentInterpolator* interp = nullptr,
+                           const FragmentInterpolator::Row* row = nullptr, double dx = 0.0) const;
+  TexelNote texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+                      const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
+                      const FragmentInterpolator::Row& row, double dx) const;
   void traceTerms(const TriangleContext& t, const glm::dvec3& b, ShadingTerms& terms) const;
   void writeColor(std::size_t index, const glm::dvec4& src, bool blend);
   glm::dvec4 storedColor(std::size_t index) const;
@@ -169,7 +189,8 @@ class Renderer {
   const bool uncertainty_;
   const DepthFormat depth_format_;
   const ColorFormat color_format_;
-  const double snap_scale_;  // 2^subpixel_bits
+  const double snap_scale_;   // 2^subpixel_bits
+  const double depth_steps_;  // depth-format steps per unit of window z
   const CameraTransform camera_;
   const Lighting lighting_;
   const ClipVolume volume_;
@@ -179,7 +200,7 @@ class Renderer {
   std::vector<std::vector<LitColor>>& gouraud_;            // per object, Gouraud only, scratch
   Frame frame_;                        // colour, id, edge_dist over the clip rectangle
   std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
-  DepthGapTracker& gaps_;              // scratch
+  UncertaintyTracker& gaps_;           // scratch
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
 };
@@ -211,11 +232,12 @@ Frame Renderer::run() {
   frame_.allocate(fb_width_, fb_height_, clear_rgba,
                   static_cast<float>(storedDepth(clear_key, depth_format_)), uncertainty_);
   depth_.assign(frame_.pixelCount(), clear_key);
-  if (uncertainty_) gaps_.reset(frame_.pixelCount(), depth_format_, frame_.depth_gap.data());
+  if (uncertainty_) gaps_.reset(frame_, depth_format_, clampDepth(scene_.clear_depth));
 
   transformVertices();
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter))
     for (const PrimitiveRef& prim : pass.primitives) drawTriangle(prim, pass);
+  if (uncertainty_) gaps_.finish(frame_);
 
   // Stored depth back to [0, 1] (one simple loop per format, so that it vectorizes).
   const std::size_t n = frame_.pixelCount();
@@ -341,6 +363,19 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     FragmentInterpolator interp;
     // A triangle of one stored colour needs no barycentrics (unless traced).
     interp.setup(wv[0], wv[i], wv[i + 1], !t.constant || trace_ != nullptr);
+    if (uncertainty_) {
+      t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
+      t.texel_choice =
+          t.texture != nullptr && scene_.state.texture_filter == TextureFilter::Nearest;
+      if (t.texel_choice) {
+        t.uq_max = glm::dvec2(0.0);
+        for (const WindowVertex* w : {&wv[0], &wv[i], &wv[i + 1]}) {
+          const glm::dvec2 uv =
+              w->bary.x * t.v[0]->uv + w->bary.y * t.v[1]->uv + w->bary.z * t.v[2]->uv;
+          t.uq_max = glm::max(t.uq_max, glm::abs(uv * w->inv_w));
+        }
+      }
+    }
     if (trace_ != nullptr) {
       switch (scene_.state.shading) {
         case Shading::Flat:
@@ -361,10 +396,13 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
 
 template <Shading kShading>
 inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::dvec3& b,
-                                          ShadingTerms* terms) const {
+                                          ShadingTerms* terms, TexelNote* note,
+                                          const FragmentInterpolator* interp,
+                                          const FragmentInterpolator::Row* row, double dx) const {
   glm::dvec3 tex(1.0);
+  glm::dvec2 uv(0.0);
   if (t.texture) {
-    const glm::dvec2 uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
+    uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
     tex = glm::dvec3(
         sampleTexture(*t.texture, uv, scene_.state.texture_filter, scene_.state.texture_wrap));
   }
@@ -383,12 +421,50 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
     lit = shadePrepared(*t.shading, p, n, terms);
   }
   const glm::dvec4 color = finalColor(lit, tex, t.material->opacity);
+  if (note && t.texel_choice) *note = texelNote(t, uv, b, lit.ambient_diffuse, *interp, *row, dx);
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
     terms->texture = tex;
     terms->color = color;
   }
   return color;
+}
+
+// The nearest filter's texel choice at a fragment (docs/tolerances.md "texel_dist"): how
+// far (px) the sample is from a texel boundary beyond float rounding, and how much the
+// pixel's colour would change with the texel(s) across it, in 8-bit units, weighted by
+// alpha when the fragment is blended.
+TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+                              const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
+                              const FragmentInterpolator::Row& row, double dx) const {
+  glm::dvec3 db[2];
+  interp.barycentricGradient(row, dx, b, db);
+  const glm::dvec3 u(t.v[0]->uv.x, t.v[1]->uv.x, t.v[2]->uv.x);
+  const glm::dvec3 v(t.v[0]->uv.y, t.v[1]->uv.y, t.v[2]->uv.y);
+  const double w = t.texture->width;
+  const double h = t.texture->height;
+  const double q = interp.invWAt(row, dx);
+  const double image = std::max(scene_.width, scene_.height);
+  TexelAxis s;
+  s.coord = uv.x * w;
+  s.gradient = w * std::hypot(glm::dot(db[0], u), glm::dot(db[1], u));
+  s.reach = kTexelCoordinateReach *
+            (w * std::max(std::fabs(uv.x), t.uq_max.x / std::fabs(q)) + s.gradient * image);
+  TexelAxis tt;
+  tt.coord = uv.y * h;
+  tt.gradient = h * std::hypot(glm::dot(db[0], v), glm::dot(db[1], v));
+  tt.reach = kTexelCoordinateReach *
+             (h * std::max(std::fabs(uv.y), t.uq_max.y / std::fabs(q)) + tt.gradient * image);
+  const TexelChoice choice = nearestTexelChoice(*t.texture, s, tt, scene_.state.texture_wrap, 1.0);
+  TexelNote note;
+  note.dist = static_cast<float>(choice.dist_px);
+  double alt = 0.0;
+  for (int k = 0; k < choice.alternatives; ++k)
+    for (int c = 0; c < 3; ++c)
+      alt = std::max(alt, std::fabs(ambient_diffuse[c] * (choice.alt[k][c] - choice.chosen[c])));
+  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+  note.alt = static_cast<float>(255.0 * alt * weight);
+  return note;
 }
 
 // The ambient and per-light terms of flat and Gouraud fragments (Phong records them
@@ -436,6 +512,9 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
                          const FragmentInterpolator& interp, Shade&& shade) {
   const bool always = t.pass->depth_func == DepthFunc::Always;
   const bool depth_write = t.pass->depth_write;
+  const bool blend = t.pass->blend;
+  const float slope = t.depth_slope;
+  const auto alpha = static_cast<float>(std::clamp(t.material->opacity, 0.0, 1.0));
   const std::uint32_t id = t.prim->id;
   std::uint32_t* const depth = depth_.data();
   std::uint32_t* const ids = frame_.id.data();
@@ -454,15 +533,16 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       const bool pass = always || key < depth[index];
       if constexpr (kGaps) {
         if (pass) {
-          gaps_.passed(index, z, !always, depth_write);
+          gaps_.passed(index, z, slope, !always, depth_write, blend);
         } else {
-          gaps_.failed(index, z);
+          gaps_.failed(index, z, slope, blend);
         }
       }
       if (!pass) continue;
       if (depth_write) depth[index] = key;
       ids[index] = id;
-      shade(index, row, dx);
+      const TexelNote note = shade(index, row, dx);
+      if constexpr (kGaps) gaps_.colourWritten(index, blend, alpha, note.dist, note.alt);
     }
   });
 }
@@ -490,6 +570,7 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
       c[1] = c1;
       c[2] = c2;
       c[3] = c3;
+      return TexelNote{};
     };
     if (uncertainty_) {  // only the depth plane was set up
       fillSpans<kFormat, true, false>(t, coverage, interp, shade);
@@ -527,6 +608,7 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
             b.x * g0.ambient_diffuse + b.y * g1.ambient_diffuse + b.z * g2.ambient_diffuse;
         const glm::dvec3 sp = b.x * g0.specular + b.y * g1.specular + b.z * g2.specular;
         store(index, ad + sp);
+        return TexelNote{};
       });
     } else {
       const glm::dvec3 w0 = t.v[0]->world;
@@ -542,29 +624,33 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
         const glm::dvec3 n = safeNormalize(b.x * n0 + b.y * n1 + b.z * n2);
         const LitColor lit = shadePrepared(shading, p, n);
         store(index, lit.ambient_diffuse + lit.specular);
+        return TexelNote{};
       });
     }
     return;
   }
+  // The general path; the texel note only where the uncertainty channels are kept.
+  const bool notes = uncertainty_;
+  auto general = [&](auto shading) {
+    constexpr Shading kShading = decltype(shading)::value;
+    fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+      TexelNote note;
+      const glm::dvec3 b = interp.barycentricAt(row, dx);
+      writeColor(index,
+                 fragmentColor<kShading>(t, b, nullptr, notes ? &note : nullptr, &interp, &row, dx),
+                 blend);
+      return note;
+    });
+  };
   switch (scene_.state.shading) {
     case Shading::Flat:
-      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
-        writeColor(index, fragmentColor<Shading::Flat>(t, interp.barycentricAt(row, dx), nullptr),
-                   blend);
-      });
+      general(std::integral_constant<Shading, Shading::Flat>{});
       break;
     case Shading::Gouraud:
-      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
-        writeColor(index,
-                   fragmentColor<Shading::Gouraud>(t, interp.barycentricAt(row, dx), nullptr),
-                   blend);
-      });
+      general(std::integral_constant<Shading, Shading::Gouraud>{});
       break;
     case Shading::Phong:
-      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
-        writeColor(index, fragmentColor<Shading::Phong>(t, interp.barycentricAt(row, dx), nullptr),
-                   blend);
-      });
+      general(std::integral_constant<Shading, Shading::Phong>{});
       break;
   }
 }

@@ -55,4 +55,52 @@ glm::dvec4 sampleTexture(const Texture& texture, const glm::dvec2& uv, TextureFi
          (1.0 - a) * b * texel(texture, i0, j1) + a * b * texel(texture, i1, j1);
 }
 
+namespace {
+
+// One axis: the distance (px, `cap` when farther) to the nearest texel boundary the wrap
+// mode has, and the texel index on its other side. Under clamp-to-edge only the
+// boundaries inside the texture (1 .. size-1) change the texel; under repeat every
+// integer does.
+struct AxisChoice {
+  double dist_px;
+  int chosen;
+  int other;
+};
+AxisChoice axisChoice(const TexelAxis& a, int size, TextureWrap wrap, double cap) {
+  const int chosen = wrapIndex(std::floor(a.coord), size, wrap);
+  AxisChoice out{cap, chosen, chosen};
+  if (!std::isfinite(a.coord)) return out;
+  double k = std::round(a.coord);
+  if (wrap == TextureWrap::Clamp) {
+    if (size < 2) return out;
+    k = std::clamp(k, 1.0, size - 1.0);
+  }
+  const double d = std::fabs(a.coord - k);
+  double px = 0.0;
+  if (d > a.reach) px = a.gradient > 0.0 ? (d - a.reach) / a.gradient : cap;
+  if (!(px < cap)) return out;
+  out.dist_px = px;
+  // The texel on the other side of boundary k: k itself when the sample is below it.
+  out.other = wrapIndex(a.coord < k ? k : k - 1.0, size, wrap);
+  if (out.other == chosen) out.other = wrapIndex(a.coord < k ? k - 1.0 : k, size, wrap);
+  return out;
+}
+
+}  // namespace
+
+TexelChoice nearestTexelChoice(const Texture& texture, const TexelAxis& s, const TexelAxis& t,
+                               TextureWrap wrap, double cap) {
+  const AxisChoice cs = axisChoice(s, texture.width, wrap, cap);
+  const AxisChoice ct = axisChoice(t, texture.height, wrap, cap);
+  TexelChoice out;
+  out.dist_px = std::min(cs.dist_px, ct.dist_px);
+  out.chosen = texel(texture, cs.chosen, ct.chosen);
+  const bool in_s = cs.dist_px < cap && cs.other != cs.chosen;
+  const bool in_t = ct.dist_px < cap && ct.other != ct.chosen;
+  if (in_s) out.alt[out.alternatives++] = texel(texture, cs.other, ct.chosen);
+  if (in_t) out.alt[out.alternatives++] = texel(texture, cs.chosen, ct.other);
+  if (in_s && in_t) out.alt[out.alternatives++] = texel(texture, cs.other, ct.other);
+  return out;
+}
+
 }  // namespace rc::ref

@@ -17,4 +17,31 @@ namespace rc::ref {
 glm::dvec4 sampleTexture(const Texture& texture, const glm::dvec2& uv, TextureFilter filter,
                          TextureWrap wrap);
 
+// Float32 rounding of a texture coordinate in a driver, as a fraction of the magnitudes it
+// is computed from (16 ulps; docs/tolerances.md "texel_dist"): the perspective-correct
+// interpolation (two attribute planes and a division), the scaling by the texture size
+// and the plane evaluation relative to a far origin each round a few times.
+inline constexpr double kTexelCoordinateReach = 0x1p-20;
+
+// One axis of a nearest-filtered sample, in texels: the coordinate (u * W), its
+// screen-space gradient magnitude (texels/px), and how far float rounding may move it.
+struct TexelAxis {
+  double coord = 0.0;
+  double gradient = 0.0;
+  double reach = 0.0;
+};
+
+// The nearest filter's discontinuities around a sample: the screen distance (px) the
+// sample would have to move, beyond `reach`, for another texel to be chosen (capped at
+// `cap`), and the texels across the nearest boundary of each axis closer than `cap` px
+// (in s, in t, and across both when both are).
+struct TexelChoice {
+  double dist_px = 1.0;
+  glm::dvec4 chosen{0.0};
+  int alternatives = 0;
+  glm::dvec4 alt[3] = {glm::dvec4(0.0), glm::dvec4(0.0), glm::dvec4(0.0)};
+};
+TexelChoice nearestTexelChoice(const Texture& texture, const TexelAxis& s, const TexelAxis& t,
+                               TextureWrap wrap, double cap);
+
 }  // namespace rc::ref

@@ -12,21 +12,27 @@
 //     would change the final id. depth_gap = min |z_f - z_s| over those comparisons, in
 //     steps of the depth format (d16/d24: * (2^b - 1); d32f: * 2^24), z the clamped,
 //     unquantized window depth of each fragment; +inf when no comparison decided it.
-//     DepthGapTracker computes it in draw order, exactly (see there for why it is exact).
-//     Not counted: tests against the clear depth (they decide primitive vs background,
-//     which the comparator never excuses by depth), and passes without a depth test
-//     (painter's, depth_test false: ALWAYS), where the shared far-to-near sort or the file
-//     order, identical in both renderers, decides the winner: no depth error can change it,
-//     so a pixel drawn last by such a pass is +inf. In a single z-buffer pass this is the
-//     gap between the winner and the nearest other fragment (DESIGN.md's wording).
+//     UncertaintyTracker computes it in draw order, exactly (see there for why it is exact).
+//     Not counted: tests against the clear depth (clear_gap below), and passes without a
+//     depth test (painter's, depth_test false: ALWAYS), where the shared far-to-near sort
+//     or the file order, identical in both renderers, decides the winner: no depth error
+//     can change it, so a pixel drawn last by such a pass is +inf. In a single z-buffer
+//     pass this is the gap between the winner and the nearest other fragment (DESIGN.md's
+//     wording).
+//   clear_gap: how close the pixel came to the other side of primitive-or-background: a
+//     fragment within a step of the clear depth, near the far plane, may legally pass or
+//     fail its test against it (UncertaintyTracker says which fragments count).
 // It does not decide coverage or visibility.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
+#include "fixtures/frame.h"
 #include "fixtures/scene.h"
 #include "reference/fragment_ops.h"
 #include "reference/rasterizer.h"
@@ -52,47 +58,149 @@ namespace rc::ref {
 // id through a transparent fragment whose depth lies between the two opaque candidates;
 // that fragment's own comparison is then closer and is counted, so the minimum is the same.
 //
+// The same stream gives the other per-fragment channels (frame.h UncertaintyChannel):
+//  - depth_slope: the depth gradient (steps/px) of the fragment that stored the depth;
+//  - gap_slope: the steeper fragment of each comparison depth_gap counts, the largest
+//    over them (reset with the gap when a passing fragment decides the id anew);
+//  - clear_gap / clear_slope (finish()): whether the pixel could legally be background
+//    where the reference drew something, or the reverse. Every tested fragment would have
+//    to fail (for background) or one to pass (for a primitive) against the clear depth, so
+//    a drawn pixel gets the LARGEST |z - clear| over its tested fragments, a background
+//    pixel the smallest; +inf when a fragment was drawn without a test, or none was tested.
+//    clear_slope: the steepest tested fragment;
+//  - blend_gap / blend_slope: every test of a blended fragment against the stored depth
+//    changes the pixel's colour when it flips, whether or not it decides the id: the
+//    smallest such gap, and the steepest fragment of those tests;
+//  - blend_count, texel_dist, texel_alt: composited like the colour itself
+//    (colourWritten()): an opaque write starts them afresh, a blended one adds its own,
+//    weighted by alpha.
+//
 // Storage: the window depth of the fragment that stored each pixel's depth (a double: the
-// gap must be exact), and the running gap already in steps, as the float the frame keeps:
+// gap must be exact), and the gaps already in steps, as the floats the frame keeps:
 // x -> float(x * steps) never decreases, so the minimum of the converted gaps is the
 // converted minimum.
-class DepthGapTracker {
+class UncertaintyTracker {
  public:
-  // Starts a frame: `gap_steps` (pixels floats, the frame's depth_gap channel) must hold
-  // +inf; it receives the result as fragments arrive.
-  void reset(std::size_t pixels, DepthFormat format, float* gap_steps) {
-    stored_z_.assign(pixels, kInf);
+  // Starts a frame whose uncertainty channels hold their initial values; they receive the
+  // results as fragments arrive. `clear_z`: the clear depth, clamped to [0, 1].
+  void reset(Frame& frame, DepthFormat format, double clear_z) {
+    const std::size_t n = frame.pixelCount();
+    stored_z_.assign(n, kInf);
+    clear_near_.assign(n, kInfF);
+    clear_far_.assign(n, -1.0f);  // < 0: no tested fragment yet
+    clear_z_ = clear_z;
     steps_ = depthStepsPerUnit(format);
-    gap_ = gap_steps;
+    gap_ = frame.depth_gap.data();
+    gap_slope_ = frame.gap_slope.data();
+    depth_slope_ = frame.depth_slope.data();
+    blend_gap_ = frame.blend_gap.data();
+    blend_slope_ = frame.blend_slope.data();
+    blend_count_ = frame.blend_count.data();
+    texel_dist_ = frame.texel_dist.data();
+    texel_alt_ = frame.texel_alt.data();
+    clear_slope_ = frame.clear_slope.data();
   }
 
-  // Fragment at clamped window depth z passed the test (tested: LESS; else ALWAYS) and,
-  // when `writes`, stored its depth.
-  void passed(std::size_t index, double z, bool tested, bool writes) {
-    // +inf against the clear depth (|z - inf| = inf) and without a test.
-    gap_[index] = tested ? toSteps(std::fabs(z - stored_z_[index])) : kInfF;
-    if (writes) stored_z_[index] = z;
+  // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px),
+  // passed the test (tested: LESS; else ALWAYS) and, when `writes`, stored its depth.
+  // `blended`: drawn in a blending pass.
+  void passed(std::size_t index, double z, float slope, bool tested, bool writes, bool blended) {
+    if (tested) {
+      // +inf against the clear depth (|z - inf| = inf).
+      const float g = toSteps(std::fabs(z - stored_z_[index]));
+      gap_[index] = g;
+      gap_slope_[index] = std::max(slope, depth_slope_[index]);
+      clearTest(index, z, slope);
+      if (blended) blendTest(index, z, slope);
+    } else {
+      gap_[index] = kInfF;
+      gap_slope_[index] = 0.0f;
+      clear_near_[index] = -kInfF;  // drawn whatever the depths: never background
+    }
+    if (writes) {
+      stored_z_[index] = z;
+      depth_slope_[index] = slope;
+    }
   }
   // Fragment at clamped window depth z failed the LESS test.
-  void failed(std::size_t index, double z) {
+  void failed(std::size_t index, double z, float slope, bool blended) {
     const float g = toSteps(std::fabs(z - stored_z_[index]));  // +inf against the clear depth
+    clearTest(index, z, slope);
+    if (blended) blendTest(index, z, slope);
+    if (std::isinf(g)) return;
     if (g < gap_[index]) gap_[index] = g;
+    gap_slope_[index] = std::max({gap_slope_[index], slope, depth_slope_[index]});
+  }
+
+  // A fragment's colour was written: over the old one when `blended` (with weight `alpha`),
+  // else in its place. texel_dist / texel_alt are the fragment's own (texel_alt already
+  // weighted by alpha when blended).
+  void colourWritten(std::size_t index, bool blended, float alpha, float texel_dist,
+                     float texel_alt) {
+    if (!blended) {
+      blend_count_[index] = 0.0f;
+      texel_dist_[index] = texel_dist;
+      texel_alt_[index] = texel_alt;
+      return;
+    }
+    blend_count_[index] += 1.0f;
+    texel_dist_[index] = std::min(texel_dist_[index], texel_dist);
+    texel_alt_[index] = (1.0f - alpha) * texel_alt_[index] + texel_alt;
+  }
+
+  // Ends the frame: clear_gap from each pixel's final id (frame.id).
+  void finish(Frame& frame) {
+    for (std::size_t i = 0; i < frame.pixelCount(); ++i) {
+      if (clear_near_[i] == -kInfF || clear_far_[i] < 0.0f) continue;  // stays +inf
+      frame.clear_gap[i] = frame.id[i] != 0 ? clear_far_[i] : clear_near_[i];
+    }
   }
 
   // The storage, for reuse between frames (reset() refills it).
   std::size_t capacity() const { return stored_z_.capacity(); }
-  void release() { stored_z_ = {}; }
+  void release() {
+    stored_z_ = {};
+    clear_near_ = {};
+    clear_far_ = {};
+  }
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   static constexpr float kInfF = std::numeric_limits<float>::infinity();
   float toSteps(double gap) const { return static_cast<float>(gap * steps_); }
+  void clearTest(std::size_t index, double z, float slope) {
+    const float g = toSteps(std::fabs(z - clear_z_));
+    if (clear_near_[index] != -kInfF) clear_near_[index] = std::min(clear_near_[index], g);
+    clear_far_[index] = std::max(clear_far_[index], g);
+    clear_slope_[index] = std::max(clear_slope_[index], slope);
+  }
+  // A blended fragment's test against the stored depth (the clear depth counts here: it
+  // decides whether the fragment is blended at all).
+  void blendTest(std::size_t index, double z, float slope) {
+    const double s = std::isinf(stored_z_[index]) ? clear_z_ : stored_z_[index];
+    const float g = toSteps(std::fabs(z - s));
+    if (g < blend_gap_[index]) blend_gap_[index] = g;
+    blend_slope_[index] = std::max({blend_slope_[index], slope, depth_slope_[index]});
+  }
 
   // Window depth of the fragment that stored the pixel's depth; +inf while it holds the
-  // clear depth (comparisons with it never count).
+  // clear depth (comparisons with it never count in depth_gap).
   std::vector<double> stored_z_;
+  // |z - clear| (steps) over the pixel's tested fragments: smallest (-inf once a fragment
+  // was drawn without a test) and largest (< 0 before the first).
+  std::vector<float> clear_near_;
+  std::vector<float> clear_far_;
+  double clear_z_ = 1.0;
   double steps_ = 1.0;
   float* gap_ = nullptr;
+  float* gap_slope_ = nullptr;
+  float* depth_slope_ = nullptr;
+  float* blend_gap_ = nullptr;
+  float* blend_slope_ = nullptr;
+  float* blend_count_ = nullptr;
+  float* texel_dist_ = nullptr;
+  float* texel_alt_ = nullptr;
+  float* clear_slope_ = nullptr;
 };
 
 // Twice the signed area (> 0 counter-clockwise) and the perimeter of a window polygon.

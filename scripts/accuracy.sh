@@ -34,6 +34,6 @@ rm -rf "$work/catalog" "$work/drivers"
 run fixtures/scenes --backends "$backends" --out "$work/catalog"
 run fixtures/scenes --backends gl:egl:softpipe --against gl:egl:llvmpipe --out "$work/drivers"
 "$exe" accuracy "$work/catalog" "$work/drivers" \
-  --expectations tests/conformance/expectations.json \
+  --expectations fixtures/expectations.json \
   --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\` and \`rastercheck run fixtures/scenes --backends gl:egl:softpipe --against gl:egl:llvmpipe\`, then \`rastercheck accuracy\` on both run folders)" \
   --out docs/accuracy.md

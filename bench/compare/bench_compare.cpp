@@ -23,8 +23,7 @@ Pair makePair(float colour_noise_units) {
   constexpr int kW = 1920, kH = 1080;
   p.ref = rc::testing::renderRects(kW, kH, rc::testing::defaultRects(kW, kH));
   p.gl = p.ref;
-  p.gl.edge_dist.clear();
-  p.gl.depth_gap.clear();
+  p.gl.clearUncertainty();
   p.gl.meta["backend"] = "gl:bench";
   std::mt19937 rng(1);
   std::uniform_int_distribution<int> dz(-2, 2);

@@ -38,8 +38,7 @@ const rc::Frame& frame(int channels) {
   }();
   static const rc::Frame gl = [] {
     rc::Frame f = ref;
-    f.edge_dist.clear();
-    f.depth_gap.clear();
+    f.clearUncertainty();
     return f;
   }();
   return channels == 8 ? ref : gl;
@@ -124,7 +123,7 @@ void BM_ReadFrameDir(benchmark::State& state) {
 }
 
 std::size_t rawBytes(const rc::Frame& f) {
-  return f.pixelCount() * (f.hasUncertainty() ? 8 : 6) * sizeof(float);
+  return f.pixelCount() * (6 + (f.hasUncertainty() ? rc::kUncertaintyChannels : 0)) * sizeof(float);
 }
 
 // Floor 1: copying the frame's bytes once in memory (warm destination).
@@ -148,8 +147,9 @@ void BM_FloorFreshFrame(benchmark::State& state) {
     fresh.color.resize(f.color.size());
     fresh.depth.resize(f.depth.size());
     fresh.id.resize(f.id.size());
-    fresh.edge_dist.resize(f.edge_dist.size());
-    fresh.depth_gap.resize(f.depth_gap.size());
+    const auto from = f.uncertainty();
+    const auto to = fresh.uncertainty();
+    for (int c = 0; c < rc::kUncertaintyChannels; ++c) to[c]->resize(from[c]->size());
     benchmark::DoNotOptimize(fresh.color.data());
   }
 }

@@ -31,6 +31,11 @@ constexpr Block kEmptyBlock{20, 240, 40, 252};
 // Inside the steep rectangle.
 constexpr Block kSteepBlock{185, 30, 205, 50};
 
+// A d24 depth moved by `steps` steps.
+float quantized(float depth, double steps) {
+  return static_cast<float>((std::nearbyint(depth * kD24) + steps) / kD24);
+}
+
 template <typename F>
 void forBlock(const Block& b, F f) {
   for (int y = b.y0; y < b.y1; ++y)
@@ -42,8 +47,7 @@ class CompareTest : public ::testing::Test {
   void SetUp() override {
     ref_ = testing::renderRects(kW, kH, testing::defaultRects(kW, kH));
     gl_ = ref_;
-    gl_.edge_dist.clear();
-    gl_.depth_gap.clear();
+    gl_.clearUncertainty();
     gl_.meta["backend"] = "gl:test";
     tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F);
     baseline_ = compareFrames(ref_, ref_, ref_, tol_);
@@ -351,8 +355,7 @@ TEST_F(CompareTest, GlAgainstGlUsesTheReferenceUncertainty) {
 
 TEST_F(CompareTest, WithoutUncertaintyEveryMismatchIsHard) {
   Frame plain = ref_;
-  plain.edge_dist.clear();
-  plain.depth_gap.clear();
+  plain.clearUncertainty();
   ref_.edge_dist[ref_.index(80, 30)] = 0.0f;
   gl_.id[ref_.index(80, 30)] = 0;
   const PairResult r = compareFrames(plain, gl_, plain, tol_);
@@ -536,8 +539,7 @@ TEST_P(FastPathTest, VectorAndGeneralPathsAgree) {
   };
   requantize(ref);
   Frame gl = ref;
-  gl.edge_dist.clear();
-  gl.depth_gap.clear();
+  gl.clearUncertainty();
   std::mt19937 rng(5);
   std::uniform_int_distribution<int> dz(-30, 30);
   std::uniform_real_distribution<float> dc(-6.0f / 255.0f, 6.0f / 255.0f);
@@ -591,9 +593,11 @@ TEST(CompareEdgeCases, DegenerateFramesNeverCrash) {
   one.depth_gap[0] = std::numeric_limits<float>::quiet_NaN();
   ClassMaps maps;
   r = compareFrames(one, other, one, tol, &maps);
-  EXPECT_EQ(r.depth.slope_unknown, 1u);     // a one-pixel triangle has no neighbours:
-  EXPECT_EQ(r.depth.status, Status::Warn);  // its legal error is unbounded, it cannot fail
+  EXPECT_EQ(r.depth.status, Status::Fail);  // depth_slope 0: the reference says it is flat
   EXPECT_EQ(r.shading.status, Status::Fail);
+  one.depth_slope[0] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(compareFrames(one, other, one, tol).depth.status, Status::Fail);  // NaN excuses nothing
+  one.depth_slope[0] = 0.0f;
   other.id[0] = 0;
   r = compareFrames(one, other, one, tol);
   EXPECT_EQ(r.visibility.hard, 1u);  // NaN edge_dist excuses nothing
@@ -612,70 +616,144 @@ TEST(CompareEdgeCases, DegenerateFramesNeverCrash) {
   EXPECT_EQ(r.status, Status::Fail);
 }
 
-// Nearest texture filtering: at a texel edge the driver may take the texel on the other
-// side (float32 texture coordinates within rounding of the edge). That colour is what
-// the reference shows next door, so it passes when the frames say nearest-filtered
-// textures were drawn; the same change fails without that, and a colour no neighbour
-// has fails either way, also right at the edge.
-TEST(TexelChoice, TheNeighbouringTexelPassesOnlyForNearestTextures) {
-  testing::Rect r;
-  r.x0 = 0;
-  r.y0 = 0;
-  r.x1 = 16;
-  r.y1 = 8;
-  Frame ref = testing::renderRects(16, 8, {r});
-  for (int y = 0; y < 8; ++y)  // two texels: 0.2 left of x = 8, 0.8 from it
-    for (int x = 0; x < 16; ++x)
-      for (int c = 0; c < 3; ++c) ref.color[ref.index(x, y) * 4 + c] = x < 8 ? 0.2f : 0.8f;
-  Frame gl = ref;
-  gl.edge_dist.clear();
-  gl.depth_gap.clear();
-  gl.meta["backend"] = "gl:test";
-  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 4) * 4 + c] = 0.2f;  // the left texel
-
-  auto compareWith = [&](const char* filter, bool textured) {
-    for (Frame* f : {&ref, &gl}) {
-      f->meta["texture_filter"] = filter;
-      f->meta["textured"] = textured;
-    }
-    return compareFrames(ref, gl, ref, tolerancesForFrames(ref, gl));
+// Nearest texture filtering: a sample within the slope band of a texel boundary may take
+// the texel across it; the reference says so at the pixel (texel_dist) with the colour
+// change that makes (texel_alt). Exactly that much passes there; more, or the same change
+// at a pixel whose boundary is farther than the band, fails.
+TEST_F(CompareTest, TexelChoiceAllowsTheOtherTexelOnlyWithinTheBand) {
+  const double band = baseline_.depth.band_px;  // the slope band
+  const Block near_edge{70, 25, 74, 29};
+  const Block far_edge{80, 25, 84, 29};
+  const float alt = 40.0f;  // units
+  forBlock(near_edge, [&](int x, int y) {
+    ref_.texel_dist[ref_.index(x, y)] = static_cast<float>(band * 0.99);
+    ref_.texel_alt[ref_.index(x, y)] = alt;
+  });
+  forBlock(far_edge, [&](int x, int y) {
+    ref_.texel_dist[ref_.index(x, y)] = static_cast<float>(band * 1.01);
+    ref_.texel_alt[ref_.index(x, y)] = alt;
+  });
+  auto offset = [&](const Block& b, float units) {
+    forBlock(b, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4] += units / 255.0f; });
   };
-  EXPECT_EQ(compareWith("nearest", true).shading.status, Status::Pass);
-  EXPECT_EQ(compareWith("nearest", false).shading.status, Status::Fail);
-  EXPECT_EQ(compareWith("linear", true).shading.status, Status::Fail);
+  offset(near_edge, alt);  // the other texel, exactly
+  PairResult r = compare();
+  EXPECT_EQ(r.shading.status, Status::Pass);
+  EXPECT_EQ(r.shading.texel_choice, static_cast<std::uint64_t>(near_edge.size()));
+  offset(near_edge, 1.0f);  // one unit beyond it: every pixel fails
+  r = compare();
+  EXPECT_EQ(r.shading.over_fail, static_cast<std::uint64_t>(near_edge.size()));
+  offset(near_edge, -1.0f);
+  offset(far_edge, alt);  // the boundary is farther than the band: not a legal choice
+  r = compare();
+  EXPECT_EQ(r.shading.over_fail, static_cast<std::uint64_t>(far_edge.size()));
+  EXPECT_TRUE(far_edge.contains(r.shading.worst));
+  // The texture does not change alpha.
+  offset(far_edge, -alt);
+  forBlock(near_edge, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4 + 3] += 5.0f / 255.0f; });
+  EXPECT_EQ(compare().shading.over_fail, static_cast<std::uint64_t>(near_edge.size()));
+}
 
-  // Inside a texel (x = 12: every neighbour 0.8) a different colour is an error.
-  for (int c = 0; c < 3; ++c) gl.color[gl.index(12, 4) * 4 + c] = 0.5f;
-  const PairResult inside = compareWith("nearest", true);
-  EXPECT_EQ(inside.shading.status, Status::Fail);
-  EXPECT_EQ(inside.shading.over_fail, 1u);
-  EXPECT_EQ(inside.shading.worst.x, 12);
-  EXPECT_EQ(inside.shading.worst.y, 4);
+// rgba8 blending: each blended fragment may round its way (2 units, docs/tolerances.md).
+TEST_F(CompareTest, Rgba8BlendsEachAddTheirRounding) {
+  tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);
+  for (Frame* f : {&ref_, &gl_})
+    for (float& c : f->color) c = std::nearbyint(c * 255.0f) / 255.0f;  // 8-bit values
+  const Block b = kBackBlock;
+  forBlock(b, [&](int x, int y) { ref_.blend_count[ref_.index(x, y)] = 3.0f; });
+  // Up to 1 (the final rounding) + 2 x 3 units passes; 8 fails.
+  forBlock(b, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4 + 1] += 7.0f / 255.0f; });
+  EXPECT_EQ(compare().shading.status, Status::Pass);
+  forBlock(b, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4 + 1] += 1.0f / 255.0f; });
+  const PairResult r = compare();
+  EXPECT_EQ(r.shading.over_fail, static_cast<std::uint64_t>(b.size()));
+  // In rgba32f blends add no allowance (float arithmetic: the relative term covers them).
+  EXPECT_EQ(defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F).blend_rounding_units, 0.0);
+}
 
-  // An injected offset of 10 units on a 4x4 block across the texel edge: every pixel of
-  // the block fails, the flipped pixel still passes.
-  gl = ref;
-  gl.edge_dist.clear();
-  gl.depth_gap.clear();
-  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 4) * 4 + c] = 0.2f;
-  for (int y = 0; y < 4; ++y)
-    for (int x = 6; x < 10; ++x) gl.color[gl.index(x, y) * 4] += 10.0f / 255.0f;
-  const PairResult block = compareWith("nearest", true);
-  EXPECT_EQ(block.shading.over_fail, 16u);
-  EXPECT_EQ(block.visibility.mismatched, 0u);
-  EXPECT_EQ(block.depth.over_tolerance, 0u);
+// A blended pixel whose lower fragments may legally differ (an edge within the band, or a
+// blended fragment's depth test within tolerance of flipping) is not held to the depth
+// and shading tolerances; just outside either condition it is.
+TEST_F(CompareTest, BlendedPixelsWithAnUncertainFragmentSetAreExcused) {
+  const double band = baseline_.visibility.band_px;
+  const Block edge{70, 25, 74, 29};
+  const Block tie{80, 25, 84, 29};
+  const Block neither{90, 25, 94, 29};
+  const double tie_limit = 2.0 * tol_.depth.fail;  // blend_slope 0
+  forBlock(edge, [&](int x, int y) {
+    ref_.blend_count[ref_.index(x, y)] = 1.0f;
+    ref_.edge_dist[ref_.index(x, y)] = static_cast<float>(band * 0.99);
+  });
+  forBlock(tie, [&](int x, int y) {
+    ref_.blend_count[ref_.index(x, y)] = 2.0f;
+    ref_.blend_gap[ref_.index(x, y)] = static_cast<float>(tie_limit * 0.99);
+  });
+  forBlock(neither, [&](int x, int y) {
+    const std::size_t i = ref_.index(x, y);
+    ref_.blend_count[i] = 1.0f;
+    ref_.edge_dist[i] = static_cast<float>(band * 1.01);
+    ref_.blend_gap[i] = static_cast<float>(tie_limit * 1.01);
+  });
+  for (const Block& b : {edge, tie, neither})
+    forBlock(b, [&](int x, int y) {
+      const std::size_t i = gl_.index(x, y);
+      gl_.color[i * 4 + 2] += 12.0f / 255.0f;
+      gl_.depth[i] = quantized(gl_.depth[i], 500.0);
+    });
+  const PairResult r = compare();
+  const auto n = static_cast<std::uint64_t>(neither.size());
+  EXPECT_EQ(r.shading.over_fail, n);
+  EXPECT_EQ(r.depth.over_fail, n);
+  EXPECT_EQ(r.shading.blend_uncertain, 2 * n);
+  EXPECT_EQ(r.depth.blend_uncertain, 2 * n);
+  EXPECT_TRUE(neither.contains(r.shading.worst));
+  // Without a blend the same pixels are plain opaque ones: nothing is excused.
+  forBlock(edge, [&](int x, int y) { ref_.blend_count[ref_.index(x, y)] = 0.0f; });
+  EXPECT_EQ(compare().shading.over_fail, 2 * n);
+}
 
-  // Minified textures: the other texel is no neighbour's colour but lies within the
-  // range around the pixel. Alone at an edge it passes; the same change on two adjacent
-  // pixels (a region moved, not one sample) fails on both.
-  gl = ref;
-  gl.edge_dist.clear();
-  gl.depth_gap.clear();
-  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 2) * 4 + c] = 0.3f;
-  EXPECT_EQ(compareWith("nearest", true).shading.status, Status::Pass);
-  EXPECT_EQ(compareWith("nearest", false).shading.status, Status::Fail);
-  for (int c = 0; c < 3; ++c) gl.color[gl.index(8, 3) * 4 + c] = 0.3f;
-  EXPECT_EQ(compareWith("nearest", true).shading.over_fail, 2u);
+// The depth slope allowance comes from the reference's depth_slope at the pixel, however
+// few pixels the primitive shows: a one-pixel-wide sliver gets its true steep slope.
+TEST(DepthSlope, TheAllowanceIsTheReferencesSlopeAtThePixel) {
+  Frame f;
+  const float clear[4] = {0, 0, 0, 0};
+  f.allocate(64, 16, clear, 1.0f, true);
+  f.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
+  const double slope = std::hypot(3000.0, 40000.0);  // steps/px
+  for (int x = 2; x < 60; ++x) {                     // a one-pixel row
+    const std::size_t i = f.index(x, 7);
+    f.id[i] = 7;
+    f.depth[i] = static_cast<float>(std::nearbyint(2e6 + 3000.0 * x) / kD24);
+    f.color[i * 4 + 3] = 1.0f;
+    f.depth_slope[i] = static_cast<float>(slope);
+  }
+  Frame g = f;
+  g.clearUncertainty();
+  const Tolerances tol = tolerancesForFrames(f, g);
+  const std::size_t probe = f.index(31, 7);
+  const double allowance = slope * compareFrames(f, f, f, tol).depth.band_px;
+  auto off = [&](double steps) {
+    g.depth[probe] = static_cast<float>((std::nearbyint(f.depth[probe] * kD24) + steps) / kD24);
+    return compareFrames(f, g, f, tol);
+  };
+  const PairResult within = off(std::floor(tol.depth.warn + allowance));
+  EXPECT_EQ(within.depth.status, Status::Pass);
+  EXPECT_NEAR(within.depth.worst_allowance, allowance, 1e-3 * allowance);
+  EXPECT_EQ(off(std::ceil(tol.depth.fail + allowance) + 1.0).depth.over_fail, 1u);
+}
+
+// Missing and extra pixels near the clear depth: the reference's clear_gap says how close
+// the fragment's test against the clear depth came to flipping.
+TEST_F(CompareTest, ClearGapExcusesMissingOnlyWithinOneDepthTolerance) {
+  const Block b{70, 25, 72, 26};
+  forBlock(b, [&](int x, int y) { gl_.id[gl_.index(x, y)] = 0; });
+  ref_.clear_gap[ref_.index(70, 25)] = static_cast<float>(tol_.depth.fail * 0.99);
+  ref_.clear_gap[ref_.index(71, 25)] = static_cast<float>(tol_.depth.fail * 1.01);
+  const PairResult r = compare();
+  EXPECT_EQ(r.visibility.missing, 2u);
+  EXPECT_EQ(r.visibility.missing_hard, 1u);
+  EXPECT_EQ(r.visibility.ambiguous_by_depth_gap, 1u);
+  EXPECT_EQ(r.visibility.worst.x, 71);
 }
 
 }  // namespace

@@ -68,8 +68,7 @@ class RealFramesTest : public ::testing::Test {
   void SetUp() override {
     ref_ = render(catalog("shading/teapot.json"));
     actual_ = ref_;
-    actual_.edge_dist.clear();
-    actual_.depth_gap.clear();
+    actual_.clearUncertainty();
     actual_.meta["backend"] = "ref+fault";
     tol_ = tolerancesForFrames(ref_, actual_);
     baseline_ = compareFrames(ref_, actual_, ref_, tol_);
@@ -316,52 +315,6 @@ TEST(Ambiguity, AClearOcclusionErrorIsHard) {
     EXPECT_GT(zbuffer.depth_gap[i], 2.0 * tol.depth.fail) << i;
   }
   EXPECT_GT(zbuffer.depth_gap[zbuffer.index(r.visibility.worst.x, r.visibility.worst.y)], 100.0f);
-}
-
-// ---- Depth slope on slivers ----
-
-TEST(SliverSlopes, PrimitivesWithoutNeighboursGetTheirPlaneFromAllTheirPixels) {
-  // A steep sliver (a long thin triangle seen nearly edge-on): 1-2 px wide, so its
-  // neighbourhood never shows it along both axes, but its pixels span a plane.
-  Frame f;
-  const float clear[4] = {0, 0, 0, 0};
-  f.allocate(64, 16, clear, 1.0f, true);
-  f.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
-  const double slope_x = 3000.0;  // steps per px
-  const double slope_y = 40000.0;
-  for (int x = 2; x < 60; ++x) {
-    for (int y = 7; y <= (x % 3 == 0 ? 8 : 7); ++y) {  // a ragged one- or two-pixel row
-      const std::size_t i = f.index(x, y);
-      f.id[i] = 7;
-      f.depth[i] = static_cast<float>(std::nearbyint(2e6 + slope_x * x + slope_y * y) / kD24);
-      f.color[i * 4] = 0.5f;
-      f.color[i * 4 + 3] = 1.0f;
-      f.edge_dist[i] = 0.3f;
-    }
-  }
-  Frame g = f;
-  g.edge_dist.clear();
-  g.depth_gap.clear();
-  // 60 steps off at one pixel: within the allowance of the true slope (|(3000, 40000)| x
-  // the band ~ 221 steps), far above what its row neighbours alone show (3000 x band).
-  const std::size_t probe = f.index(31, 7);
-  g.depth[probe] = static_cast<float>((std::nearbyint(f.depth[probe] * kD24) + 60) / kD24);
-  const Tolerances tol = tolerancesForFrames(f, g);
-  const PairResult r = compareFrames(f, g, f, tol);
-  EXPECT_EQ(r.depth.max_steps, 60.0);
-  EXPECT_EQ(r.depth.slope_fitted, 1u);
-  EXPECT_EQ(r.depth.over_tolerance, 0u);
-  EXPECT_NEAR(r.depth.worst_allowance, std::hypot(slope_x, slope_y) * r.depth.band_px,
-              0.01 * std::hypot(slope_x, slope_y) * r.depth.band_px);
-  // A lone pixel with nothing drawn around it has no slope: it may warn, never fail.
-  Frame lone = f;
-  std::fill(lone.id.begin(), lone.id.end(), 0u);
-  lone.id[probe] = 9;
-  Frame lone_g = g;
-  lone_g.id = lone.id;
-  const PairResult l = compareFrames(lone, lone_g, lone, tol);
-  EXPECT_EQ(l.depth.slope_unknown, 1u);
-  EXPECT_EQ(l.depth.status, Status::Warn);
 }
 
 }  // namespace

@@ -63,8 +63,7 @@ class ReportTest : public ::testing::Test {
     const Tolerances tol = tolerancesForFrames(ref, ref);
 
     auto add = [&](Frame actual, const std::string& fixture, const std::string& backend) {
-      actual.edge_dist.clear();
-      actual.depth_gap.clear();
+      actual.clearUncertainty();
       actual.meta["backend"] = backend;
       Frame expected = ref;
       expected.meta["fixture"] = fixture;

@@ -43,6 +43,8 @@ Frame renderRects(int width, int height, const std::vector<Rect>& rects) {
       const std::size_t i = f.index(x, y);
       double best = std::numeric_limits<double>::infinity();
       double second = std::numeric_limits<double>::infinity();
+      double best_slope = 0.0;  // steps/px of the winner and of the steepest other
+      double other_slope = 0.0;
       double edge = 1.0;
       for (const Rect& r : rects) {
         const std::array<Vec, 4> c = {Vec{r.x0, r.y0}, Vec{r.x1, r.y0}, Vec{r.x1, r.y1},
@@ -57,11 +59,15 @@ Frame renderRects(int width, int height, const std::vector<Rect>& rects) {
         if (p.x < r.x0 || p.x >= r.x1 || p.y < r.y0 || p.y >= r.y1) continue;
         const double z = r.z0 + r.dzdx * (p.x - r.x0) + r.dzdy * (p.y - r.y0);
         const double zs = std::nearbyint(z * 16777215.0);
+        const double slope = std::hypot(r.dzdx, r.dzdy) * 16777215.0;
         if (zs < best) {
           second = best;
           best = zs;
+          if (std::isfinite(second)) other_slope = std::max(other_slope, best_slope);
+          best_slope = slope;
         } else {
           second = std::min(second, zs);
+          other_slope = std::max(other_slope, slope);
           continue;
         }
         const double cross = (r.x1 - r.x0) * (p.y - r.y0) - (r.y1 - r.y0) * (p.x - r.x0);
@@ -75,6 +81,11 @@ Frame renderRects(int width, int height, const std::vector<Rect>& rects) {
       }
       f.edge_dist[i] = static_cast<float>(edge);
       f.depth_gap[i] = static_cast<float>(second - best);  // +inf when one fragment
+      f.depth_slope[i] = static_cast<float>(best_slope);
+      // The steeper of the two fragments of any comparison (an upper bound of the
+      // reference's, which keeps only the comparisons that decided the id).
+      if (std::isfinite(second))
+        f.gap_slope[i] = static_cast<float>(std::max(best_slope, other_slope));
     }
   }
   return f;

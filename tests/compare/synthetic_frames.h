@@ -1,7 +1,8 @@
 // Reference-like frames built in code for the comparator's tests and benchmark: a few
 // axis-aligned rectangles, each two triangles split along its diagonal, with depth planes
-// and colour gradients, z-buffered, with edge_dist and depth_gap computed independently
-// of the comparator (exact geometry, not pixels). Faults are then injected into copies.
+// and colour gradients, z-buffered, with edge_dist, depth_gap, depth_slope and gap_slope
+// computed independently of the comparator (exact geometry, not pixels). Faults are then
+// injected into copies.
 #pragma once
 
 #include <cstdint>

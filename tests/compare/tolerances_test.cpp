@@ -216,13 +216,11 @@ TEST(ToleranceDefaults, LinearTexturesGetTheFilteringAllowanceOnly) {
   EXPECT_EQ(plain.texture_rounding_units, 0.0);
   EXPECT_EQ(textured.texture_weight_error, 2.0 / 256.0);
   EXPECT_EQ(textured.texture_rounding_units, 1.0);
-  EXPECT_EQ(plain.texel_choice, 0.0);
-  EXPECT_EQ(textured.texel_choice, 0.0);
-  DrawnWith nearest;
-  nearest.nearest_textures = true;
-  const Tolerances near = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F, nearest);
-  EXPECT_EQ(near.texel_choice, 1.0);
-  EXPECT_EQ(near.texture_weight_error, 0.0);
+  // The texel choice applies wherever the reference's texel_alt says so, whatever the
+  // frames' metadata: always on.
+  EXPECT_EQ(plain.texel_choice, 1.0);
+  EXPECT_EQ(textured.texel_choice, 1.0);
+  EXPECT_EQ(plain.blend_rounding_units, 0.0);
   EXPECT_EQ(textured.shading.fail, plain.shading.fail);
   EXPECT_EQ(plain.shading_relative, 1.0 / 1024.0);
   // rgba8: one unit of rounding passes, two fail.

@@ -14,6 +14,7 @@
 #include "compare/pair_images.h"
 #include "compare/report.h"
 #include "fixtures/catalog.h"
+#include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
 #include "fixtures/scene_writer.h"
@@ -167,118 +168,42 @@ std::vector<std::string> catalogNames() {
   return out;
 }
 
-fs::path expectationsFile() {
-  return fs::path(RC_SOURCE_DIR) / "tests" / "conformance" / "expectations.json";
-}
+fs::path expectationsFile() { return fs::path(RC_SOURCE_DIR) / "fixtures" / "expectations.json"; }
 
-Expectations parseExpectations(const nlohmann::json& doc, const std::set<std::string>& fixtures,
-                               const std::vector<std::string>& known) {
-  Expectations out;
-  if (!doc.is_object() || !doc.contains("expectations") || !doc["expectations"].is_array()) {
-    out.errors.emplace_back("expectations: must be an array under the top-level object");
-    return out;
-  }
-  for (const auto& [key, value] : doc.items()) {
-    if (key != "about" && key != "expectations")
-      out.errors.push_back(fmt::format("{}: unknown key", key));
-  }
-  static const std::set<std::string> classes = {"visibility", "depth", "shading"};
-  std::set<std::tuple<std::string, std::string, std::string>> seen;
-  const auto& list = doc["expectations"];
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const auto& e = list[i];
-    const std::string at = fmt::format("expectations[{}]", i);
-    const std::size_t before = out.errors.size();
-    if (!e.is_object()) {
-      out.errors.push_back(fmt::format("{}: must be an object", at));
-      continue;
-    }
-    Expectation x;
-    for (const auto& [key, value] : e.items()) {
-      std::string* field = key == "fixture"   ? &x.fixture
-                           : key == "backend" ? &x.backend
-                           : key == "class"   ? &x.cls
-                           : key == "reason"  ? &x.reason
-                                              : nullptr;
-      if (field == nullptr) {
-        out.errors.push_back(fmt::format("{}.{}: unknown key", at, key));
-      } else if (!value.is_string()) {
-        out.errors.push_back(fmt::format("{}.{}: must be a string", at, key));
-      } else {
-        *field = value.get<std::string>();
-      }
-    }
-    for (const char* key : {"fixture", "backend", "class", "reason"}) {
-      if (!e.contains(key)) out.errors.push_back(fmt::format("{}.{}: missing", at, key));
-    }
-    // Values are checked only where they are strings (else that is the error already).
-    auto given = [&e](const char* key) { return e.contains(key) && e[key].is_string(); };
-    if (given("fixture") && !fixtures.count(x.fixture))
+SuiteExpectations checkExpectations(const Expectations& parsed,
+                                    const std::set<std::string>& fixtures,
+                                    const std::vector<std::string>& known) {
+  SuiteExpectations out;
+  out.parsed = parsed;
+  for (std::size_t i = 0; i < parsed.entries.size(); ++i) {
+    const Expectation& e = parsed.entries[i];
+    const std::string at = fmt::format("expectations[{}] ({})", i, e.id);
+    const bool pattern = e.fixture.find_first_of("*?") != std::string::npos;
+    if (!pattern && !fixtures.count(e.fixture))
       out.errors.push_back(
-          fmt::format("{}.fixture: no fixture named \"{}\" in the catalog", at, x.fixture));
-    if (given("backend")) {
-      bool any = false;
-      for (const std::string& b : known) any = any || backendMatches(x.backend, b);
-      if (!any)
-        out.errors.push_back(
-            fmt::format("{}.backend: \"{}\" matches none of the suite's backends", at, x.backend));
-    }
-    if (given("class") && !classes.count(x.cls))
+          fmt::format("{}.fixture: no fixture named \"{}\" in the catalog", at, e.fixture));
+    bool any = false;
+    for (const std::string& b : known) any = any || backendMatches(e.backend, b);
+    if (!any)
       out.errors.push_back(
-          fmt::format("{}.class: \"{}\" is not one of visibility, depth, shading", at, x.cls));
-    if (given("reason") && x.reason.find_first_not_of(" \t") == std::string::npos)
-      out.errors.push_back(fmt::format("{}.reason: must say why", at));
-    if (out.errors.size() != before) continue;
-    if (!seen.emplace(x.fixture, x.backend, x.cls).second) {
-      out.errors.push_back(fmt::format("{}: repeats an earlier entry ({}, {}, {})", at, x.fixture,
-                                       x.backend, x.cls));
-      continue;
-    }
-    out.entries.push_back(x);
+          fmt::format("{}.backend: \"{}\" matches none of the suite's backends", at, e.backend));
   }
   return out;
 }
 
-const Expectations& expectations() {
-  static const Expectations parsed = [] {
-    std::ifstream in(expectationsFile());
-    const auto doc = nlohmann::json::parse(in, nullptr, false);
-    if (doc.is_discarded()) {
-      Expectations bad;
-      bad.errors.push_back(fmt::format("{}: not valid JSON", expectationsFile().string()));
+const SuiteExpectations& expectations() {
+  static const SuiteExpectations checked = [] {
+    try {
+      const std::vector<std::string> names = catalogNames();
+      return checkExpectations(readExpectations(expectationsFile()), {names.begin(), names.end()},
+                               knownBackends());
+    } catch (const InputError& e) {
+      SuiteExpectations bad;
+      bad.errors.emplace_back(e.what());
       return bad;
     }
-    const std::vector<std::string> names = catalogNames();
-    return parseExpectations(doc, {names.begin(), names.end()}, knownBackends());
   }();
-  return parsed;
-}
-
-bool backendMatches(const std::string& pattern, const std::string& backend) {
-  auto split = [](const std::string& s) {
-    std::vector<std::string> parts;
-    std::size_t start = 0;
-    for (std::size_t i = 0; i <= s.size(); ++i) {
-      if (i == s.size() || s[i] == ':') {
-        parts.push_back(s.substr(start, i - start));
-        start = i + 1;
-      }
-    }
-    return parts;
-  };
-  const auto p = split(pattern);
-  const auto b = split(backend);
-  if (p.size() != b.size()) return false;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    if (p[i] != "*" && p[i] != b[i]) return false;
-  return true;
-}
-
-std::vector<Expectation> expectationsFor(const std::string& fixture, const std::string& backend) {
-  std::vector<Expectation> out;
-  for (const Expectation& e : expectations().entries)
-    if (e.fixture == fixture && backendMatches(e.backend, backend)) out.push_back(e);
-  return out;
+  return checked;
 }
 
 Tolerances tolerancesFor(const Scene& scene, const Frame& expected, const Frame& actual) {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "compare/compare.h"
+#include "compare/expectations.h"
 #include "fixtures/frame.h"
 #include "fixtures/scene.h"
 
@@ -62,28 +63,20 @@ std::set<std::string> failingClasses(const PairResult& result);
 std::filesystem::path catalogDir();
 std::vector<std::string> catalogNames();
 
-// tests/conformance/expectations.json: known, understood differences. Each entry names a
-// fixture of the catalog, a backend (exact, or with '*' as a wildcard for one
-// ':'-separated part) that matches at least one known backend, a class that is expected
-// to fail, and the reason.
-struct Expectation {
-  std::string fixture;
-  std::string backend;
-  std::string cls;
-  std::string reason;
+// fixtures/expectations.json (compare/expectations.h), checked against the suite: an
+// entry naming one fixture exactly must name a catalog fixture, and every backend pattern
+// must match one of the suite's backends. `errors`: one line per problem (a parse error is
+// one line too); never throws.
+struct SuiteExpectations {
+  Expectations parsed;
+  std::vector<std::string> errors;
 };
-struct Expectations {
-  std::vector<Expectation> entries;  // the valid ones
-  std::vector<std::string> errors;   // one line per problem, naming the JSON path
-};
-// Validates `doc` against the fixture names and backends given; never throws.
-Expectations parseExpectations(const nlohmann::json& doc, const std::set<std::string>& fixtures,
-                               const std::vector<std::string>& backends);
-// The file in the source tree, parsed and validated against the catalog (cached).
-const Expectations& expectations();
+SuiteExpectations checkExpectations(const Expectations& parsed,
+                                    const std::set<std::string>& fixtures,
+                                    const std::vector<std::string>& backends);
+// The file in the source tree, parsed and checked against the catalog (cached).
+const SuiteExpectations& expectations();
 std::filesystem::path expectationsFile();
-bool backendMatches(const std::string& pattern, const std::string& backend);
-std::vector<Expectation> expectationsFor(const std::string& fixture, const std::string& backend);
 
 // Writes the pair's images and a one-pair report under the build tree for a person to
 // open after a failure; returns the report folder.

@@ -1,5 +1,6 @@
 // Depth quantization per format against hand-computed values, the depth test, and the
 // uncertainty channels (depth_gap, edge_dist) against analytic values.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -109,6 +110,9 @@ TEST(DepthGap, TwoParallelPlanesAKnownNumberOfStepsApart) {
     const double expected = 10.0 / 16777216.0 * steps;  // d24: 9.9999994, d32f: 10
     for (int y = 0; y < 8; ++y) {
       const float gap = f.depth_gap[f.index(3, y)];
+      // Every plane would have to fail against the clear depth 1 for background: the
+      // farthest from it, the plane at 0.5 (or 10 steps nearer), decides.
+      EXPECT_NEAR(f.clear_gap[f.index(3, y)], 0.5 * steps, 1e-5 * steps) << y;
       if (y < 4)
         EXPECT_EQ(gap, std::numeric_limits<float>::infinity()) << y;  // one plane only
       else
@@ -179,14 +183,21 @@ TEST(DepthGap, AlphaPassCountsOnlyTheComparisonsThatDecidedTheWinner) {
 
 // The depth_gap definition evaluated by brute force: simulate the pixel's fragments, flip
 // each depth comparison's outcome alone (later fragments re-tested against what then gets
-// stored), and keep |z_f - z_s| of every comparison whose flip changes the final fragment.
+// stored), and keep |z_f - z_s| of every comparison with a stored fragment whose flip
+// changes the final fragment. clear_gap by its definition: a drawn pixel is background
+// only if every tested fragment fails against the clear depth 1 (the largest |z - 1|), a
+// background pixel drawn if one passes (the smallest); +inf with an untested fragment.
+struct Gaps {
+  double depth = std::numeric_limits<double>::infinity();
+  double clear = std::numeric_limits<double>::infinity();
+};
 struct TestFragment {
   double z;
   bool tested;  // LESS, else ALWAYS
   bool writes;
 };
 
-double bruteForceGap(const std::vector<TestFragment>& frags, DepthFormat format) {
+Gaps bruteForceGaps(const std::vector<TestFragment>& frags, DepthFormat format) {
   const std::uint32_t clear = ref::depthKey(1.0, format);
   struct Run {
     int final = -1;
@@ -214,14 +225,23 @@ double bruteForceGap(const std::vector<TestFragment>& frags, DepthFormat format)
     return r;
   };
   const Run base = simulate(-1);
-  double gap = std::numeric_limits<double>::infinity();
+  Gaps gaps;
   for (const auto& [f, s] : base.comparisons) {
-    if (s < 0) continue;  // against the clear depth: not counted
-    if (simulate(f).final != base.final)
-      gap = std::min(gap, std::fabs(frags[static_cast<std::size_t>(f)].z -
-                                    frags[static_cast<std::size_t>(s)].z));
+    if (s < 0 || simulate(f).final == base.final) continue;
+    gaps.depth = std::min(gaps.depth, std::fabs(frags[static_cast<std::size_t>(f)].z -
+                                                frags[static_cast<std::size_t>(s)].z));
   }
-  return gap;
+  bool untested = false;
+  double near = std::numeric_limits<double>::infinity();
+  double far = -1.0;
+  for (const TestFragment& f : frags) {
+    untested = untested || !f.tested;
+    if (!f.tested) continue;
+    near = std::min(near, 1.0 - f.z);
+    far = std::max(far, 1.0 - f.z);
+  }
+  if (!untested && far >= 0.0) gaps.clear = base.final >= 0 ? far : near;
+  return gaps;
 }
 
 TEST(DepthGap, TrackerEqualsTheBruteForceDefinitionOnRandomPixels) {
@@ -244,25 +264,35 @@ TEST(DepthGap, TrackerEqualsTheBruteForceDefinitionOnRandomPixels) {
       const double z = 0.25 + 0.001 * rnd(16) + (rnd(2) ? 1e-6 * rnd(8) : 0.0);
       frags.push_back({z, !always, i < opaque});
     }
-    float got = std::numeric_limits<float>::infinity();  // the frame's depth_gap pixel
-    ref::DepthGapTracker tracker;
-    tracker.reset(1, format, &got);
+    Frame pixel;  // one pixel's uncertainty channels
+    const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    pixel.allocate(1, 1, clear, 1.0f, true);
+    ref::UncertaintyTracker tracker;
+    tracker.reset(pixel, format, 1.0);
     std::uint32_t stored = ref::depthKey(1.0, format);
     for (const TestFragment& f : frags) {
       const std::uint32_t key = ref::depthKey(f.z, format);
       if (!f.tested || key < stored) {
-        tracker.passed(0, f.z, f.tested, f.writes);
+        tracker.passed(0, f.z, 0.0f, f.tested, f.writes, !f.writes);
+        pixel.id[0] = 1;  // drawn
         if (f.writes) stored = key;
       } else {
-        tracker.failed(0, f.z);
+        tracker.failed(0, f.z, 0.0f, !f.writes);
       }
     }
-    const double want = bruteForceGap(frags, format);
-    const float expected = std::isinf(want)
-                               ? std::numeric_limits<float>::infinity()
-                               : static_cast<float>(want * ref::depthStepsPerUnit(format));
-    ASSERT_EQ(got, expected) << "trial " << trial;
-    finite += !std::isinf(want);
+    tracker.finish(pixel);
+    const Gaps want = bruteForceGaps(frags, format);
+    auto steps = [&](double gap) {
+      return std::isinf(gap) ? std::numeric_limits<float>::infinity()
+                             : static_cast<float>(gap * ref::depthStepsPerUnit(format));
+    };
+    ASSERT_EQ(pixel.depth_gap[0], steps(want.depth)) << "trial " << trial;
+    std::string history;
+    for (const TestFragment& f : frags)
+      history += fmt::format(" (z {}, {}, {})", f.z, f.tested ? "LESS" : "ALWAYS",
+                             f.writes ? "writes" : "no writes");
+    ASSERT_EQ(pixel.clear_gap[0], steps(want.clear)) << "trial " << trial << ":" << history;
+    finite += !std::isinf(want.depth);
   }
   EXPECT_GT(finite, 5000);  // the cases are not all trivial
 }

@@ -223,8 +223,7 @@ std::string frameBytes(const Frame& frame) {
   append(out, frame.color);
   append(out, frame.depth);
   append(out, frame.id);
-  append(out, frame.edge_dist);
-  append(out, frame.depth_gap);
+  for (const std::vector<float>* c : frame.uncertainty()) append(out, *c);
   return out;
 }
 

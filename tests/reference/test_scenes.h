@@ -50,8 +50,8 @@ struct NamedScene {
 };
 std::vector<NamedScene> featureScenes();
 
-// The pixel channels of a frame as raw bytes (colour, depth, id, edge_dist, depth_gap), for
-// bit-exact comparisons.
+// The pixel channels of a frame as raw bytes (colour, depth, id, every uncertainty channel),
+// for bit-exact comparisons.
 std::string frameBytes(const Frame& frame);
 
 // ---- benchmark scenes (bench/reference, bench/gl) ----------------------------------------

@@ -1,0 +1,177 @@
+// The reference's per-fragment uncertainty channels (frame.h UncertaintyChannel) against
+// values worked out by hand from the scene geometry: depth_slope and gap_slope from the
+// planes, texel_dist and texel_alt from texel boundaries and texel values, blend_count and
+// blend_gap from the layers drawn.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "reference/fragment_ops.h"
+#include "reference/reference_renderer.h"
+#include "tests/reference/test_scenes.h"
+
+namespace rc {
+namespace {
+
+constexpr double kD24 = 16777215.0;
+
+// windowScene maps world (x, y) to GL window (x, y) and world z to window depth 1 - z, so a
+// plane z = a + b x + c y has |grad window z| = hypot(b, c) per px.
+TEST(UncertaintyChannels, DepthSlopeIsTheGradientOfTheStoredFragmentsPlane) {
+  Scene s = test::windowScene(16, 16);
+  // z = 0.9 - 0.0125 (y + 16): a plane tilted in y over the whole window.
+  test::addTriangle(s, {-16, -16, 0.9f}, {48, -16, 0.9f}, {-16, 48, 0.1f});
+  const Frame f = renderReference(s);
+  const float want = static_cast<float>(0.0125 * kD24);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      ASSERT_EQ(f.id[f.index(x, y)], 1u);
+      EXPECT_NEAR(f.depth_slope[f.index(x, y)], want, want * 1e-6) << x << "," << y;
+    }
+  // Under d16 the same plane counts d16 steps.
+  s.state.depth_format = DepthFormat::D16;
+  const Frame d16 = renderReference(s);
+  EXPECT_NEAR(d16.depth_slope[0], 0.0125 * 65535.0, 0.0125 * 65535.0 * 1e-6);
+}
+
+TEST(UncertaintyChannels, GapSlopeIsTheSteeperFragmentOfTheDecidingComparison) {
+  Scene s = test::windowScene(16, 16);
+  test::addRect(s, -1, -1, 17, 17, 0.5f);  // flat, window depth 0.5, drawn first
+  // Steep, in front on the left: z = 0.9 - 0.05 x (window depth 0.1 + 0.05 x), behind for
+  // x > 8.
+  test::addTriangle(s, {-16, -16, 0.9f + 0.8f}, {48, -16, 0.9f - 2.4f}, {-16, 48, 0.9f + 0.8f});
+  const Frame f = renderReference(s);
+  const float steep = static_cast<float>(0.05 * kD24);
+  for (int x : {2, 13}) {  // steep wins at x = 2, the flat one at x = 13
+    const std::size_t i = f.index(x, 8);
+    EXPECT_NEAR(f.gap_slope[i], steep, steep * 1e-6) << x;
+    const double zs = 0.1 + 0.05 * (x + 0.5);
+    EXPECT_NEAR(f.depth_gap[i], std::fabs(zs - 0.5) * kD24, 2.0) << x;
+  }
+  EXPECT_NEAR(f.depth_slope[f.index(2, 8)], steep, steep * 1e-6);
+  EXPECT_EQ(f.depth_slope[f.index(13, 8)], 0.0f);  // the flat plane stored the depth there
+}
+
+// A 4x2 texture whose rows differ: row 0 (the bottom, v in [0, 0.5), stored first in
+// Texture::rgba) bright (200, 220, 240), row 1 dark (10, 20, 40): 200 units apart at most.
+std::shared_ptr<Texture> rowsTexture() {
+  auto t = std::make_shared<Texture>();
+  t->width = 4;
+  t->height = 2;
+  t->rgba.assign(4 * 8, 255);
+  for (int i = 0; i < 4; ++i) {
+    t->rgba[4 * i + 0] = 200;
+    t->rgba[4 * i + 1] = 220;
+    t->rgba[4 * i + 2] = 240;
+    t->rgba[4 * (4 + i) + 0] = 10;
+    t->rgba[4 * (4 + i) + 1] = 20;
+    t->rgba[4 * (4 + i) + 2] = 40;
+  }
+  return t;
+}
+constexpr double kRowsContrast = 200.0;  // the largest channel difference of the two rows
+
+TEST(UncertaintyChannels, ATriangleSampledExactlyOnATexelBoundaryMayTakeEitherTexel) {
+  // uv (0, 1) at every vertex (as in assimp-testmodels spider.obj): v * 2 = 2 is a texel
+  // boundary under repeat (row 2 wraps to row 0, the driver's 0.99999994 takes row 1).
+  Scene s = test::windowScene(16, 16);
+  s.materials[0].texture = rowsTexture();
+  test::addMesh(s, {{0, 0, 0.5f}, {16, 0, 0.5f}, {0, 16, 0.5f}}, {{0, 1, 2}}, 0, {0, 0, 1},
+                {{0, 1}, {0, 1}, {0, 1}});
+  const Frame f = renderReference(s);
+  const std::size_t i = f.index(3, 12);
+  ASSERT_EQ(f.id[i], 1u);
+  EXPECT_EQ(f.color[4 * i], 200.0f / 255.0f);  // the reference takes row 0 (bright)
+  EXPECT_EQ(f.texel_dist[i], 0.0f);
+  EXPECT_NEAR(f.texel_alt[i], kRowsContrast, 1e-3);  // the other row
+  // Clamp-to-edge has no boundary at v = 1: nothing to choose.
+  s.state.texture_wrap = TextureWrap::Clamp;
+  const Frame c = renderReference(s);
+  EXPECT_EQ(c.texel_dist[i], 1.0f);
+  EXPECT_EQ(c.texel_alt[i], 0.0f);
+  // Linear filtering has no texel boundary to cross.
+  s.state.texture_wrap = TextureWrap::Repeat;
+  s.state.texture_filter = TextureFilter::Linear;
+  const Frame l = renderReference(s);
+  EXPECT_EQ(l.texel_alt[i], 0.0f);
+}
+
+TEST(UncertaintyChannels, TexelDistIsTheScreenDistanceToTheNextTexelBoundary) {
+  // A 4x2 texture over a 16x16 rectangle: a texel is 4 px wide and 8 px high, boundaries
+  // at window x = 4, 8, 12 and y = 8 (and the wrap boundaries at 0 and 16).
+  Scene s = test::windowScene(16, 16);
+  s.materials[0].texture = rowsTexture();
+  test::addRect(s, 0, 0, 16, 16, 0.5f);
+  const Frame f = renderReference(s);
+  // Pixel centre x = 3.5: 0.5 px from the boundary at x = 4 (in s, 0.125 texels at 0.25
+  // texels/px); y = 5.5 (image row 10) is 2.5 px from y = 8 and 5.5 from 0: farther than 1.
+  const std::size_t near_x = f.index(3, 10);
+  EXPECT_NEAR(f.texel_dist[near_x], 0.5, 1e-4);
+  EXPECT_EQ(f.texel_alt[near_x], 0.0f);  // the texels across x = 4 are the same colour
+  // Pixel centre y = 7.5 (image row 8): 0.5 px below the row boundary at y = 8.
+  const std::size_t near_y = f.index(5, 8);
+  EXPECT_NEAR(f.texel_dist[near_y], 0.5, 1e-4);
+  EXPECT_NEAR(f.texel_alt[near_y], kRowsContrast, 1e-3);
+  // Pixel centre (5.5, 5.5): more than a pixel from every boundary.
+  EXPECT_EQ(f.texel_dist[f.index(5, 10)], 1.0f);
+  EXPECT_EQ(f.texel_alt[f.index(5, 10)], 0.0f);
+  // An untextured opaque rectangle drawn over it clears what the texture left.
+  test::addRect(s, 0, 0, 16, 16, 0.8f, test::addMaterial(s, s.materials[0]));
+  s.materials.back().texture = nullptr;
+  const Frame over = renderReference(s);
+  EXPECT_EQ(over.texel_dist[near_y], 1.0f);
+  EXPECT_EQ(over.texel_alt[near_y], 0.0f);
+}
+
+Material translucent(double opacity) {
+  Material m;
+  m.ambient = glm::dvec3(1.0);
+  m.diffuse = glm::dvec3(0.0);
+  m.specular = glm::dvec3(0.0);
+  m.opacity = opacity;
+  return m;
+}
+
+TEST(UncertaintyChannels, BlendCountAndBlendGapFollowTheTransparentLayers) {
+  Scene s = test::windowScene(16, 16);
+  s.state.blend = Blend::Alpha;
+  test::addRect(s, -1, -1, 17, 17, 0.2f);  // opaque, window depth 0.8
+  const std::size_t glass = test::addMaterial(s, translucent(0.5));
+  test::addRect(s, -1, -1, 17, 8, 0.5f, glass);   // window depth 0.5, lower half (GL y < 8)
+  test::addRect(s, -1, -1, 8, 17, 0.6f, glass);   // window depth 0.4, left half
+  test::addRect(s, -1, -1, 17, 17, 0.3f, glass);  // window depth 0.7, everywhere
+  const Frame f = renderReference(s);
+  EXPECT_EQ(f.blend_count[f.index(3, 12)], 3.0f);   // left, GL y 3: all three
+  EXPECT_EQ(f.blend_count[f.index(12, 12)], 2.0f);  // right, GL y 3
+  EXPECT_EQ(f.blend_count[f.index(12, 3)], 1.0f);   // right, GL y 12: the full one
+  // Every blended fragment is tested against the opaque depth 0.8; the closest is the full
+  // layer at 0.7: 0.1 of the range.
+  EXPECT_NEAR(f.blend_gap[f.index(3, 12)], 0.1 * kD24, 2.0);
+  EXPECT_EQ(f.blend_slope[f.index(3, 12)], 0.0f);
+  // Opaque only: nothing blended.
+  s.state.blend = Blend::None;
+  const Frame opaque = renderReference(s);
+  for (float c : opaque.blend_count) EXPECT_EQ(c, 0.0f);
+  for (float g : opaque.blend_gap) EXPECT_EQ(g, std::numeric_limits<float>::infinity());
+}
+
+TEST(UncertaintyChannels, TexelAltOfABlendedLayerIsWeightedByItsAlpha) {
+  Scene s = test::windowScene(16, 16);
+  s.state.blend = Blend::Alpha;
+  test::addRect(s, -1, -1, 17, 17, 0.2f);  // opaque, untextured
+  Material glass = translucent(0.25);
+  glass.texture = rowsTexture();
+  const std::size_t m = test::addMaterial(s, glass);
+  test::addMesh(s, {{0, 0, 0.5f}, {16, 0, 0.5f}, {0, 16, 0.5f}}, {{0, 1, 2}}, m, {0, 0, 1},
+                {{0, 1}, {0, 1}, {0, 1}});
+  const Frame f = renderReference(s);
+  const std::size_t i = f.index(3, 12);
+  EXPECT_EQ(f.blend_count[i], 1.0f);
+  EXPECT_EQ(f.texel_dist[i], 0.0f);
+  EXPECT_NEAR(f.texel_alt[i], 0.25 * kRowsContrast, 1e-3);
+}
+
+}  // namespace
+}  // namespace rc
