@@ -45,7 +45,9 @@ int runCli(int argc, char** argv) {
   GenerateArgs generate;
   CLI::App* generate_cmd =
       app.add_subcommand("generate", "Write reproducible random fixtures (docs/random-scenes.md)");
-  generate_cmd->add_option("--seed,-s", generate.seed, "Seed (0 to 2^64 - 1)")->required();
+  generate_cmd->add_option("--seed,-s", generate.seed, "Seed (0 to 2^64 - 1)")
+      ->required()
+      ->type_name("UINT");
   generate_cmd->add_option("--count,-n", generate.count, "Number of fixtures")
       ->capture_default_str();
   generate_cmd

@@ -17,8 +17,8 @@ struct RenderArgs {
 int renderCommand(const RenderArgs& args);
 
 struct GenerateArgs {
-  std::uint64_t seed = 0;
-  std::uint64_t first = 0;
+  std::string seed;         // 0 .. 2^64 - 1, decimal (checked here: CLI11 wraps "-1")
+  std::string first = "0";  // index of the first fixture, same range
   std::int64_t count = 100;
   std::filesystem::path out;
   std::string max_size = "200x150";  // WxH

@@ -2,7 +2,9 @@
 // (fixtures/random_scene.h), written all-or-nothing through a staging folder beside DIR.
 #include <unistd.h>
 
+#include <charconv>
 #include <iostream>
+#include <limits>
 #include <regex>
 
 #include <fmt/format.h>
@@ -77,15 +79,28 @@ class StagedFolder {
   bool committed_ = false;
 };
 
+// A decimal in [0, 2^64 - 1], digits only.
+std::uint64_t parseUnsigned(const std::string& text, const char* option) {
+  std::uint64_t v = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  if (text.empty() || ec != std::errc() || ptr != end)
+    throw InputError(fmt::format("{}: expected an integer in [0, 18446744073709551615], got '{}'",
+                                 option, text));
+  return v;
+}
+
 }  // namespace
 
 int generateCommand(const GenerateArgs& args) {
   RandomSceneOptions options;
-  options.seed = args.seed;
-  options.first = args.first;
+  options.seed = parseUnsigned(args.seed, "--seed");
+  options.first = parseUnsigned(args.first, "--first");
   if (args.count < 1 || args.count > 1'000'000)
     throw InputError(fmt::format("--count: must be in [1, 1000000], got {}", args.count));
-  options.count = args.count;
+  options.count = static_cast<std::uint64_t>(args.count);
+  if (options.first > std::numeric_limits<std::uint64_t>::max() - options.count)
+    throw InputError("--first: first + count goes beyond 2^64 - 1");
   std::smatch m;
   if (!std::regex_match(args.max_size, m, std::regex(R"(([0-9]{1,5})x([0-9]{1,5}))")))
     throw InputError(

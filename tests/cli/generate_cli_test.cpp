@@ -1,6 +1,8 @@
 // `rastercheck generate` as a user meets it: the output folder's layout, the same bytes
 // for the same seed, a generated folder replaced whole, bad arguments refused in one line
 // with exit code 2 and nothing written.
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -86,9 +88,11 @@ TEST(CliGenerate, WritesTheLayoutAndTheSameBytesForTheSameSeed) {
   ASSERT_EQ(list.code, 0) << list.out;
   const auto rows = nlohmann::json::parse(list.out);
   ASSERT_EQ(rows.size(), 12u);
-  for (std::size_t i = 0; i < rows.size(); ++i)
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::string index = std::to_string(i);
     EXPECT_EQ(rows[i]["name"],
-              "random-generators/s5/0000" + std::string(i < 10 ? "0" : "") + std::to_string(i));
+              "random-generators/s5/" + std::string(5 - index.size(), '0') + index);
+  }
 
   // Another generation with the same arguments: the same files, byte for byte.
   ASSERT_EQ(
@@ -96,9 +100,11 @@ TEST(CliGenerate, WritesTheLayoutAndTheSameBytesForTheSameSeed) {
           .code,
       0);
   ASSERT_EQ(listing(dir / "b"), files);
-  for (const std::string& f : files)
-    if (fs::is_regular_file(dir / "a" / f))
+  for (const std::string& f : files) {
+    if (fs::is_regular_file(dir / "a" / f)) {
       EXPECT_EQ(readFile(dir / "a" / f), readFile(dir / "b" / f)) << f;
+    }
+  }
 
   // A generated folder is replaced whole: nothing of the larger generation stays.
   ASSERT_EQ(
