@@ -37,6 +37,11 @@ ClipVolume clipVolume(int width, int height, double limit_px);
 struct ClipVertex {
   glm::dvec4 clip{0.0};
   glm::dvec3 bary{0.0};  // w.r.t. the original triangle's vertices 0, 1, 2
+  // How far a float32 implementation's clip coordinates of this vertex may be from `clip`
+  // (per component): the vertex transform's error for an original vertex; for one made by
+  // clipping, what its two end points' errors and the float32 intersection add
+  // (lerpFromInside()). Zero when nobody asked (no uncertainty channels).
+  glm::dvec4 err{0.0};
 };
 
 // A convex polygon: each of the six planes adds at most one vertex to a triangle.
@@ -88,7 +93,8 @@ inline ClipClass classifyTriangle(const glm::dvec4& c0, const glm::dvec4& c1, co
 // false (and count 0) when nothing of it is inside. Intersections are always computed
 // from the inside vertex towards the outside one, so an edge shared by two triangles is
 // cut at bit-identical points in both (no cracks along clipped shared edges).
+// `errors` (optional): the three vertices' clip-space error bounds (ClipVertex::err).
 bool clipTriangle(const glm::dvec4& c0, const glm::dvec4& c1, const glm::dvec4& c2,
-                  const ClipVolume& volume, ClipPolygon& out);
+                  const ClipVolume& volume, ClipPolygon& out, const glm::dvec4* errors = nullptr);
 
 }  // namespace rc::ref

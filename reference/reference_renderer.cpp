@@ -214,7 +214,8 @@ void Renderer::transformVertices() {
     const Object& obj = scene_.objects[o];
     if (obj.mesh.triangles.empty()) continue;
     // Flat shading lights the face normal: vertex normals would go unused (unless traced).
-    transformObject(obj, camera_, vertices_[o], shading != Shading::Flat || trace_ != nullptr);
+    transformObject(obj, camera_, vertices_[o], shading != Shading::Flat || trace_ != nullptr,
+                    uncertainty_);
     if (shading != Shading::Gouraud) continue;
     // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
     const PreparedShading& prepared = shading_[obj.material];
@@ -304,14 +305,17 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
     case ClipClass::Rejected:
       return;
     case ClipClass::Inside: {  // what clipTriangle() would return, without its bookkeeping
-      const ClipVertex whole[3] = {
-          {c0, {1.0, 0.0, 0.0}}, {c1, {0.0, 1.0, 0.0}}, {c2, {0.0, 0.0, 1.0}}};
+      const ClipVertex whole[3] = {{c0, {1.0, 0.0, 0.0}, verts[tri[0]].clip_err},
+                                   {c1, {0.0, 1.0, 0.0}, verts[tri[1]].clip_err},
+                                   {c2, {0.0, 0.0, 1.0}, verts[tri[2]].clip_err}};
       drawPolygon(prim, pass, whole, 3);
       return;
     }
     case ClipClass::Cut: {
       ClipPolygon poly;
-      if (clipTriangle(c0, c1, c2, volume_, poly))
+      const glm::dvec4 errors[3] = {verts[tri[0]].clip_err, verts[tri[1]].clip_err,
+                                    verts[tri[2]].clip_err};
+      if (clipTriangle(c0, c1, c2, volume_, poly, errors))
         drawPolygon(prim, pass, poly.v.data(), poly.count);
       return;
     }
@@ -339,10 +343,19 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
   };
 
   if (uncertainty_) {
+    // How far a float32 implementation may put each vertex beyond snapping (its clip
+    // coordinates' error through the divide and the viewport): its edges' reach.
+    double reach[kMaxClipVertices];
+    double max_reach = 0.0;
+    for (int i = 0; i < count; ++i) {
+      reach[i] = windowErrorPx(poly[i], scene_.width, scene_.height);
+      if (!(reach[i] < kMaxVertexReachPx)) reach[i] = kMaxVertexReachPx;  // NaN too
+      max_reach = std::max(max_reach, reach[i]);
+    }
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
-    if (rasterized || cullCouldFlip(wv, count))
-      addEdgeDistances(wv, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data());
+    if (rasterized || cullCouldFlip(wv, count, max_reach))
+      addEdgeDistances(wv, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(), reach);
   }
 
   TriangleContext t;

@@ -31,8 +31,8 @@ double polygonPerimeter(const WindowVertex* polygon, int count) {
   return p;
 }
 
-bool cullCouldFlip(const WindowVertex* polygon, int count) {
-  constexpr double d = kSnapDisagreementPx;
+bool cullCouldFlip(const WindowVertex* polygon, int count, double extra_px) {
+  const double d = kSnapDisagreementPx + extra_px;
   return std::fabs(polygonArea2(polygon, count)) <=
          2.0 * d * polygonPerimeter(polygon, count) + 4.0 * d * d;
 }
@@ -69,7 +69,7 @@ inline double ceilFast(double x) { return -floorFast(-x); }
 // float, so cur^2 is exact in double). Pixels are visited in any superset of the band
 // within one pixel of the segment: a pixel farther than 1 keeps its value (<= 1).
 void lowerRow(float* row, int first, int last, double cy, const WindowVertex& a,
-              const WindowVertex& b) {
+              const WindowVertex& b, double reach) {
   const double dx = b.x - a.x;
   const double dy = b.y - a.y;
   const double len2 = dx * dx + dy * dy;
@@ -81,18 +81,21 @@ void lowerRow(float* row, int first, int last, double cy, const WindowVertex& a,
     const double qx = cx - (a.x + t * dx);
     const double qy = py - (a.y + t * dy);
     const double cur = row[px];
-    if (qx * qx + qy * qy >= cur * cur * (1.0 + 0x1p-40)) continue;
-    const double d = std::hypot(qx, qy);
-    if (d < cur) row[px] = static_cast<float>(d);
+    const double limit = cur + reach;  // == cur without reach: the same test, bit for bit
+    if (qx * qx + qy * qy >= limit * limit * (1.0 + 0x1p-40)) continue;
+    const double d = std::hypot(qx, qy) - reach;
+    if (d < cur) row[px] = static_cast<float>(std::max(d, 0.0));
   }
 }
 
 void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& clip, int width,
-                int height, float* edge_dist) {
+                int height, float* edge_dist, double reach) {
+  // Centres farther than 1 + reach from the segment keep their value (<= 1).
+  const double band = 1.0 + reach;
   int row_first = 0;
   int row_end = 0;
-  if (!centreRange(std::min(a.y, b.y) - 1.0, std::max(a.y, b.y) + 1.0, clip.y0, clip.y1, row_first,
-                   row_end))
+  if (!centreRange(std::min(a.y, b.y) - band, std::max(a.y, b.y) + band, clip.y0, clip.y1,
+                   row_first, row_end))
     return;
   for (int py = row_first; py < row_end; ++py) {
     const double cy = py + 0.5;
@@ -101,8 +104,8 @@ void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& c
     double t0 = 0.0;
     double t1 = 1.0;
     if (b.y != a.y) {
-      t0 = (cy - 1.0 - a.y) / (b.y - a.y);
-      t1 = (cy + 1.0 - a.y) / (b.y - a.y);
+      t0 = (cy - band - a.y) / (b.y - a.y);
+      t1 = (cy + band - a.y) / (b.y - a.y);
       if (t0 > t1) std::swap(t0, t1);
       t0 = std::max(t0, 0.0);
       t1 = std::min(t1, 1.0);
@@ -112,20 +115,23 @@ void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& c
     const double xb = a.x + t1 * (b.x - a.x);
     int col_first = 0;
     int col_end = 0;
-    if (!centreRange(std::min(xa, xb) - 1.0, std::max(xa, xb) + 1.0, clip.x0, clip.x1, col_first,
-                     col_end))
+    if (!centreRange(std::min(xa, xb) - band, std::max(xa, xb) + band, clip.x0, clip.x1,
+                     col_first, col_end))
       continue;
     lowerRow(edge_dist + static_cast<std::size_t>(height - 1 - py) * width, col_first, col_end, cy,
-             a, b);
+             a, b, reach);
   }
 }
 
 }  // namespace
 
 void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& clip, int width,
-                      int height, float* edge_dist) {
-  for (int i = 0; i < count; ++i)
-    addSegment(polygon[i], polygon[(i + 1) % count], clip, width, height, edge_dist);
+                      int height, float* edge_dist, const double* reach_px) {
+  for (int i = 0; i < count; ++i) {
+    const int j = (i + 1) % count;
+    const double reach = reach_px ? std::max(reach_px[i], reach_px[j]) : 0.0;
+    addSegment(polygon[i], polygon[j], clip, width, height, edge_dist, reach);
+  }
 }
 
 }  // namespace rc::ref

@@ -207,19 +207,26 @@ class UncertaintyTracker {
 double polygonArea2(const WindowVertex* polygon, int count);
 double polygonPerimeter(const WindowVertex* polygon, int count);
 
+// A vertex whose float32 position is this uncertain (px) can be anywhere that matters:
+// capping the reach keeps the edge-distance band (1 + reach) of one polygon bounded.
+inline constexpr double kMaxVertexReachPx = 64.0;
+
 // Moving each vertex by up to this many pixels (half a step at 3 subpixel bits: coarser
 // than any driver measured, softpipe snaps to 1/16) is how much another implementation's
 // snapping may disagree with ours.
 inline constexpr double kSnapDisagreementPx = 1.0 / 16.0;
 
-// Whether snapping within kSnapDisagreementPx could change the sign of the polygon's
-// area: |2A| <= 2 * d * perimeter + 4 * d^2, since moving vertex i by d changes 2A by at
-// most d * |v(i+1) - v(i-1)| <= d * (|e(i-1)| + |e(i)|).
-bool cullCouldFlip(const WindowVertex* polygon, int count);
+// Whether moving each vertex by d = kSnapDisagreementPx + extra_px (snapping, and the
+// vertices' float32 error) could change the sign of the polygon's area:
+// |2A| <= 2 * d * perimeter + 4 * d^2, since moving vertex i by d changes 2A by at most
+// d * |v(i+1) - v(i-1)| <= d * (|e(i-1)| + |e(i)|).
+bool cullCouldFlip(const WindowVertex* polygon, int count, double extra_px = 0.0);
 
 // Lowers edge_dist (image order, top row first, width * height floats initialised to 1)
-// to the distance from each pixel centre in `clip` to the polygon's boundary segments.
+// to the distance from each pixel centre in `clip` to the polygon's boundary segments,
+// less each segment's reach: how far a float32 implementation may put it beyond snapping
+// (the larger of its end points' reach_px, windowErrorPx(); none when null), at least 0.
 void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& clip, int width,
-                      int height, float* edge_dist);
+                      int height, float* edge_dist, const double* reach_px = nullptr);
 
 }  // namespace rc::ref

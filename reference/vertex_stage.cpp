@@ -15,9 +15,11 @@ CameraTransform cameraTransform(const Scene& scene) {
 }
 
 void transformObject(const Object& object, const CameraTransform& camera,
-                     std::vector<TransformedVertex>& out, bool normals) {
+                     std::vector<TransformedVertex>& out, bool normals, bool errors) {
   const Mesh& mesh = object.mesh;
   const glm::dmat3 normal_matrix = normalMatrix(object.model);
+  glm::dmat4 abs_vp(0.0);
+  for (int c = 0; c < 4; ++c) abs_vp[c] = glm::abs(camera.view_projection[c]);
   out.resize(mesh.positions.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     TransformedVertex& v = out[i];
@@ -27,6 +29,8 @@ void transformObject(const Object& object, const CameraTransform& camera,
                    ? safeNormalize(normal_matrix * glm::dvec3(mesh.normals[i]))
                    : glm::dvec3(0.0);
     v.uv = i < mesh.uvs.size() ? glm::dvec2(mesh.uvs[i]) : glm::dvec2(0.0);
+    if (errors)
+      v.clip_err = (kClipRoundingUlps * kUlp32) * (abs_vp * glm::dvec4(glm::abs(v.world), 1.0));
   }
 }
 

@@ -24,12 +24,24 @@ struct TransformedVertex {
   glm::dvec3 normal{0.0};  // safeNormalize(normalMatrix(model) * normal): zero stays zero
   glm::dvec4 clip{0.0};    // view_projection * world
   glm::dvec2 uv{0.0};      // (0, 0) when the mesh has no uvs (as the GL backend feeds)
+  // How far a float32 implementation's clip coordinates may be from `clip`, per
+  // component: kClipRoundingUlps ulps of the magnitudes the product sums,
+  // |view_projection| * (|world|, 1) (the world position reaches GL as floats and the
+  // matrix as a float uniform). Only with `errors` (the uncertainty channels need it).
+  glm::dvec4 clip_err{0.0};
 };
+
+// Roundings of a float32 vertex transform: the world position and the matrix entries
+// rounded to float, four products and three sums per component: 8 ulps (2^-21) of the sum
+// of the terms' magnitudes bounds it (docs/tolerances.md, "Vertex precision").
+inline constexpr double kClipRoundingUlps = 8.0;
+inline constexpr double kUlp32 = 0x1p-24;  // float32 unit roundoff
 
 // Transforms every vertex of the object (non-finite input gives non-finite output;
 // the renderer drops such triangles). Without `normals` (flat shading lights the face
 // normal, never a vertex normal) TransformedVertex::normal is left zero.
 void transformObject(const Object& object, const CameraTransform& camera,
-                     std::vector<TransformedVertex>& out, bool normals = true);
+                     std::vector<TransformedVertex>& out, bool normals = true,
+                     bool errors = false);
 
 }  // namespace rc::ref

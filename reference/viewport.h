@@ -3,6 +3,8 @@
 // range [0, 1]. In double; the viewport is the whole image.
 #pragma once
 
+#include <cmath>
+
 #include <glm/glm.hpp>
 
 #include "reference/clipper.h"
@@ -28,6 +30,16 @@ inline WindowVertex toWindow(const ClipVertex& c, int width, int height) {
   v.inv_w = inv_w;
   v.bary = c.bary;
   return v;
+}
+
+// How far (px) a float32 implementation may put the window position of `c`, from its clip
+// coordinates' error bound: x_w = (x / w * 0.5 + 0.5) * width moves by
+// width / 2 * (e_x + |x / w| e_w) / |w| (y alike), as a distance.
+inline double windowErrorPx(const ClipVertex& c, int width, int height) {
+  const double aw = std::fabs(c.clip.w);
+  const double ex = 0.5 * width * (c.err.x + std::fabs(c.clip.x / c.clip.w) * c.err.w) / aw;
+  const double ey = 0.5 * height * (c.err.y + std::fabs(c.clip.y / c.clip.w) * c.err.w) / aw;
+  return std::hypot(ex, ey);
 }
 
 }  // namespace rc::ref
