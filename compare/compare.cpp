@@ -582,18 +582,21 @@ class Comparator {
     // band of a texel boundary may take the texel across it (texel_alt, RGB only); in
     // rgba8 every blended fragment may round differently (blend_count).
     double texel = 0.0;
+    double filtering = 0.0;
     double blends = 0.0;
     if (have_uncertainty_) {
       if (tol_.texel_choice > 0.0 && static_cast<double>(u_.texel_dist[i]) <= texel_band_)
         texel = tol_.texel_choice * u_.texel_alt[i];
+      // Linear filtering: quantised weights move the value by a fraction of the footprint's
+      // colour range (texel_alt), the 8-bit filtered texel by a unit times its light.
+      filtering = tol_.texture_weight_error * u_.texel_alt[i] +
+                  tol_.texture_rounding_units * u_.texel_gain[i];
       blends = tol_.blend_rounding_units * u_.blend_count[i];
     }
     for (int c = 0; c < 4; ++c) {
       const double m = std::max(std::fabs(pa[c]), std::fabs(pb[c]));
       out.allowances[c] = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
-                          tol_.texture_weight_error * around.range[c] +
-                          tol_.texture_rounding_units * std::max(1.0, m) + blends +
-                          (c < 3 ? texel : 0.0);
+                          blends + (c < 3 ? texel + filtering : 0.0);
     }
     for (int c = 0; c < 4; ++c) {
       const double excess = d[c] - out.allowances[c];

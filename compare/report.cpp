@@ -88,7 +88,7 @@ std::string shadingAllowanceText(const Tolerances& t, double slope_band_px) {
   std::string s = fmt::format("{:.3g} x 255 x |C| + {:.3g} x {:.3g} px x |dC/dpx|",
                               t.shading_relative, t.shading_slope_factor, slope_band_px);
   if (t.texture_weight_error > 0.0 || t.texture_rounding_units > 0.0)
-    s += fmt::format(" + {:.3g} x 3x3 range + {:.3g} x max(1, |C|) (linear texture filtering)",
+    s += fmt::format(" + {:.3g} x texel_alt + {:.3g} x texel_gain (linear texture filtering)",
                      t.texture_weight_error, t.texture_rounding_units);
   if (t.texel_choice > 0.0)
     s += fmt::format(" + {:.3g} x texel_alt where texel_dist <= {:.3g} px", t.texel_choice,

@@ -1,4 +1,4 @@
-// Colour gradients and ranges around a pixel: see slopes.h.
+// Colour gradients around a pixel: see slopes.h.
 #include "compare/slopes.h"
 
 #include <algorithm>
@@ -18,8 +18,6 @@ ColourNeighbourhood colourNeighbourhood(const Frame& f, int x, int y) {
   const float* c = &f.color[i * 4];
   for (int k = 0; k < 4; ++k)
     if (!finite(c[k])) return out;
-  std::array<float, 4> lo = {c[0], c[1], c[2], c[3]};
-  std::array<float, 4> hi = lo;
   std::array<float, 4> same{};  // gradient to same-primitive 4-neighbours
   std::array<float, 4> any{};   // gradient to any drawn 8-neighbour
   bool found_same = false;
@@ -35,13 +33,10 @@ ColourNeighbourhood colourNeighbourhood(const Frame& f, int x, int y) {
       const float diff = std::fabs(n[k] - c[k]) * 255.0f;
       if (same_4) same[k] = std::max(same[k], diff);
       any[k] = std::max(any[k], diff * inv_dist);
-      lo[k] = std::min(lo[k], n[k]);
-      hi[k] = std::max(hi[k], n[k]);
     }
     return true;
   });
   out.gradient = found_same ? same : any;
-  for (int k = 0; k < 4; ++k) out.range[k] = (hi[k] - lo[k]) * 255.0f;
   return out;
 }
 

@@ -27,13 +27,11 @@ struct DepthScale {
   }
 };
 
-// How the colour around (x, y) varies, per channel, in 8-bit units. gradient: the largest
-// difference to a 4-neighbour showing the same primitive (per px), else to any drawn
-// 8-neighbour (divided by its distance), else 0. range: max - min over the drawn pixels
-// of the 3x3 neighbourhood. Non-finite pixels are skipped.
+// How the colour around (x, y) varies, per channel, in 8-bit units per px: the largest
+// difference to a 4-neighbour showing the same primitive, else to any drawn 8-neighbour
+// (divided by its distance), else 0. Non-finite pixels are skipped.
 struct ColourNeighbourhood {
   std::array<float, 4> gradient{};
-  std::array<float, 4> range{};
 };
 ColourNeighbourhood colourNeighbourhood(const Frame& f, int x, int y);
 

@@ -38,14 +38,15 @@ struct Tolerances {
   // Slope allowance of a pixel = factor * depth slope of its triangle (steps/px) * slope
   // band (px): how far a triangle's stored depth moves when its vertices move by the band.
   double depth_slope_factor = 1.0;
-  // Shading allowance of a channel, in 8-bit units, with M = max(|Ca|, |Cb|), G the
-  // colour gradient (units/px) and R the colour range of the 3x3 neighbourhood (units):
+  // Shading allowance of a channel, in 8-bit units, with M = max(|Ca|, |Cb|) and G the
+  // colour gradient (units/px):
   //   255 * shading_relative * M              float32 evaluation of the lighting
   //   + shading_slope_factor * G * band       attribute planes of snapped vertices
-  //   + texture_weight_error * R              linear filtering: quantised bilinear weights
-  //   + texture_rounding_units * max(1, M)    linear filtering: the 8-bit filtered texel
-  // (the texture terms are 0 unless a textured material is filtered linearly), and from
-  // the reference's channels at the pixel:
+  // and from the reference's channels at the pixel:
+  //   + texture_weight_error * texel_alt      linear filtering: quantised bilinear weights
+  //                                           (texel_alt: the footprint's colour range)
+  //   + texture_rounding_units * texel_gain   linear filtering: the 8-bit filtered texel
+  // (these two are 0 unless a textured material is filtered linearly),
   //   + texel_choice * texel_alt   nearest filtering, where texel_dist <= the slope band:
   //                                the sample may take the texel across the boundary (RGB)
   //   + blend_rounding_units * blend_count   rgba8: each blended fragment's 8-bit rounding

@@ -94,15 +94,15 @@ struct TriangleContext {
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
   float depth_slope = 0.0f;   // |grad z| in depth-format steps per px
-  bool texel_choice = false;  // textured, nearest filter: record texel_dist / texel_alt
+  bool texel_choice = false;  // textured: record the texel channels
   glm::dvec2 uq_max{0.0};     // largest |u / w|, |v / w| over its three vertices
 };
 
-// What a drawn fragment adds to the texel channels (frame.h): nothing unless it samples a
-// nearest-filtered texture near a texel boundary.
+// What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
 struct TexelNote {
   float dist = 1.0f;  // px
   float alt = 0.0f;   // 8-bit units, weighted as the fragment's colour is in the pixel
+  float gain = 0.0f;  // units per texel unit, weighted alike
 };
 
 // Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
@@ -378,8 +378,7 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     interp.setup(wv[0], wv[i], wv[i + 1], !t.constant || trace_ != nullptr);
     if (uncertainty_) {
       t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
-      t.texel_choice =
-          t.texture != nullptr && scene_.state.texture_filter == TextureFilter::Nearest;
+      t.texel_choice = t.texture != nullptr;
       if (t.texel_choice) {
         t.uq_max = glm::dvec2(0.0);
         for (const WindowVertex* w : {&wv[0], &wv[i], &wv[i + 1]}) {
@@ -443,13 +442,26 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   return color;
 }
 
-// The nearest filter's texel choice at a fragment (docs/tolerances.md "texel_dist"): how
-// far (px) the sample is from a texel boundary beyond float rounding, and how much the
-// pixel's colour would change with the texel(s) across it, in 8-bit units, weighted by
-// alpha when the fragment is blended.
+// The texel channels of a textured fragment (docs/tolerances.md (c), (d), (e)), in 8-bit
+// units weighted by alpha when the fragment is blended: the gain (how much a texel unit
+// moves the colour: the ambient and diffuse light on the texture); with linear filtering
+// the colour range of the footprint; with nearest filtering how far (px) the sample is from
+// a texel boundary beyond float rounding and how much the colour would change with the
+// texel(s) across it.
 TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                               const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
                               const FragmentInterpolator::Row& row, double dx) const {
+  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+  TexelNote note;
+  note.gain = static_cast<float>(
+      weight * std::max({ambient_diffuse.x, ambient_diffuse.y, ambient_diffuse.z, 0.0}));
+  if (scene_.state.texture_filter == TextureFilter::Linear) {
+    const glm::dvec4 range = linearFootprintRange(*t.texture, uv, scene_.state.texture_wrap);
+    double alt = 0.0;
+    for (int c = 0; c < 3; ++c) alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
+    note.alt = static_cast<float>(255.0 * alt * weight);
+    return note;
+  }
   glm::dvec3 db[2];
   interp.barycentricGradient(row, dx, b, db);
   const glm::dvec3 u(t.v[0]->uv.x, t.v[1]->uv.x, t.v[2]->uv.x);
@@ -469,13 +481,11 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
   tt.reach = kTexelCoordinateReach *
              (h * std::max(std::fabs(uv.y), t.uq_max.y / std::fabs(q)) + tt.gradient * image);
   const TexelChoice choice = nearestTexelChoice(*t.texture, s, tt, scene_.state.texture_wrap, 1.0);
-  TexelNote note;
   note.dist = static_cast<float>(choice.dist_px);
   double alt = 0.0;
   for (int k = 0; k < choice.alternatives; ++k)
     for (int c = 0; c < 3; ++c)
       alt = std::max(alt, std::fabs(ambient_diffuse[c] * (choice.alt[k][c] - choice.chosen[c])));
-  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
   note.alt = static_cast<float>(255.0 * alt * weight);
   return note;
 }
@@ -555,7 +565,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       if (depth_write) depth[index] = key;
       ids[index] = id;
       const TexelNote note = shade(index, row, dx);
-      if constexpr (kGaps) gaps_.colourWritten(index, blend, alpha, note.dist, note.alt);
+      if constexpr (kGaps) gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain);
     }
   });
 }

@@ -44,4 +44,8 @@ struct TexelChoice {
 TexelChoice nearestTexelChoice(const Texture& texture, const TexelAxis& s, const TexelAxis& t,
                                TextureWrap wrap, double cap);
 
+// Per channel, the largest minus the smallest of the (up to four) texels the linear filter
+// reads at uv: how far a change of the filter weights can move the filtered value.
+glm::dvec4 linearFootprintRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap);
+
 }  // namespace rc::ref

@@ -71,7 +71,7 @@ namespace rc::ref {
 //  - blend_gap / blend_slope: every test of a blended fragment against the stored depth
 //    changes the pixel's colour when it flips, whether or not it decides the id: the
 //    smallest such gap, and the steepest fragment of those tests;
-//  - blend_count, texel_dist, texel_alt: composited like the colour itself
+//  - blend_count, texel_dist, texel_alt, texel_gain: composited like the colour itself
 //    (colourWritten()): an opaque write starts them afresh, a blended one adds its own,
 //    weighted by alpha.
 //
@@ -99,6 +99,7 @@ class UncertaintyTracker {
     texel_dist_ = frame.texel_dist.data();
     texel_alt_ = frame.texel_alt.data();
     clear_slope_ = frame.clear_slope.data();
+    texel_gain_ = frame.texel_gain.data();
   }
 
   // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px),
@@ -136,16 +137,18 @@ class UncertaintyTracker {
   // else in its place. texel_dist / texel_alt are the fragment's own (texel_alt already
   // weighted by alpha when blended).
   void colourWritten(std::size_t index, bool blended, float alpha, float texel_dist,
-                     float texel_alt) {
+                     float texel_alt, float texel_gain) {
     if (!blended) {
       blend_count_[index] = 0.0f;
       texel_dist_[index] = texel_dist;
       texel_alt_[index] = texel_alt;
+      texel_gain_[index] = texel_gain;
       return;
     }
     blend_count_[index] += 1.0f;
     texel_dist_[index] = std::min(texel_dist_[index], texel_dist);
     texel_alt_[index] = (1.0f - alpha) * texel_alt_[index] + texel_alt;
+    texel_gain_[index] = (1.0f - alpha) * texel_gain_[index] + texel_gain;
   }
 
   // Ends the frame: clear_gap from each pixel's final id (frame.id).
@@ -201,6 +204,7 @@ class UncertaintyTracker {
   float* texel_dist_ = nullptr;
   float* texel_alt_ = nullptr;
   float* clear_slope_ = nullptr;
+  float* texel_gain_ = nullptr;
 };
 
 // Twice the signed area (> 0 counter-clockwise) and the perimeter of a window polygon.

@@ -654,6 +654,31 @@ TEST_F(CompareTest, TexelChoiceAllowsTheOtherTexelOnlyWithinTheBand) {
   EXPECT_EQ(compare().shading.over_fail, static_cast<std::uint64_t>(near_edge.size()));
 }
 
+// Linear filtering: quantised weights may move the value by 2^-7 of the footprint's colour
+// range (texel_alt) and the 8-bit filtered texel by one unit times the light on it
+// (texel_gain). Exactly that passes; a unit more fails; without linear filtering (the
+// frames say nearest) neither term applies.
+TEST_F(CompareTest, LinearFilteringAllowsTheFootprintAndTheFilteredTexelsRounding) {
+  const Block b = kBackBlock;
+  forBlock(b, [&](int x, int y) {
+    ref_.texel_alt[ref_.index(x, y)] = 128.0f;  // 2^-7 of it: 1 unit
+    ref_.texel_gain[ref_.index(x, y)] = 1.5f;   // 1.5 units
+  });
+  DrawnWith linear;
+  linear.linear_textures = true;
+  tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F, linear);
+  const double allowed = 128.0 * tol_.texture_weight_error + 1.5 * tol_.texture_rounding_units;
+  ASSERT_DOUBLE_EQ(allowed, 2.5);
+  const auto offset = static_cast<float>(allowed + tol_.shading.fail * 0.9);
+  forBlock(b, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4] += offset / 255.0f; });
+  EXPECT_EQ(compare().shading.over_fail, 0u);
+  forBlock(b, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4] += 1.0f / 255.0f; });
+  EXPECT_EQ(compare().shading.over_fail, static_cast<std::uint64_t>(b.size()));
+  tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F);  // not linear
+  forBlock(b, [&](int x, int y) { gl_.color[gl_.index(x, y) * 4] -= 1.0f / 255.0f; });
+  EXPECT_EQ(compare().shading.over_fail, static_cast<std::uint64_t>(b.size()));
+}
+
 // rgba8 blending: each blended fragment may round its way (2 units, docs/tolerances.md).
 TEST_F(CompareTest, Rgba8BlendsEachAddTheirRounding) {
   tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);

@@ -91,11 +91,20 @@ TEST(UncertaintyChannels, ATriangleSampledExactlyOnATexelBoundaryMayTakeEitherTe
   const Frame c = renderReference(s);
   EXPECT_EQ(c.texel_dist[i], 1.0f);
   EXPECT_EQ(c.texel_alt[i], 0.0f);
-  // Linear filtering has no texel boundary to cross.
+  // Linear filtering has no texel boundary to cross; texel_alt is the colour range of the
+  // footprint: at v = 1 (t = 2, repeat) it straddles rows 1 and 0 (2 - 0.5 = 1.5).
   s.state.texture_wrap = TextureWrap::Repeat;
   s.state.texture_filter = TextureFilter::Linear;
   const Frame l = renderReference(s);
-  EXPECT_EQ(l.texel_alt[i], 0.0f);
+  EXPECT_EQ(l.texel_dist[i], 1.0f);
+  EXPECT_NEAR(l.texel_alt[i], kRowsContrast, 1e-3);
+  EXPECT_EQ(l.texel_gain[i], 1.0f);  // ambient 1 x ambient light 1
+  // At v = 0.1 (t - 0.5 = -0.3) under clamp both rows of the footprint are row 0: no
+  // contrast. (A tap of weight 0 still counts: quantised weights may give it 2^-8.)
+  s.state.texture_wrap = TextureWrap::Clamp;
+  for (glm::vec2& uv : s.objects[0].mesh.uvs) uv = {0.375f, 0.1f};
+  const Frame centre = renderReference(s);
+  EXPECT_EQ(centre.texel_alt[i], 0.0f);
 }
 
 TEST(UncertaintyChannels, TexelDistIsTheScreenDistanceToTheNextTexelBoundary) {
