@@ -69,8 +69,9 @@ namespace rc::ref {
 //    pixel the smallest; +inf when a fragment was drawn without a test, or none was tested.
 //    clear_slope: the steepest tested fragment;
 //  - blend_gap / blend_slope: every test of a blended fragment against the stored depth
-//    changes the pixel's colour when it flips, whether or not it decides the id: the
-//    smallest such gap, and the steepest fragment of those tests;
+//    changes the pixel's colour when it flips, whether or not it decides the id; so do the
+//    comparisons that decided the opaque fragment the first blend goes over (depth_gap and
+//    clear_gap as they stand then): the smallest such gap, and the steepest fragment;
 //  - blend_count, texel_dist, texel_alt, texel_gain: composited like the colour itself
 //    (colourWritten()): an opaque write starts them afresh, a blended one adds its own,
 //    weighted by alpha.
@@ -106,6 +107,7 @@ class UncertaintyTracker {
   // passed the test (tested: LESS; else ALWAYS) and, when `writes`, stored its depth.
   // `blended`: drawn in a blending pass.
   void passed(std::size_t index, double z, float slope, bool tested, bool writes, bool blended) {
+    if (blended && blend_count_[index] == 0.0f) baseDecided(index);
     if (tested) {
       // +inf against the clear depth (|z - inf| = inf).
       const float g = toSteps(std::fabs(z - stored_z_[index]));
@@ -176,6 +178,18 @@ class UncertaintyTracker {
     if (clear_near_[index] != -kInfF) clear_near_[index] = std::min(clear_near_[index], g);
     clear_far_[index] = std::max(clear_far_[index], g);
     clear_slope_[index] = std::max(clear_slope_[index], slope);
+  }
+  // The first blend over the pixel's opaque colour: what decided that opaque fragment (or
+  // the background) decides the blended colour too.
+  void baseDecided(std::size_t index) {
+    float g = gap_[index];
+    float s = gap_slope_[index];
+    if (!std::isinf(stored_z_[index])) {  // a drawn base might have been background
+      g = std::min(g, clear_far_[index]);
+      s = std::max(s, clear_slope_[index]);
+    }
+    if (g < blend_gap_[index]) blend_gap_[index] = g;
+    blend_slope_[index] = std::max(blend_slope_[index], s);
   }
   // A blended fragment's test against the stored depth (the clear depth counts here: it
   // decides whether the fragment is blended at all).

@@ -166,6 +166,28 @@ TEST(UncertaintyChannels, BlendCountAndBlendGapFollowTheTransparentLayers) {
   for (float g : opaque.blend_gap) EXPECT_EQ(g, std::numeric_limits<float>::infinity());
 }
 
+// A z-fight under a transparent layer: which twin is under does not decide the id (the
+// glass on top wins either way), but it decides the colour: blend_gap says so.
+TEST(UncertaintyChannels, AZFightUnderAGlassLayerMakesTheBlendUncertain) {
+  Scene s = test::windowScene(16, 16);
+  s.state.blend = Blend::Alpha;
+  Material dark = translucent(1.0);
+  dark.ambient = glm::dvec3(0.1);
+  test::addRect(s, -1, -1, 17, 17, 0.2f);                              // opaque, white
+  test::addRect(s, -1, -1, 17, 17, 0.2f, test::addMaterial(s, dark));  // its dark twin
+  test::addRect(s, -1, -1, 17, 17, 0.6f, test::addMaterial(s, translucent(0.5)));
+  const Frame f = renderReference(s);
+  const std::size_t i = f.index(5, 5);
+  EXPECT_EQ(f.blend_count[i], 1.0f);
+  EXPECT_EQ(f.blend_gap[i], 0.0f);                                   // the twins' depths are equal
+  EXPECT_TRUE(std::isinf(f.depth_gap[i]) || f.depth_gap[i] > 1e6f);  // not the id's business
+  // Without the twin, the only comparisons are the glass against the wall (window depths
+  // 0.4 and 0.8) and the wall against the clear depth 1: the nearer, 0.2.
+  s.objects.erase(s.objects.begin() + 1);
+  const Frame single = renderReference(s);
+  EXPECT_NEAR(single.blend_gap[i], 0.2 * kD24, 2.0);
+}
+
 TEST(UncertaintyChannels, TexelAltOfABlendedLayerIsWeightedByItsAlpha) {
   Scene s = test::windowScene(16, 16);
   s.state.blend = Blend::Alpha;
