@@ -10,7 +10,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
-#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -217,8 +216,8 @@ const char* platformName(GlSpec::Platform p) {
 }
 
 // "zink (llvmpipe (...)) | OpenGL 4.6 (Core Profile) Mesa 22.3.6 | EGL surfaceless |
-// Vulkan 1.3.230 llvmpipe (...) [llvmpipe, Mesa 22.3.6 (LLVM 15.0.6)] | Mesa libraries in
-// /usr/lib/x86_64-linux-gnu".
+// Vulkan 1.3.230 llvmpipe (...) [llvmpipe, Mesa 22.3.6 (LLVM 15.0.6)] | driver
+// /usr/lib/x86_64-linux-gnu/dri/swrast_dri.so", plus "(Mesa folder DIR)" for an @DIR spec.
 std::string describeStack(const Session& s, const gl::LoadedMesa& mesa) {
   std::string out = fmt::format("{} | OpenGL {} | {}", s.renderer, s.version,
                                 platformName(s.spec.platform));
@@ -231,11 +230,8 @@ std::string describeStack(const Session& s, const gl::LoadedMesa& mesa) {
                              ? s.vulkan["driver_info"].get<std::string>()
                              : std::string());
   }
-  if (!mesa.dir.empty()) {
-    out += " | Mesa libraries from " + mesa.dir;
-  } else if (!mesa.driver_library.empty()) {
-    out += " | Mesa libraries in " + std::filesystem::path(mesa.driver_library).parent_path().string();
-  }
+  if (!mesa.driver_library.empty()) out += " | driver " + mesa.driver_library;
+  if (!mesa.dir.empty()) out += " (Mesa folder " + mesa.dir + ")";
   return out;
 }
 
