@@ -37,13 +37,8 @@ void restartWithStartupEnvironment(const RenderArgs& args, const BackendSpec& ba
   }
   if (!missing) return;
   const std::string exe = "/proc/self/exe";
-  std::vector<std::string> argv = {exe,
-                                   "render",
-                                   args.scene.string(),
-                                   "--backend",
-                                   args.backend,
-                                   "--out",
-                                   args.out.string()};
+  std::vector<std::string> argv = {exe,          "render", args.scene.string(), "--backend",
+                                   args.backend, "--out",  args.out.string()};
   std::vector<char*> raw;
   for (std::string& a : argv) raw.push_back(a.data());
   raw.push_back(nullptr);

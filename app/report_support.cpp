@@ -58,9 +58,9 @@ namespace {
 nlohmann::json driverStack(const Frame& frame) {
   if (!frame.meta.contains("stack")) return nullptr;
   nlohmann::json out = nlohmann::json::object();
-  for (const char* key : {"stack", "gl_renderer", "gl_version", "platform", "driver",
-                          "subpixel_bits", "gl_subpixel_bits", "subpixel_bits_source", "mesa",
-                          "vulkan"}) {
+  for (const char* key :
+       {"stack", "gl_renderer", "gl_version", "platform", "driver", "subpixel_bits",
+        "gl_subpixel_bits", "subpixel_bits_source", "mesa", "vulkan"}) {
     if (frame.meta.contains(key)) out[key] = frame.meta[key];
   }
   return out;

@@ -93,8 +93,8 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
         return sub.meta.contains(name) ? sub.meta[name] : nlohmann::json(nullptr);
       };
       // GL's answer; older frames carried it as subpixel_bits only.
-      v["subpixel_bits"] = sub.meta.contains("gl_subpixel_bits") ? key("gl_subpixel_bits")
-                                                                  : key("subpixel_bits");
+      v["subpixel_bits"] =
+          sub.meta.contains("gl_subpixel_bits") ? key("gl_subpixel_bits") : key("subpixel_bits");
       v["band_subpixel_bits"] = key("subpixel_bits");
       const variants::SubpixelResult subpixel = variants::analyseSubpixel(sub, reference);
       v["subpixel"] = variants::toJson(subpixel);

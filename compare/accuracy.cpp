@@ -289,12 +289,15 @@ void variantsSection(const AccuracyData& data, const Line& line) {
   line();
   line("## Driver stacks and variants");
   line();
-  line("Probed once per backend and run (docs/debugging.md, \"Variants\"). *GL_SUBPIXEL_BITS*");
-  line("is the driver's answer; *rasterizes like* is what the subpixel probe measured; *snap");
-  line("band* is the precision the backend's frames carry, which the comparator's visibility");
-  line("band uses (docs/gl_backend.md: zink's comes from its Vulkan device).");
+  line("Probed once per backend and run (docs/debugging.md, \"Variant detection\").");
+  line("*GL_SUBPIXEL_BITS* is the driver's answer; *rasterizes like* is what the subpixel");
+  line("probe measured; *snap band* is the precision the backend's frames carry, which the");
+  line("comparator's visibility band uses (docs/gl_backend.md: zink's comes from its Vulkan");
+  line("device).");
   line();
-  line("| backend | stack | GL_SUBPIXEL_BITS | rasterizes like | snap band | tie-break | depth rounding |");
+  line(
+      "| backend | stack | GL_SUBPIXEL_BITS | rasterizes like | snap band | tie-break | depth "
+      "rounding |");
   line("|---|---|---|---|---|---|---|");
   std::vector<std::string> findings;
   for (const auto& [spec, v] : data.variants) {
@@ -311,13 +314,14 @@ void variantsSection(const AccuracyData& data, const Line& line) {
       else if (sub.contains("best") && sub["best"].is_number())
         observed = fmt::format("no fixed grid (closest {})", sub["best"].get<int>());
     }
-    const std::string band =
-        v.contains("band_subpixel_bits") ? variantText(v, "band_subpixel_bits") : variantText(v, "subpixel_bits");
+    const std::string band = v.contains("band_subpixel_bits") ? variantText(v, "band_subpixel_bits")
+                                                              : variantText(v, "subpixel_bits");
     auto rule = [&](const char* key) {
       if (!v.contains(key) || !v[key].is_object()) return std::string("-");
       const json& x = v[key];
       const std::string name = x.value("rule", std::string("-"));
-      return fmt::format("{}{}", cell(name), x.value("matches_reference", false) ? " (as ref)" : " (differs from ref)");
+      return fmt::format("{}{}", cell(name),
+                         x.value("matches_reference", false) ? " (as ref)" : " (differs from ref)");
     };
     line(fmt::format("| `{}` | {} | {} | {} | {} | {} | {} |", spec,
                      v.contains("stack") ? variantText(v, "stack") : variantText(v, "renderer"),

@@ -431,9 +431,10 @@ std::string variantsTable(const Report& report) {
       continue;
     }
     const std::string band = text(v, "band_subpixel_bits");
-    out += fmt::format("<td title=\"{}\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>",
-                       esc(text(v, "stack")), esc(text(v, "renderer")),
-                       esc(text(v, "subpixel_bits")), esc(band.empty() ? text(v, "subpixel_bits") : band));
+    out +=
+        fmt::format("<td title=\"{}\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>",
+                    esc(text(v, "stack")), esc(text(v, "renderer")), esc(text(v, "subpixel_bits")),
+                    esc(band.empty() ? text(v, "subpixel_bits") : band));
     out += fmt::format("<td>{} {}</td>",
                        mark(v, "subpixel", "confirmed", "confirmed", "not confirmed"),
                        esc(text(v, "subpixel")));

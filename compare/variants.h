@@ -37,12 +37,12 @@ inline constexpr int kMinCandidateBits = 0;
 inline constexpr int kMaxCandidateBits = 12;
 
 struct SubpixelResult {
-  int queried = -1;  // GL_SUBPIXEL_BITS from frame.json gl_subpixel_bits (older frames:
-                     // subpixel_bits) (-1: absent)
-  int band = -1;     // frame.json subpixel_bits: what the comparator's snap band assumes
-                     // (differs from queried where the driver stack knows better, e.g.
-                     // zink's Vulkan device) (-1: absent)
-  std::string band_source;                  // frame.json subpixel_bits_source ("" if absent)
+  int queried = -1;         // GL_SUBPIXEL_BITS from frame.json gl_subpixel_bits (older frames:
+                            // subpixel_bits) (-1: absent)
+  int band = -1;            // frame.json subpixel_bits: what the comparator's snap band assumes
+                            // (differs from queried where the driver stack knows better, e.g.
+                            // zink's Vulkan device) (-1: absent)
+  std::string band_source;  // frame.json subpixel_bits_source ("" if absent)
   std::map<int, std::uint64_t> mismatches;  // N -> pixels whose id differs from ref:subpixel=N
   int best = -1;                            // N with the fewest mismatches (smallest N on ties)
   std::uint64_t best_mismatches = 0;

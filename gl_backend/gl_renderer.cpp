@@ -154,9 +154,9 @@ struct Session {
   int gl_subpixel_bits = 0;  // GL_SUBPIXEL_BITS, as the driver answers it
   int subpixel_bits = 0;     // the precision it rasterizes with (see subpixelBits())
   std::string subpixel_source;
-  nlohmann::json mesa;    // frame.json "mesa"
-  nlohmann::json vulkan;  // frame.json "vulkan" (zink), else null
-  std::string stack;      // frame.json "stack": the layers in one line
+  nlohmann::json mesa;                      // frame.json "mesa"
+  nlohmann::json vulkan;                    // frame.json "vulkan" (zink), else null
+  std::string stack;                        // frame.json "stack": the layers in one line
   std::map<std::string, Program> programs;  // by source text
   std::vector<std::string> debug_errors;    // KHR_debug error messages since the last check
   Framebuffer framebuffer;
@@ -219,8 +219,8 @@ const char* platformName(GlSpec::Platform p) {
 // Vulkan 1.3.230 llvmpipe (...) [llvmpipe, Mesa 22.3.6 (LLVM 15.0.6)] | driver
 // /usr/lib/x86_64-linux-gnu/dri/swrast_dri.so", plus "(Mesa folder DIR)" for an @DIR spec.
 std::string describeStack(const Session& s, const gl::LoadedMesa& mesa) {
-  std::string out = fmt::format("{} | OpenGL {} | {}", s.renderer, s.version,
-                                platformName(s.spec.platform));
+  std::string out =
+      fmt::format("{} | OpenGL {} | {}", s.renderer, s.version, platformName(s.spec.platform));
   if (s.vulkan.is_object()) {
     out += fmt::format(" | Vulkan {} {}", s.vulkan.value("api_version", ""),
                        s.vulkan.value("device", ""));

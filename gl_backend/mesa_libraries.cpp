@@ -52,7 +52,8 @@ void writeIfChanged(const fs::path& file, const std::string& text) {
   {
     std::ifstream in(file, std::ios::binary);
     if (in) {
-      const std::string have((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      const std::string have((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
       if (have == text) return;
     }
   }
@@ -75,8 +76,9 @@ void writeIfChanged(const fs::path& file, const std::string& text) {
 // named after what it points to so that every process asking for the same folder shares
 // one file.
 fs::path manifest(const std::string& kind, const fs::path& library, const nlohmann::json& doc) {
-  const fs::path file = privateRuntimeDir() / fmt::format("{}-{:016x}.json", kind,
-                                                          std::hash<std::string>{}(library.string()));
+  const fs::path file =
+      privateRuntimeDir() /
+      fmt::format("{}-{:016x}.json", kind, std::hash<std::string>{}(library.string()));
   writeIfChanged(file, doc.dump(2) + "\n");
   return file;
 }
@@ -94,9 +96,7 @@ bool holdsDriver(std::string_view name) {
          startsWith(name, "libOSMesa.so");
 }
 
-bool inside(const std::string& path, const std::string& dir) {
-  return startsWith(path, dir + "/");
-}
+bool inside(const std::string& path, const std::string& dir) { return startsWith(path, dir + "/"); }
 
 // Whether LD_LIBRARY_PATH starts with `dir` (what startupEnvironment asks for).
 bool startupEnvironmentApplied(const std::string& dir) {
@@ -114,13 +114,12 @@ void checkMesaDir(std::string_view spec_text, const GlSpec& spec) {
   std::error_code ec;
   const fs::file_status st = fs::status(dir, ec);
   if (!fs::exists(st))
-    throw InputError(fmt::format("backend '{}': Mesa folder {} does not exist", spec_text,
-                                 spec.mesa_dir));
+    throw InputError(
+        fmt::format("backend '{}': Mesa folder {} does not exist", spec_text, spec.mesa_dir));
   if (!fs::is_directory(st))
     throw InputError(
         fmt::format("backend '{}': Mesa folder {} is not a folder", spec_text, spec.mesa_dir));
-  const char* hint =
-      "name the library folder of a Mesa install, e.g. PREFIX/lib/x86_64-linux-gnu";
+  const char* hint = "name the library folder of a Mesa install, e.g. PREFIX/lib/x86_64-linux-gnu";
   if (spec.platform == GlSpec::Platform::OSMesa) {
     if (!isFile(dir / RC_OSMESA_SONAME))
       throw InputError(fmt::format("backend '{}': {} holds no {} ({})", spec_text, spec.mesa_dir,
@@ -147,9 +146,9 @@ fs::path privateRuntimeDir() {
   struct stat st {};
   if (::lstat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::getuid() ||
       (st.st_mode & 077) != 0) {
-    throw BackendError(fmt::format(
-        "{} is not a private folder of this user (mode 0700, not a symlink); remove it",
-        dir.string()));
+    throw BackendError(
+        fmt::format("{} is not a private folder of this user (mode 0700, not a symlink); remove it",
+                    dir.string()));
   }
   return dir;
 }
@@ -208,7 +207,8 @@ LoadedMesa checkLoadedMesa(const GlSpec& spec) {
     if (endsWith(path, " (deleted)")) path.resize(path.size() - 10);
     const std::string name = fs::path(path).filename().string();
     const bool from_dir = !out.dir.empty() && inside(path, out.dir);
-    if (!isMesaLibrary(name) && !(from_dir && startsWith(name, "lib") && name.find(".so") != std::string::npos))
+    if (!isMesaLibrary(name) &&
+        !(from_dir && startsWith(name, "lib") && name.find(".so") != std::string::npos))
       continue;
     if (seen.insert(path).second) out.libraries.push_back(path);
   }
@@ -245,12 +245,13 @@ std::string mesaVersion(const std::string& gl_version) {
 }
 
 nlohmann::json toJson(const LoadedMesa& mesa, const GlSpec& spec, const std::string& version) {
-  return {{"version", version.empty() ? nlohmann::json(nullptr) : nlohmann::json(version)},
-          {"asked", spec.mesa_dir.empty() ? nlohmann::json(nullptr) : nlohmann::json(spec.mesa_dir)},
-          {"dir", mesa.dir.empty() ? nlohmann::json(nullptr) : nlohmann::json(mesa.dir)},
-          {"driver_library", mesa.driver_library.empty() ? nlohmann::json(nullptr)
-                                                         : nlohmann::json(mesa.driver_library)},
-          {"libraries", mesa.libraries}};
+  return {
+      {"version", version.empty() ? nlohmann::json(nullptr) : nlohmann::json(version)},
+      {"asked", spec.mesa_dir.empty() ? nlohmann::json(nullptr) : nlohmann::json(spec.mesa_dir)},
+      {"dir", mesa.dir.empty() ? nlohmann::json(nullptr) : nlohmann::json(mesa.dir)},
+      {"driver_library",
+       mesa.driver_library.empty() ? nlohmann::json(nullptr) : nlohmann::json(mesa.driver_library)},
+      {"libraries", mesa.libraries}};
 }
 
 }  // namespace rc::gl

@@ -16,8 +16,7 @@ namespace rc::gl {
 
 std::string zinkDeviceName(const std::string& gl_renderer) {
   constexpr std::string_view kPrefix = "zink (";
-  if (gl_renderer.compare(0, kPrefix.size(), kPrefix) != 0 || gl_renderer.back() != ')')
-    return "";
+  if (gl_renderer.compare(0, kPrefix.size(), kPrefix) != 0 || gl_renderer.back() != ')') return "";
   return gl_renderer.substr(kPrefix.size(), gl_renderer.size() - kPrefix.size() - 1);
 }
 
@@ -68,7 +67,8 @@ std::optional<VulkanDevice> queryVulkanDevice(const std::string& name, std::stri
     why = fmt::format("cannot load libvulkan.so.1: {}", e ? e : "unknown error");
     return std::nullopt;
   }
-  auto get_proc = reinterpret_cast<PFN_vkGetInstanceProcAddr>(::dlsym(lib, "vkGetInstanceProcAddr"));
+  auto get_proc =
+      reinterpret_cast<PFN_vkGetInstanceProcAddr>(::dlsym(lib, "vkGetInstanceProcAddr"));
   if (get_proc == nullptr) {
     why = "libvulkan.so.1 does not export vkGetInstanceProcAddr";
     return std::nullopt;
@@ -120,8 +120,8 @@ std::optional<VulkanDevice> queryVulkanDevice(const std::string& name, std::stri
     VkPhysicalDeviceProperties p{};
     properties(device, &p);
     names.emplace_back(p.deviceName);
-    const bool wanted = name.empty() ? p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU
-                                     : name == p.deviceName;
+    const bool wanted =
+        name.empty() ? p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU : name == p.deviceName;
     if (!wanted) continue;
     out.name = p.deviceName;
     out.type = typeName(p.deviceType);
@@ -142,13 +142,14 @@ std::optional<VulkanDevice> queryVulkanDevice(const std::string& name, std::stri
     // Mesa's drivers pack Mesa's version the VK_MAKE_VERSION way; other vendors have
     // their own encodings, kept as the raw number.
     const bool mesa = p.vendorID == VK_VENDOR_ID_MESA || out.driver_info.rfind("Mesa", 0) == 0;
-    out.driver_version = mesa ? driverVersionText(p.driverVersion) : fmt::format("0x{:08x}", p.driverVersion);
+    out.driver_version =
+        mesa ? driverVersionText(p.driverVersion) : fmt::format("0x{:08x}", p.driverVersion);
     return out;
   }
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-  why = fmt::format("no Vulkan device called '{}' (found: {})", name.empty() ? "<a CPU device>" : name,
-                    list.empty() ? "none" : list);
+  why = fmt::format("no Vulkan device called '{}' (found: {})",
+                    name.empty() ? "<a CPU device>" : name, list.empty() ? "none" : list);
   return std::nullopt;
 }
 
@@ -162,7 +163,9 @@ std::optional<VulkanDevice> queryVulkanDevice(const std::string& /*name*/, std::
 #endif
 
 nlohmann::json toJson(const VulkanDevice& d) {
-  auto text = [](const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); };
+  auto text = [](const std::string& s) {
+    return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s);
+  };
   return {{"device", d.name},
           {"device_type", d.type},
           {"api_version", d.api_version},

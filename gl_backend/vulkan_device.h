@@ -12,12 +12,12 @@
 namespace rc::gl {
 
 struct VulkanDevice {
-  std::string name;         // VkPhysicalDeviceProperties::deviceName
-  std::string type;         // cpu, integrated-gpu, discrete-gpu, virtual-gpu, other
-  std::string api_version;  // "1.3.230"
-  std::string driver_version;  // Mesa's encoding (major.minor.patch); hex for other vendors
-  std::string driver_name;     // VkPhysicalDeviceDriverProperties (Vulkan 1.2), "" before
-  std::string driver_info;     // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+  std::string name;                  // VkPhysicalDeviceProperties::deviceName
+  std::string type;                  // cpu, integrated-gpu, discrete-gpu, virtual-gpu, other
+  std::string api_version;           // "1.3.230"
+  std::string driver_version;        // Mesa's encoding (major.minor.patch); hex for other vendors
+  std::string driver_name;           // VkPhysicalDeviceDriverProperties (Vulkan 1.2), "" before
+  std::string driver_info;           // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
   int subpixel_precision_bits = -1;  // VkPhysicalDeviceLimits::subPixelPrecisionBits
   int viewport_subpixel_bits = -1;
   std::string loader;  // the real path of the Vulkan loader library

@@ -137,9 +137,10 @@ TEST(Accuracy, VariantsAndFindingsOfEachStackAreListed) {
   ASSERT_EQ(data.variants.size(), 2u);
   const std::string md = accuracyMarkdown(data, "`make-it`");
   EXPECT_TRUE(hasLine(md, "## Driver stacks and variants")) << md;
-  EXPECT_TRUE(hasLine(md,
-                      "| `gl:x:y` | zink (dev) \\| OpenGL 4.6 \\| Vulkan 1.3 dev | 4 | 8 bits | 8 | "
-                      "left+bottom (as ref) | truncate (differs from ref) |"))
+  EXPECT_TRUE(
+      hasLine(md,
+              "| `gl:x:y` | zink (dev) \\| OpenGL 4.6 \\| Vulkan 1.3 dev | 4 | 8 bits | 8 | "
+              "left+bottom (as ref) | truncate (differs from ref) |"))
       << md;
   EXPECT_TRUE(hasLine(md, "| `gl:x:z` | error: subpixel probe: cannot start | | | | | |")) << md;
   EXPECT_TRUE(hasLine(

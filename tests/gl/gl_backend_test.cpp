@@ -60,11 +60,26 @@ TEST(GlSpecParse, AcceptsEveryDocumentedForm) {
 }
 
 TEST(GlSpecParse, RejectsEverythingElseWithTheValidForms) {
-  for (const char* bad :
-       {"", "g", "GL", "gl:", "gl:egl:", "gl:osmesa:zink", "gl:egl:llvmpipe:x", "gl:osmesa:swrast",
-        "gl:egl-device:", "gl:egl-device:-1", "gl:egl-device:1x", "gl:egl-device:llvmpipe",
-        "gl:vulkan", "ref", "gl:eglx", " gl", "gl:egl:llvmpipe@", "@/usr/lib", "gl:egl:foo@/tmp",
-        "ref@/tmp"}) {
+  for (const char* bad : {"",
+                          "g",
+                          "GL",
+                          "gl:",
+                          "gl:egl:",
+                          "gl:osmesa:zink",
+                          "gl:egl:llvmpipe:x",
+                          "gl:osmesa:swrast",
+                          "gl:egl-device:",
+                          "gl:egl-device:-1",
+                          "gl:egl-device:1x",
+                          "gl:egl-device:llvmpipe",
+                          "gl:vulkan",
+                          "ref",
+                          "gl:eglx",
+                          " gl",
+                          "gl:egl:llvmpipe@",
+                          "@/usr/lib",
+                          "gl:egl:foo@/tmp",
+                          "ref@/tmp"}) {
     try {
       parseGlSpec(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";
@@ -95,8 +110,8 @@ TEST(GlSpecParse, MesaFolderSuffixOnEveryForm) {
 
 // A folder with empty files of the given names (checkMesaDir looks only at names).
 fs::path fakeMesaDir(const std::string& name, std::initializer_list<const char*> files) {
-  const fs::path dir = fs::temp_directory_path() / ("rc_fake_mesa_" + name + "_" +
-                                                    std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("rc_fake_mesa_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   for (const char* f : files) std::ofstream(dir / f) << "";
@@ -212,7 +227,8 @@ TEST_F(GlBackend, DriverAndMetadataMatchTheSpec) {
   }
   // Which Mesa: its version from GL_VERSION, and the driver library really mapped.
   const nlohmann::json& mesa = f.meta.at("mesa");
-  EXPECT_THAT(std::string(f.meta.at("gl_version")), HasSubstr(mesa.at("version").get<std::string>()));
+  EXPECT_THAT(std::string(f.meta.at("gl_version")),
+              HasSubstr(mesa.at("version").get<std::string>()));
   EXPECT_TRUE(mesa.at("dir").is_null());
   const std::vector<std::string> libs = mesa.at("libraries");
   const std::string driver_library = mesa.at("driver_library");
@@ -381,7 +397,7 @@ TEST_F(GlProcess, ZinkSubstitutedIsABackendErrorNamingWhatLoaded) {
   EXPECT_EXIT(
       {
         gl::testing::hooks().gallium_driver = "llvmpipe";  // Mesa loads llvmpipe...
-        renderAndExit(parseGlSpec("gl:egl:zink"));          // ...zink was asked
+        renderAndExit(parseGlSpec("gl:egl:zink"));         // ...zink was asked
       },
       ::testing::ExitedWithCode(3), "asked for zink, GL_RENDERER is llvmpipe \\(LLVM");
 }

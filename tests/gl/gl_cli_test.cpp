@@ -6,19 +6,19 @@
 // "@DIR" is what really loads, and a folder that cannot be used says so in one line.
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <set>
-#include <cstdlib>
-#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "fixtures/frame_io.h"
 #include <nlohmann/json.hpp>
+#include "fixtures/frame_io.h"
 #include "tests/support/command.h"
 
 namespace fs = std::filesystem;
@@ -181,7 +181,6 @@ TEST(GlCli, InjectedFaultIsRecordedAndWarnedOnce) {
   if (ran == 0) GTEST_SKIP() << "no GL driver starts here";
 }
 
-
 TEST(GlCli, ZinkStartsQuietlyWithoutXdgRuntimeDir) {
   // Without XDG_RUNTIME_DIR the Vulkan loader's window-system code prints "error:
   // XDG_RUNTIME_DIR is invalid or not set in the environment." twice on every start; the
@@ -190,8 +189,8 @@ TEST(GlCli, ZinkStartsQuietlyWithoutXdgRuntimeDir) {
   const Result r = run(renderArgs("gl:egl:zink", out), "env -u XDG_RUNTIME_DIR");
   if (r.code != 0 && !requireGl()) GTEST_SKIP() << "zink does not start here: " << r.out;
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_EQ(lines(r.out), std::vector<std::string>{kFixtureName + ": gl:egl:zink -> " +
-                                                   out.string()})
+  EXPECT_EQ(lines(r.out),
+            std::vector<std::string>{kFixtureName + ": gl:egl:zink -> " + out.string()})
       << r.out;
   const rc::Frame f = rc::readFrameDir(out);
   EXPECT_EQ(f.meta.at("driver"), "zink");
@@ -220,8 +219,7 @@ void copyMesaOf(const nlohmann::json& mesa, const fs::path& dir,
                      [&](const std::string& k) { return name.rfind(k, 0) == 0; }))
       continue;
     const bool dri = fs::path(lib).parent_path().filename() == "dri";
-    fs::copy_file(lib, (dri ? dir / "dri" : dir) / sonameOf(name),
-                  fs::copy_options::skip_existing);
+    fs::copy_file(lib, (dri ? dir / "dri" : dir) / sonameOf(name), fs::copy_options::skip_existing);
   }
 }
 
@@ -252,8 +250,7 @@ TEST(GlCli, MesaFolderCopyIsWhatLoads) {
     const nlohmann::json& mesa = f.meta.at("mesa");
     EXPECT_EQ(mesa.at("asked"), copy.string());
     EXPECT_EQ(mesa.at("dir"), real);
-    EXPECT_EQ(mesa.at("driver_library").get<std::string>().rfind(real + "/", 0), 0u)
-        << mesa.dump();
+    EXPECT_EQ(mesa.at("driver_library").get<std::string>().rfind(real + "/", 0), 0u) << mesa.dump();
     for (const std::string lib : mesa.at("libraries"))
       EXPECT_EQ(lib.rfind(real + "/", 0), 0u) << asked << " loaded " << lib;
     EXPECT_NE(std::string(f.meta.at("stack")).find("(Mesa folder " + real + ")"),
@@ -278,8 +275,12 @@ TEST(GlCli, MesaFolderCopyIsWhatLoads) {
   EXPECT_EQ(row.at("actual"), copied);
   EXPECT_TRUE(row.at("stacks").at("expected").at("mesa").at("dir").is_null());
   EXPECT_EQ(row.at("stacks").at("actual").at("mesa").at("dir"), real);
-  EXPECT_EQ(row.at("stacks").at("actual").at("mesa").at("driver_library").get<std::string>().rfind(
-                real + "/", 0),
+  EXPECT_EQ(row.at("stacks")
+                .at("actual")
+                .at("mesa")
+                .at("driver_library")
+                .get<std::string>()
+                .rfind(real + "/", 0),
             0u);
 
   // What was asked is not what loaded: without dri/ the copy's libEGL_mesa finds the
