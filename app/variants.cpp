@@ -100,9 +100,14 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
       v["subpixel"] = variants::toJson(subpixel);
       v["findings"] = nlohmann::json::array();
       if (!subpixel.finding.empty()) v["findings"].push_back("subpixel: " + subpixel.finding);
-      if (subpixel.band >= 0 && subpixel.best >= 0 && !subpixel.band_confirmed)
+      // A band finer than the driver's snapping would call legal edge pixels hard; a
+      // coarser one (softpipe's 4 bits over its float edges) only excuses more.
+      if (subpixel.band >= 0 && subpixel.best >= 0 && !subpixel.band_confirmed &&
+          subpixel.best < subpixel.band)
         v["findings"].push_back(fmt::format(
-            "subpixel: the snap band's {} bits do not reproduce the probe", subpixel.band));
+            "subpixel: the driver snaps to {} bits, coarser than the {} bits its frames carry "
+            "for the snap band: legal edge pixels may be reported hard",
+            subpixel.best, subpixel.band));
       v["tie_break"] = variants::toJson(variants::analyseTieBreak(tie, tb));
       v["depth_rounding"] = variants::toJson(variants::analyseDepthRounding(depth, dr));
       v["probe_seconds"] = shared_seconds;

@@ -131,9 +131,11 @@ SubpixelResult analyseSubpixel(const Frame& driver, const std::map<int, Frame>& 
   if (r.exact && r.queried >= 0 && !r.confirmed) {
     r.finding = fmt::format("GL_SUBPIXEL_BITS says {} but the driver rasterizes like {} bits{}",
                             r.queried, r.best, r.best == kMaxCandidateBits ? " or finer" : "");
-  } else if (!r.exact && r.best >= 0) {
-    r.finding = fmt::format("no fixed grid of {}..{} bits reproduces the driver's coverage",
-                            kMinCandidateBits, kMaxCandidateBits);
+  } else if (!r.exact && r.best >= 0 && r.queried >= 0) {
+    r.finding = fmt::format(
+        "GL_SUBPIXEL_BITS says {} but no fixed grid of {}..{} bits reproduces the driver's "
+        "coverage (closest: {} bits)",
+        r.queried, kMinCandidateBits, kMaxCandidateBits, r.best);
   }
   return r;
 }
