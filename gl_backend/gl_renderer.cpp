@@ -274,11 +274,13 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
   s->mesa = gl::toJson(loaded, spec, gl::mesaVersion(s->version));
   if (s->driver == "zink") {
     std::string why;
+    const auto start = Clock::now();
     if (const auto device = gl::queryVulkanDevice(gl::zinkDeviceName(s->renderer), why)) {
       s->vulkan = gl::toJson(*device);
     } else {
       s->vulkan = {{"error", why}};
     }
+    s->vulkan["query_ms"] = msSince(start);  // a Vulkan instance of its own: part of context
   }
   chooseSubpixelBits(*s);
   s->stack = describeStack(*s, loaded);
