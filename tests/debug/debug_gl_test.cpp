@@ -221,7 +221,7 @@ TEST(DebugGl, ZinkAgainstLlvmpipeAndItsSubpixelFinding) {
     const json& stack = row["stacks"]["actual"];
     EXPECT_EQ(stack["gl_subpixel_bits"], 4);
     EXPECT_EQ(stack["vulkan"]["subpixel_precision_bits"], 8);
-    EXPECT_TRUE(row["stacks"]["expected"]["vulkan"].is_null());
+    EXPECT_FALSE(row["stacks"]["expected"].contains("vulkan"));  // llvmpipe: no Vulkan
   }
   const json& z = report["variants"][kZink];
   EXPECT_EQ(z["subpixel_bits"], 4);
