@@ -242,6 +242,13 @@ TEST(DebugGl, ZinkAgainstLlvmpipeAndItsSubpixelFinding) {
   std::ifstream in(dir / "report.html");
   const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(html.find(finding), std::string::npos);
+  if (std::system("/usr/bin/python3 -c 'import jsonschema' 2>/dev/null") == 0) {
+    const Result valid = rc::test::runShell(
+        "/usr/bin/python3 -c \"import json,sys,jsonschema; jsonschema.validate(json.load(open("
+        "sys.argv[1])), json.load(open(sys.argv[2])))\" '" +
+        (dir / "report.json").string() + "' '" RC_SOURCE_DIR "/docs/report-schema.json'");
+    EXPECT_EQ(valid.code, 0) << valid.out << valid.err;
+  }
   fs::remove_all(dir);
 }
 

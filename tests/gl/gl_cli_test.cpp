@@ -282,6 +282,14 @@ TEST(GlCli, MesaFolderCopyIsWhatLoads) {
                 .get<std::string>()
                 .rfind(real + "/", 0),
             0u);
+  if (std::system("/usr/bin/python3 -c 'import jsonschema' 2>/dev/null") == 0) {
+    const Result valid = rc::test::runShell(
+        "/usr/bin/python3 -c \"import json,sys,jsonschema; jsonschema.validate(json.load(open("
+        "sys.argv[1])), json.load(open(sys.argv[2])))\" '" +
+        (dir / "run" / "report.json").string() + "' '" RC_SOURCE_DIR "/docs/report-schema.json'");
+    EXPECT_EQ(valid.code, 0) << "report.json with stacks against docs/report-schema.json: "
+                             << valid.out;
+  }
 
   // What was asked is not what loaded: without dri/ the copy's libEGL_mesa finds the
   // system's driver. Exit 3, one line naming the stray library, nothing written.
