@@ -40,6 +40,7 @@ void restartWithStartupEnvironment(const RenderArgs& args, const BackendSpec& ba
   std::vector<std::string> argv = {exe,          "render", args.scene.string(), "--backend",
                                    args.backend, "--out",  args.out.string()};
   std::vector<char*> raw;
+  raw.reserve(argv.size() + 1);
   for (std::string& a : argv) raw.push_back(a.data());
   raw.push_back(nullptr);
   std::cout.flush();

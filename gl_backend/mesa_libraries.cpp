@@ -76,9 +76,8 @@ void writeIfChanged(const fs::path& file, const std::string& text) {
 // named after what it points to so that every process asking for the same folder shares
 // one file.
 fs::path manifest(const std::string& kind, const fs::path& library, const nlohmann::json& doc) {
-  const fs::path file =
-      privateRuntimeDir() /
-      fmt::format("{}-{:016x}.json", kind, std::hash<std::string>{}(library.string()));
+  fs::path file = privateRuntimeDir() /
+                  fmt::format("{}-{:016x}.json", kind, std::hash<std::string>{}(library.string()));
   writeIfChanged(file, doc.dump(2) + "\n");
   return file;
 }
@@ -139,7 +138,7 @@ void checkMesaDir(std::string_view spec_text, const GlSpec& spec) {
 fs::path privateRuntimeDir() {
   const char* tmp = std::getenv("TMPDIR");
   const fs::path base = tmp != nullptr && *tmp == '/' ? fs::path(tmp) : fs::path("/tmp");
-  const fs::path dir = base / fmt::format("rastercheck-{}", ::getuid());
+  fs::path dir = base / fmt::format("rastercheck-{}", ::getuid());
   if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST)
     throw BackendError(fmt::format("cannot create {}: {}", dir.string(), std::strerror(errno)));
   // Someone else's folder (or a symlink planted in a shared /tmp) must not be used.
