@@ -281,6 +281,14 @@ std::string variantText(const json& v, const char* key) {
   return cell(x.is_string() ? x.get<std::string>() : x.dump());
 }
 
+// A probed rule and whether it is the reference's: "left+bottom (as ref)".
+std::string variantRule(const json& v, const char* key) {
+  if (!v.contains(key) || !v[key].is_object()) return "-";
+  const json& x = v[key];
+  return fmt::format("{}{}", cell(x.value("rule", std::string("-"))),
+                     x.value("matches_reference", false) ? " (as ref)" : " (differs from ref)");
+}
+
 // "Driver stacks and variants": what each GL backend ran on, the legal variants the probes
 // found, and the findings (a driver's answer contradicted by what it does).
 template <typename Line>
@@ -316,17 +324,10 @@ void variantsSection(const AccuracyData& data, const Line& line) {
     }
     const std::string band = v.contains("band_subpixel_bits") ? variantText(v, "band_subpixel_bits")
                                                               : variantText(v, "subpixel_bits");
-    auto rule = [&](const char* key) {
-      if (!v.contains(key) || !v[key].is_object()) return std::string("-");
-      const json& x = v[key];
-      const std::string name = x.value("rule", std::string("-"));
-      return fmt::format("{}{}", cell(name),
-                         x.value("matches_reference", false) ? " (as ref)" : " (differs from ref)");
-    };
     line(fmt::format("| `{}` | {} | {} | {} | {} | {} | {} |", spec,
                      v.contains("stack") ? variantText(v, "stack") : variantText(v, "renderer"),
-                     variantText(v, "subpixel_bits"), observed, band, rule("tie_break"),
-                     rule("depth_rounding")));
+                     variantText(v, "subpixel_bits"), observed, band, variantRule(v, "tie_break"),
+                     variantRule(v, "depth_rounding")));
     if (v.contains("findings") && v["findings"].is_array())
       for (const json& f : v["findings"])
         if (f.is_string()) findings.push_back(fmt::format("`{}`: {}", spec, f.get<std::string>()));

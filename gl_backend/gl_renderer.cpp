@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -152,10 +153,14 @@ struct Session {
   gl::Functions gl;
   std::string vendor, renderer, version, glsl_version, driver;
   int gl_subpixel_bits = 0;  // GL_SUBPIXEL_BITS, as the driver answers it
-  int subpixel_bits = 0;     // the precision it rasterizes with (see subpixelBits())
+  int subpixel_bits = 0;     // the precision it rasterizes with (chooseSubpixelBits)
   std::string subpixel_source;
-  nlohmann::json mesa;                      // frame.json "mesa"
-  nlohmann::json vulkan;                    // frame.json "vulkan" (zink), else null
+  gl::LoadedMesa mesa;  // frame.json "mesa"
+  std::string mesa_version;
+  bool zink = false;                       // frame.json "vulkan" only then:
+  std::optional<gl::VulkanDevice> vulkan;  // the device under zink, or
+  std::string vulkan_error;                // why it could not be asked
+  double vulkan_query_ms = 0.0;
   std::string stack;                        // frame.json "stack": the layers in one line
   std::map<std::string, Program> programs;  // by source text
   std::vector<std::string> debug_errors;    // KHR_debug error messages since the last check
@@ -197,8 +202,8 @@ void checkGl(Session& s, const char* stage) {
 void chooseSubpixelBits(Session& s) {
   s.subpixel_bits = s.gl_subpixel_bits;
   s.subpixel_source = "GL_SUBPIXEL_BITS";
-  if (s.vulkan.is_object() && s.vulkan.value("subpixel_precision_bits", -1) >= 0) {
-    s.subpixel_bits = s.vulkan["subpixel_precision_bits"].get<int>();
+  if (s.vulkan && s.vulkan->subpixel_precision_bits >= 0) {
+    s.subpixel_bits = s.vulkan->subpixel_precision_bits;
     s.subpixel_source = "VkPhysicalDeviceLimits::subPixelPrecisionBits";
   }
 }
@@ -221,14 +226,10 @@ const char* platformName(GlSpec::Platform p) {
 std::string describeStack(const Session& s, const gl::LoadedMesa& mesa) {
   std::string out =
       fmt::format("{} | OpenGL {} | {}", s.renderer, s.version, platformName(s.spec.platform));
-  if (s.vulkan.is_object()) {
-    out += fmt::format(" | Vulkan {} {}", s.vulkan.value("api_version", ""),
-                       s.vulkan.value("device", ""));
-    if (s.vulkan["driver_name"].is_string())
-      out += fmt::format(" [{}, {}]", s.vulkan["driver_name"].get<std::string>(),
-                         s.vulkan["driver_info"].is_string()
-                             ? s.vulkan["driver_info"].get<std::string>()
-                             : std::string());
+  if (s.vulkan) {
+    out += fmt::format(" | Vulkan {} {}", s.vulkan->api_version, s.vulkan->name);
+    if (!s.vulkan->driver_name.empty())
+      out += fmt::format(" [{}, {}]", s.vulkan->driver_name, s.vulkan->driver_info);
   }
   if (!mesa.driver_library.empty()) out += " | driver " + mesa.driver_library;
   if (!mesa.dir.empty()) out += " (Mesa folder " + mesa.dir + ")";
@@ -271,16 +272,13 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
   }
   // What was loaded, after the driver created its screen (and zink its Vulkan device).
   const gl::LoadedMesa loaded = gl::checkLoadedMesa(spec);
-  s->mesa = gl::toJson(loaded, spec, gl::mesaVersion(s->version));
+  s->mesa = loaded;
+  s->mesa_version = gl::mesaVersion(s->version);
   if (s->driver == "zink") {
-    std::string why;
-    const auto start = Clock::now();
-    if (const auto device = gl::queryVulkanDevice(gl::zinkDeviceName(s->renderer), why)) {
-      s->vulkan = gl::toJson(*device);
-    } else {
-      s->vulkan = {{"error", why}};
-    }
-    s->vulkan["query_ms"] = msSince(start);  // a Vulkan instance of its own: part of context
+    s->zink = true;
+    const auto start = Clock::now();  // a Vulkan instance of its own: part of the context
+    s->vulkan = gl::queryVulkanDevice(gl::zinkDeviceName(s->renderer), s->vulkan_error);
+    s->vulkan_query_ms = msSince(start);
   }
   chooseSubpixelBits(*s);
   s->stack = describeStack(*s, loaded);
@@ -932,8 +930,11 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["platform"] = s.context->platform();
   m["driver"] = s.driver;
   m["stack"] = s.stack;
-  m["mesa"] = s.mesa;
-  if (!s.vulkan.is_null()) m["vulkan"] = s.vulkan;
+  m["mesa"] = gl::toJson(s.mesa, s.spec, s.mesa_version);
+  if (s.zink) {
+    m["vulkan"] = s.vulkan ? gl::toJson(*s.vulkan) : nlohmann::json{{"error", s.vulkan_error}};
+    m["vulkan"]["query_ms"] = s.vulkan_query_ms;
+  }
   m["skipped_triangles"] = data.skipped_triangles;
   if (faults.any()) m["fault_injected"] = faults.describe();
   m["timing_ms"] = {

@@ -110,7 +110,7 @@ TEST(GlSpecParse, MesaFolderSuffixOnEveryForm) {
 
 // A folder with empty files of the given names (checkMesaDir looks only at names).
 fs::path fakeMesaDir(const std::string& name, std::initializer_list<const char*> files) {
-  const fs::path dir =
+  fs::path dir =
       fs::temp_directory_path() / ("rc_fake_mesa_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);

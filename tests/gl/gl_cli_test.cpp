@@ -321,8 +321,10 @@ TEST(GlCli, UnusableMesaFolderExitsTwoInOneLine) {
     EXPECT_NE(r.out.find(what), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(dir / "frame"));
     // `run` checks every SPEC before rendering anything.
-    const Result rr = run("run " + kFixture + " --backends gl:egl:llvmpipe," + spec + " --out " +
-                          (dir / "run").string());
+    std::string args = "run " + kFixture;
+    args += " --backends gl:egl:llvmpipe," + spec;
+    args += " --out " + (dir / "run").string();
+    const Result rr = run(args);
     EXPECT_EQ(rr.code, 2) << rr.out;
     EXPECT_EQ(lines(rr.out).size(), 1u) << rr.out;
     EXPECT_FALSE(fs::exists(dir / "run"));
