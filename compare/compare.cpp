@@ -864,7 +864,6 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
       break;
     }
   }
-  r.expected_driver = metaString(expected, "gl_version");
   r.actual_driver = metaString(actual, "gl_version");
   r.width = expected.width;
   r.height = expected.height;

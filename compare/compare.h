@@ -133,10 +133,9 @@ struct PairResult {
   std::string expected;  // backend specs, e.g. "ref", "gl:egl:llvmpipe"
   std::string actual;
   // The fixture's render state (frame.json "state": the fixture's state block with every
-  // default filled in) and each side's GL version string ("" for the reference): what
-  // expected failures are scoped by.
+  // default filled in) and the actual side's GL version string ("" for the reference):
+  // what expected failures are scoped by.
   nlohmann::json state = nlohmann::json::object();
-  std::string expected_driver;
   std::string actual_driver;
   // Non-empty when the pair failed only in classes known to fail (applyExpectations()).
   std::vector<KnownFailure> known;
@@ -147,6 +146,10 @@ struct PairResult {
   std::uint64_t pixels = 0;
   int expected_subpixel_bits = 8;
   int actual_subpixel_bits = 8;
+  // The driver stack each side ran on (frame.json "stack", "mesa", "vulkan", ...); null
+  // for the reference or frames that do not say. report.json "stacks".
+  nlohmann::json expected_stack;
+  nlohmann::json actual_stack;
   Tolerances tolerances;  // the ones in effect
   VisibilityStats visibility;
   DepthStats depth;

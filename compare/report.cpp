@@ -150,8 +150,6 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
             {"status", toString(r.status)},
             {"pixels", r.pixels}};
   if (!r.state.empty()) j["state"] = r.state;
-  if (!r.expected_driver.empty() || !r.actual_driver.empty())
-    j["drivers"] = {{"expected", r.expected_driver}, {"actual", r.actual_driver}};
   if (!r.known.empty()) {
     json known = json::array();
     for (const KnownFailure& k : r.known)
@@ -179,6 +177,8 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
   j["width"] = r.width;
   j["height"] = r.height;
   j["subpixel_bits"] = {{"expected", r.expected_subpixel_bits}, {"actual", r.actual_subpixel_bits}};
+  if (!r.expected_stack.is_null() || !r.actual_stack.is_null())
+    j["stacks"] = {{"expected", r.expected_stack}, {"actual", r.actual_stack}};
   j["tolerances"] = {{"depth_format", toString(t.depth_format)},
                      {"color_format", toString(t.color_format)},
                      {"visibility", thresholds(t.visibility)},
