@@ -85,7 +85,11 @@ TEST(FrameIo, ExrHasTheContractChannelsAndTypes) {
   auto in = OIIO::ImageInput::open((dir / "frame.exr").string());
   ASSERT_TRUE(in);
   const OIIO::ImageSpec& spec = in->spec();
-  const std::vector<std::string> want = {"R", "G", "B", "A", "Z", "id", "edge_dist", "depth_gap"};
+  // The contract's colour, depth and id channels, then every uncertainty channel by name.
+  std::vector<std::string> want = {"R", "G", "B", "A", "Z", "id"};
+  for (const rc::UncertaintyChannelInfo& info : rc::kUncertaintyChannelInfo)
+    want.emplace_back(info.name);
+  ASSERT_EQ(want.size(), 18u);
   ASSERT_EQ(spec.nchannels, static_cast<int>(want.size()));
   for (const std::string& name : want) {
     const int c = spec.channelindex(name);
