@@ -115,8 +115,8 @@ void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& c
     const double xb = a.x + t1 * (b.x - a.x);
     int col_first = 0;
     int col_end = 0;
-    if (!centreRange(std::min(xa, xb) - band, std::max(xa, xb) + band, clip.x0, clip.x1,
-                     col_first, col_end))
+    if (!centreRange(std::min(xa, xb) - band, std::max(xa, xb) + band, clip.x0, clip.x1, col_first,
+                     col_end))
       continue;
     lowerRow(edge_dist + static_cast<std::size_t>(height - 1 - py) * width, col_first, col_end, cy,
              a, b, reach);

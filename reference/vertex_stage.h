@@ -41,7 +41,6 @@ inline constexpr double kUlp32 = 0x1p-24;  // float32 unit roundoff
 // the renderer drops such triangles). Without `normals` (flat shading lights the face
 // normal, never a vertex normal) TransformedVertex::normal is left zero.
 void transformObject(const Object& object, const CameraTransform& camera,
-                     std::vector<TransformedVertex>& out, bool normals = true,
-                     bool errors = false);
+                     std::vector<TransformedVertex>& out, bool normals = true, bool errors = false);
 
 }  // namespace rc::ref

@@ -315,7 +315,7 @@ TEST(EdgeDist, DistanceToEdgeSegmentsCappedAtOne) {
   auto at = [&](int x, int gl_y) { return f.edge_dist[f.index(x, 15 - gl_y)]; };
   EXPECT_NEAR(at(3, 8), 0.25, kSmallReach);  // centre 3.5: 0.25 right of x = 3.25
   EXPECT_NEAR(at(2, 8), 0.75, kSmallReach);
-  EXPECT_FLOAT_EQ(at(4, 8), 1.0f);  // 1.25 away: capped
+  EXPECT_FLOAT_EQ(at(4, 8), 1.0f);          // 1.25 away: capped
   EXPECT_NEAR(at(8, 1), 0.5, kSmallReach);  // centre y 1.5 above the bottom edge y = 1
   // Below-left of the vertex (3.25, 1): distance to the segment end, not to the line.
   EXPECT_NEAR(at(2, 0), std::hypot(0.75, 0.5), kSmallReach);
