@@ -16,7 +16,7 @@ namespace rc {
 namespace {
 
 constexpr const char* kValidSpecs =
-    "ref, ref:painter, ref:subpixel=N, gl, gl:egl[:llvmpipe|:softpipe|:zink], "
+    "ref, ref:painter, ref:abuffer, ref:subpixel=N, gl, gl:egl[:llvmpipe|:softpipe|:zink], "
     "gl:osmesa[:llvmpipe|:softpipe], gl:egl-device[:N], a gl SPEC followed by @MESA_LIB_DIR";
 
 ReferenceOptions parseReferenceSpec(std::string_view spec) {
@@ -30,6 +30,8 @@ ReferenceOptions parseReferenceSpec(std::string_view spec) {
     rest = end == std::string_view::npos ? std::string_view{} : rest.substr(end);
     if (part == "painter") {
       opts.force_painter = true;
+    } else if (part == "abuffer") {
+      opts.abuffer = true;
     } else if (part.substr(0, 9) == "subpixel=") {
       const std::string_view num = part.substr(9);
       int bits = -1;

@@ -1,4 +1,5 @@
-// Backend SPECs (DESIGN.md): parsing `ref`, `ref:painter`, `ref:subpixel=N` and the
+// Backend SPECs (DESIGN.md): parsing `ref`, `ref:painter`, `ref:abuffer`, `ref:subpixel=N`
+// (options combine: `ref:abuffer:subpixel=4`) and the
 // `gl...` forms, and rendering one scene with one backend in this process. This is the
 // only place where the reference and the GL backend meet.
 #pragma once

@@ -29,9 +29,10 @@ int runCli(int argc, char** argv) {
   CLI::App* render_cmd = app.add_subcommand("render", "Render one fixture with one backend");
   render_cmd->add_option("scene", render.scene, "Fixture file (JSON)")->required();
   render_cmd
-      ->add_option("--backend,-b", render.backend,
-                   "ref, ref:painter, ref:subpixel=N, gl, gl:egl[:llvmpipe|:softpipe], "
-                   "gl:osmesa[:llvmpipe|:softpipe], gl:egl-device[:N]")
+      ->add_option(
+          "--backend,-b", render.backend,
+          "ref, ref:painter, ref:abuffer, ref:subpixel=N, gl, gl:egl[:llvmpipe|:softpipe|:zink], "
+          "gl:osmesa[:llvmpipe|:softpipe], gl:egl-device[:N]")
       ->capture_default_str();
   render_cmd->add_option("--out,-o", render.out, "Output folder (frame.exr, color.png, frame.json)")
       ->required();
@@ -78,6 +79,8 @@ int runCli(int argc, char** argv) {
   compare_cmd->add_option("--tolerance,-t", compare.tolerance,
                           "Override a threshold: CLASS.KEY=VALUE (visibility|depth|shading . "
                           "warn|fail, depth.slope_factor); repeatable");
+  compare_cmd->add_option("--flip-threshold", compare.flip_threshold,
+                          "Fail the pair when its mean LDR-FLIP error (0..1) exceeds this");
 
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand(
@@ -90,6 +93,8 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_option("--out,-o", run.out, "Report folder")->required();
   run_cmd->add_option("--tolerance,-t", run.tolerance, "As for compare; repeatable");
+  run_cmd->add_option("--flip-threshold", run.flip_threshold,
+                      "Fail a pair whose mean LDR-FLIP error (0..1) exceeds this");
   run_cmd->add_option("--jobs,-j", run.jobs, "Renders at a time (default: one per core)");
   run_cmd->add_option("--expectations", run.expectations,
                       "Known driver differences to mark as known failures: a file, or 'none' "
@@ -107,8 +112,9 @@ int runCli(int argc, char** argv) {
   explain_cmd->add_option("--backends,-b", explain.backends, "Backend SPECs to compare there")
       ->delimiter(',');
   explain_cmd
-      ->add_option("--reference", explain.reference,
-                   "Reference SPEC whose history is told (ref, ref:painter, ref:subpixel=N)")
+      ->add_option(
+          "--reference", explain.reference,
+          "Reference SPEC whose history is told (ref, ref:painter, ref:abuffer, ref:subpixel=N)")
       ->capture_default_str();
   explain_cmd->add_option("--tolerance,-t", explain.tolerance, "As for compare; repeatable");
   explain_cmd->add_flag("--json", explain.json, "Print JSON (documented in docs/explain.md)");

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,7 @@ struct CompareArgs {
   std::filesystem::path uncertainty;  // empty: the expected (or actual) frame's channels
   std::filesystem::path out;
   std::vector<std::string> tolerance;
+  std::optional<double> flip_threshold;  // a pair whose mean LDR-FLIP exceeds it fails
 };
 int compareCommand(const CompareArgs& args);
 
@@ -58,8 +60,9 @@ struct RunArgs {
   std::string against = "ref";
   std::filesystem::path out;
   std::vector<std::string> tolerance;
-  int jobs = 0;          // 0: one per core
-  bool variants = true;  // probe each GL backend's variants (app/variants.h)
+  std::optional<double> flip_threshold;  // as for compare
+  int jobs = 0;                          // 0: one per core
+  bool variants = true;                  // probe each GL backend's variants (app/variants.h)
   // Known driver differences to mark (compare/expectations.h): a file, "none", or empty
   // for the default (defaultExpectationsFile()).
   std::string expectations;

@@ -20,6 +20,11 @@ namespace fs = std::filesystem;
 int compareCommand(const CompareArgs& args) {
   CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
+  cli.extra.flip_mean_fail = args.flip_threshold;
+  {
+    Tolerances check;  // a bad threshold is refused before anything is read
+    applyOverrides(check, cli);
+  }
   // The frames are independent files: read them concurrently (decompression dominates),
   // each with the check that its color.png can be reused (a digest of the whole frame).
   struct Read {

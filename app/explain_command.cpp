@@ -407,6 +407,23 @@ std::string story(const Json& doc) {
       s += fmt::format("  colour buffer now {}\n", fmtVec(f["color_after"]));
     }
   }
+  if (doc.contains("abuffer")) {
+    const Json& ab = doc["abuffer"];
+    if (ab["fragments"].empty()) {
+      s += "\nA-buffer (ref:abuffer): no blended fragment here.\n";
+    } else {
+      s += fmt::format(
+          "\nA-buffer (ref:abuffer): {} blended fragment{}, far to near (the exact order){}:\n",
+          ab["fragments"].size(), ab["fragments"].size() == 1 ? "" : "s",
+          ab["draw_order_matches"].get<bool>() ? ", the same as the draw order"
+                                               : "; the draw order blends them differently");
+      for (const Json& f : ab["fragments"])
+        s += fmt::format("  {}. primitive {} ('{}', drawn {}.) window depth {}: src {} -> {}\n",
+                         f["rank"].get<int>(), f["primitive"].get<int>(),
+                         f["object"].get<std::string>(), f["draw_order"].get<int>() + 1,
+                         fmtNum(f["window_z"]), fmtVec(f["src"]), fmtVec(f["color_after"]));
+    }
+  }
   const Json& fin = doc["final"];
   s += fmt::format("\nfinal: primitive {}{}, colour {}, depth {}", fmtNum(fin["id"]),
                    fin["object"].is_null()
@@ -471,7 +488,7 @@ int explainCommand(const ExplainArgs& args) {
   if (reference.kind != BackendSpec::Kind::Reference)
     throw InputError(
         fmt::format("--reference {}: must be a reference SPEC (ref, ref:painter, "
-                    "ref:subpixel=N)",
+                    "ref:abuffer, ref:subpixel=N)",
                     args.reference));
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));
@@ -561,7 +578,9 @@ int explainCommand(const ExplainArgs& args) {
     // The buffer as the reference reads it back to blend (rgba8: exactly q / 255) and, in
     // color_after, as frame.exr holds it (a float per channel).
     const glm::dvec4 after = f.color_written;
-    if (f.depth_pass && pass.blend) {
+    // ref:abuffer keeps a blended fragment for its pixel's sorted list ("abuffer" below).
+    const bool kept = f.depth_pass && pass.blend && reference.reference.abuffer;
+    if (f.depth_pass && pass.blend && !kept) {
       const glm::dvec4 src = f.shading.color;
       j["blend"] = {
           {"src", vec(src)},
@@ -571,9 +590,9 @@ int explainCommand(const ExplainArgs& args) {
     } else {
       j["blend"] = nullptr;
     }
-    j["written"] = f.depth_pass;
+    j["written"] = f.depth_pass && !kept;
     j["color_after"] = vec(glm::dvec4(glm::vec4(after)));
-    if (f.depth_pass) {
+    if (f.depth_pass && !kept) {
       buffer = after;
       final_fragment = k + 1;
     }
@@ -581,6 +600,31 @@ int explainCommand(const ExplainArgs& args) {
     fragments.push_back(std::move(j));
   }
   doc["fragments"] = fragments;
+  // The A-buffer's sorted list (ref:abuffer as --reference or among --backends): the
+  // blended fragments far to near, as ref:abuffer blends them, beside the draw order above.
+  const bool show_abuffer = reference.reference.abuffer ||
+                            std::any_of(backends.begin(), backends.end(), [](const BackendSpec& b) {
+                              return b.kind == BackendSpec::Kind::Reference && b.reference.abuffer;
+                            });
+  if (show_abuffer) {
+    ReferenceOptions opts = reference.reference;
+    opts.abuffer = true;
+    Json list = Json::array();
+    std::uint32_t prev_order = 0;
+    bool in_order = true;
+    for (const SortedFragment& f : abufferPixel(scene, opts, pixel.x, pixel.y)) {
+      if (!list.empty() && f.draw_order < prev_order) in_order = false;
+      prev_order = f.draw_order;
+      list.push_back({{"rank", list.size() + 1},
+                      {"primitive", f.primitive},
+                      {"object", scene.objects[ctx.primitives[f.primitive - 1].object].name},
+                      {"draw_order", f.draw_order},
+                      {"window_z", num(f.window_z)},
+                      {"src", vec(f.color)},
+                      {"color_after", vec(glm::dvec4(glm::vec4(f.color_after)))}});
+    }
+    doc["abuffer"] = {{"fragments", list}, {"draw_order_matches", in_order}};
+  }
 
   const std::uint32_t final_id = frame.id[i];
   doc["final"] = {

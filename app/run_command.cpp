@@ -69,6 +69,11 @@ class Progress {
 int runCommand(const RunArgs& args) {
   CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
+  cli.extra.flip_mean_fail = args.flip_threshold;
+  {
+    Tolerances check;  // a bad threshold is refused before anything renders
+    applyOverrides(check, cli);
+  }
   Expectations known;
   if (args.expectations != "none") {
     const fs::path file =

@@ -13,7 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "compare/flip.h"
 #include "compare/histogram.h"
+#include "compare/oit.h"
 #include "compare/tolerances.h"
 #include "fixtures/frame.h"
 
@@ -156,6 +158,11 @@ struct PairResult {
   ShadingStats shading;
   NonFiniteCounts nonfinite_expected;
   NonFiniteCounts nonfinite_actual;
+  // Against an A-buffer frame (ref:abuffer): the distance from exact transparency.
+  std::optional<OitStats> oit;
+  // The perceptual error (LDR-FLIP): computed when maps are asked for or a FLIP threshold
+  // is set; its verdict joins the pair's status.
+  std::optional<FlipStats> flip;
   // Files written by writePairImages, by kind: expected, actual, visibility, depth_heat,
   // shading_heat, diff_exr. Reports print them relative to the report folder.
   std::map<std::string, std::filesystem::path> images;
@@ -180,12 +187,14 @@ struct ClassMaps {
   // Where shading_abs exceeds warn: the threshold it is held to (warn + its largest
   // channel error - that pixel's largest channel excess over its allowance), else 0.
   std::vector<float> shading_tolerance;
+  std::vector<float> flip;  // LDR-FLIP per pixel (every pixel), empty when not computed
 };
 
 // Compares `actual` with `expected`. `uncertainty` is the reference frame whose
 // edge_dist/depth_gap and Z classify the pair: usually `expected` itself (pass the same
 // object), or the reference render of the same fixture when both sides are GL drivers.
-// Without uncertainty channels every mismatch is hard. Subpixel bits come from each
+// Without uncertainty channels every mismatch is hard. FLIP (result.flip) is computed when
+// `maps` is given or tolerances.flip_mean_fail is set. Subpixel bits come from each
 // frame's meta["subpixel_bits"] (8 when absent). Throws InputError when sizes differ or
 // a frame's buffers do not match its size.
 PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame& uncertainty,

@@ -257,6 +257,46 @@ std::string rowsTable(const char* title, Status status,
 
 std::string at(const PixelRef& p, int height) { return where(p, height); }
 
+// The LDR-FLIP heat map (linear in the error, magma) and the tables of the additive
+// report blocks (flip, oit), kept together here so that they stay apart from the rest.
+std::string flipFigure(const PairResult& r, const fs::path& report_dir) {
+  if (!r.flip) return "";
+  return figure(r, "flip_heat", "LDR-FLIP error (0 to 1, magma)", report_dir,
+                fmt::format("<div class=\"ramp-labels\"><span>0</span><span>mean {}</span>"
+                            "<span>1</span></div>",
+                            esc(number(r.flip->mean))));
+}
+
+std::string flipAndOitTables(const PairResult& r) {
+  std::string out;
+  if (r.flip) {
+    const FlipStats& f = *r.flip;
+    out += rowsTable("flip (LDR-FLIP)", f.status,
+                     {{"mean", number(f.mean)},
+                      {"weighted median", number(f.weighted_median)},
+                      {"weighted quartiles", number(f.weighted_q1) + " / " + number(f.weighted_q3)},
+                      {"max", number(f.max)},
+                      {"pixels per degree", number(f.ppd)},
+                      {"fail above (mean)", f.threshold ? number(*f.threshold) : "none"}});
+  }
+  if (r.oit) {
+    const OitStats& o = *r.oit;
+    std::string pairs;
+    for (std::size_t k = 0; k < o.out_of_order.size() && k < 8; ++k)
+      pairs += fmt::format("{}{} over {} ({} px)", k ? ", " : "", o.out_of_order[k].far_id,
+                           o.out_of_order[k].near_id, o.out_of_order[k].pixels);
+    out += rowsTable(
+        "transparency vs exact (A-buffer)", Status::Pass,
+        {{"blended pixels", fmt::format("{}", o.blended_pixels)},
+         {"draw order not depth order", fmt::format("{}", o.unsorted_pixels)},
+         {"pixels over shading warn", fmt::format("{}", o.pixels)},
+         {"max abs (8-bit)", number(o.max_abs)},
+         {"mean abs (blended)", number(o.mean_abs)},
+         {"out-of-order pairs (far over near)", pairs.empty() ? std::string("none") : pairs}});
+  }
+  return out;
+}
+
 std::string pairSection(const PairResult& r, std::size_t k, const fs::path& report_dir,
                         const std::string& gradient) {
   // Passing pairs start folded so that a large run shows what needs attention.
@@ -276,6 +316,7 @@ std::string pairSection(const PairResult& r, std::size_t k, const fs::path& repo
                 heatLegend(r.depth_heat_scale, "steps", gradient));
   out += figure(r, "shading_heat", "shading max |dC| (8-bit units)", report_dir,
                 heatLegend(r.shading_heat_scale, "units", gradient));
+  out += flipFigure(r, report_dir);  // compare/flip.h; empty without FLIP
   out += "</div>";
   if (const auto it = r.images.find("diff_exr"); it != r.images.end())
     out += fmt::format("<div class=\"meta\">float channels: <a href=\"{0}\">{1}</a></div>",
@@ -340,6 +381,7 @@ std::string pairSection(const PairResult& r, std::size_t k, const fs::path& repo
        {"worst", at(s.worst, r.height)},
        {"worst error / allowance",
         fmt::format("{} / {}", number(s.worst_abs), number(s.worst_allowance))}});
+  out += flipAndOitTables(r);
   const std::uint64_t nf_e = r.nonfinite_expected.total();
   const std::uint64_t nf_a = r.nonfinite_actual.total();
   if (nf_e || nf_a) {

@@ -307,10 +307,16 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
       [&] { writeDiffExr(expected, actual, maps, result, tmp_diff, diff_exr); },
   });
 
+  // LDR-FLIP's heat map (compare/flip.h), when the comparison computed FLIP.
+  const fs::path flip_png = dir / "flip_heat.png";
+  if (maps.flip.size() == n)
+    writeRgb8(files.stage(flip_png), w, h, flipHeatRgb(maps.flip), flip_png);
+
   files.commit();
   result.images = {{"expected", expected_png},     {"actual", actual_png},
                    {"visibility", visibility_png}, {"depth_heat", depth_png},
                    {"shading_heat", shading_png},  {"diff_exr", diff_exr}};
+  if (maps.flip.size() == n) result.images["flip_heat"] = flip_png;
 }
 
 fs::path pairDirectory(const fs::path& out_dir, const PairResult& result) {

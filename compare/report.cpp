@@ -248,6 +248,9 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                   {"histogram", histogram(s.histogram, s.max_abs, "8-bit units")}};
   j["nonfinite"] = {{"expected", nonfinite(r.nonfinite_expected)},
                     {"actual", nonfinite(r.nonfinite_actual)}};
+  // Additive blocks kept in their own modules (compare/oit.h, compare/flip.h).
+  if (r.oit) j["oit"] = oitJson(*r.oit, r.height);
+  if (r.flip) j["flip"] = flipJson(*r.flip);
   json images = json::object();
   for (const auto& [kind, file] : r.images) images[kind] = relativePath(file, report_dir);
   j["images"] = images;
@@ -294,6 +297,9 @@ std::string describe(const PairResult& r) {
     parts.push_back(visibilityText(r));
   if (r.depth.status == r.status && r.status != Status::Pass) parts.push_back(depthText(r));
   if (r.shading.status == r.status && r.status != Status::Pass) parts.push_back(shadingText(r));
+  if (r.flip && r.flip->status == r.status && r.status != Status::Pass)
+    parts.push_back(fmt::format("flip: mean {:.4g} over the threshold {:.4g}", r.flip->mean,
+                                r.flip->threshold.value_or(0.0)));
   if (parts.empty()) return head;
   return head + ": " + fmt::format("{}", fmt::join(parts, "; "));
 }

@@ -111,6 +111,8 @@ void applyOverrides(Tolerances& tolerances, const CommandLineTolerances& overrid
   checkValue(x.shading_relative, "shading.relative");
   checkValue(x.shading_slope_factor, "shading.slope_factor");
   checkValue(x.band_px, "visibility.band");
+  checkValue(x.flip_mean_fail, "--flip-threshold");
+  if (x.flip_mean_fail) tolerances.flip_mean_fail = *x.flip_mean_fail;
   if (x.shading_relative) tolerances.shading_relative = *x.shading_relative;
   if (x.shading_slope_factor) tolerances.shading_slope_factor = *x.shading_slope_factor;
   if (x.band_px) tolerances.band_px = *x.band_px;

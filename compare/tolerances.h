@@ -60,6 +60,8 @@ struct Tolerances {
   double window_error_ulps = 16.0;
   // When set, replaces the derived visibility band (px); for experiments and odd backends.
   std::optional<double> band_px;
+  // When set (--flip-threshold), a pair whose mean LDR-FLIP error exceeds it fails.
+  std::optional<double> flip_mean_fail;
 };
 
 // What a pair's frames say about how it was drawn, beyond the formats (frame.json).
@@ -104,6 +106,7 @@ struct ExtraOverrides {
   std::optional<double> shading_relative;
   std::optional<double> shading_slope_factor;
   std::optional<double> band_px;
+  std::optional<double> flip_mean_fail;  // --flip-threshold
 };
 struct CommandLineTolerances {
   ToleranceOverrides thresholds;

@@ -6,6 +6,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <string>
 #include <type_traits>
 
@@ -28,6 +29,9 @@ using namespace rc::ref;
 
 constexpr int kMaxImageSide = 16384;
 constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 26;
+// frame.json "abuffer.out_of_order" lists at most this many triangle pairs (most pixels
+// first); "out_of_order_pairs" counts them all.
+constexpr std::size_t kMaxReportedPairs = 64;
 
 // ---- input validation -------------------------------------------------------------------
 
@@ -105,6 +109,19 @@ struct TexelNote {
   float gain = 0.0f;  // units per texel unit, weighted alike
 };
 
+// A blended fragment the A-buffer keeps (ReferenceOptions::abuffer) until its pixel's list
+// is sorted and blended.
+struct KeptFragment {
+  std::uint32_t index = 0;  // pixel, framebuffer order
+  std::uint32_t seq = 0;    // position of its triangle in the blending pass
+  std::uint32_t id = 0;     // primitive id
+  float slope = 0.0f;       // depth gradient, steps/px (uncertainty channels)
+  double z = 0.0;           // clamped window depth: the sort key
+  glm::dvec4 color{0.0};    // its colour and alpha, before blending
+  float alpha = 0.0f;       // clamped opacity (uncertainty channels)
+  TexelNote note;
+};
+
 // Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
 // a pixel; transformed vertices: 96 bytes each, Gouraud colours: 48), kept per thread
 // between renders so that rendering many frames does not page-fault fresh memory each
@@ -125,13 +142,15 @@ class Renderer {
   // Renders into a framebuffer covering `clip` (GL window coordinates): the whole image,
   // or one pixel when trace is non-null.
   Renderer(const Scene& scene, const ReferenceOptions& options, const PixelRect& clip,
-           std::vector<FragmentTrace>* trace)
+           std::vector<FragmentTrace>* trace, std::vector<SortedFragment>* sorted = nullptr)
       : scene_(scene),
         options_(options),
         clip_(clip),
         fb_width_(clip.x1 - clip.x0),
         fb_height_(clip.y1 - clip.y0),
         trace_(trace),
+        sorted_(sorted),
+        defer_blends_(options.abuffer),
         uncertainty_(options.uncertainty && trace == nullptr),
         depth_format_(scene.state.depth_format),
         color_format_(scene.state.color_format),
@@ -179,6 +198,7 @@ class Renderer {
   void traceTerms(const TriangleContext& t, const glm::dvec3& b, ShadingTerms& terms) const;
   void writeColor(std::size_t index, const glm::dvec4& src, bool blend);
   glm::dvec4 storedColor(std::size_t index) const;
+  void resolveABuffer();
 
   const Scene& scene_;
   const ReferenceOptions& options_;
@@ -186,6 +206,8 @@ class Renderer {
   const int fb_width_;
   const int fb_height_;
   std::vector<FragmentTrace>* trace_;
+  std::vector<SortedFragment>* sorted_;  // abufferPixel(): the traced pixel's sorted list
+  bool defer_blends_;                    // A-buffer: blends go to kept_ until resolved
   const bool uncertainty_;
   const DepthFormat depth_format_;
   const ColorFormat color_format_;
@@ -203,6 +225,9 @@ class Renderer {
   UncertaintyTracker& gaps_;           // scratch
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
+  std::vector<KeptFragment> kept_;     // A-buffer: blended fragments, in draw order
+  std::uint32_t blend_seq_ = 0;        // triangles of blending passes drawn so far
+  nlohmann::json abuffer_meta_;        // frame.json "abuffer"
 };
 
 void Renderer::transformVertices() {
@@ -236,8 +261,13 @@ Frame Renderer::run() {
   if (uncertainty_) gaps_.reset(frame_, depth_format_, clampDepth(scene_.clear_depth));
 
   transformVertices();
-  for (const DrawPass& pass : drawPasses(scene_, options_.force_painter))
-    for (const PrimitiveRef& prim : pass.primitives) drawTriangle(prim, pass);
+  for (const DrawPass& pass : drawPasses(scene_, options_.force_painter)) {
+    for (const PrimitiveRef& prim : pass.primitives) {
+      drawTriangle(prim, pass);
+      if (pass.blend) ++blend_seq_;
+    }
+  }
+  if (options_.abuffer) resolveABuffer();
   if (uncertainty_) gaps_.finish(frame_);
 
   // Stored depth back to [0, 1] (one simple loop per format, so that it vectorizes).
@@ -264,6 +294,7 @@ Frame Renderer::run() {
                  {"triangles_rasterized", triangles_drawn_},
                  {"fragments", fragments_},
                  {"timing_ms", {{"render", ms}}}};
+  if (options_.abuffer) frame_.meta["abuffer"] = std::move(abuffer_meta_);
   return std::move(frame_);
 }
 
@@ -517,6 +548,10 @@ glm::dvec4 Renderer::storedColor(std::size_t index) const {
 }
 
 inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool blend) {
+  if (blend && defer_blends_) {  // the fragment loop has just kept this fragment
+    kept_.back().color = src;
+    return;
+  }
   float* c = &frame_.color[4 * index];
   if (!blend) {
     for (int k = 0; k < 4; ++k) c[k] = storeColor(src[k], color_format_);
@@ -536,6 +571,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
   const bool always = t.pass->depth_func == DepthFunc::Always;
   const bool depth_write = t.pass->depth_write;
   const bool blend = t.pass->blend;
+  const bool keep = blend && defer_blends_;
   const float slope = t.depth_slope;
   const auto alpha = static_cast<float>(std::clamp(t.material->opacity, 0.0, 1.0));
   const std::uint32_t id = t.prim->id;
@@ -563,6 +599,13 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       }
       if (!pass) continue;
       if (depth_write) depth[index] = key;
+      if (keep) {  // blended later, in depth order (resolveABuffer)
+        kept_.push_back({static_cast<std::uint32_t>(index), blend_seq_, id, slope, z});
+        KeptFragment& kept = kept_.back();
+        kept.alpha = alpha;
+        kept.note = shade(index, row, dx);  // its colour goes to kept.color
+        continue;
+      }
       ids[index] = id;
       const TexelNote note = shade(index, row, dx);
       if constexpr (kGaps) gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain);
@@ -722,13 +765,98 @@ void Renderer::traceSpans(const TriangleContext& t, const TriangleCoverage& cove
       const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading);
       if (pass) {
         if (t.pass->depth_write) depth_[index] = key;
-        frame_.id[index] = t.prim->id;
+        if (t.pass->blend && defer_blends_) {
+          kept_.push_back({static_cast<std::uint32_t>(index), blend_seq_, t.prim->id, 0.0f, z});
+        } else {
+          frame_.id[index] = t.prim->id;
+        }
         writeColor(index, color, t.pass->blend);
       }
       f.color_written = storedColor(index);
       trace_->push_back(std::move(f));
     }
   });
+}
+
+// The A-buffer's resolve: each pixel's kept fragments sorted far to near (window depth,
+// ties in draw order: the order the sorted-triangle pass would blend them in), blended in
+// that order through writeColor() (so that where the orders agree the colour is bit for
+// bit the plain reference's), the nearest one as the id. Also the uncertainty channels of
+// that order (UncertaintyTracker::sortedList) and which triangles the draw order blends
+// out of depth order (frame.json "abuffer").
+void Renderer::resolveABuffer() {
+  defer_blends_ = false;
+  std::stable_sort(kept_.begin(), kept_.end(), [](const KeptFragment& a, const KeptFragment& b) {
+    if (a.index != b.index) return a.index < b.index;
+    if (a.z != b.z) return a.z > b.z;
+    return a.seq < b.seq;
+  });
+  struct PairCount {
+    std::uint64_t pixels = 0;
+    std::uint32_t first = 0;  // pixel index
+  };
+  std::map<std::pair<std::uint32_t, std::uint32_t>, PairCount> pairs;  // (near, far)
+  std::uint64_t blended_pixels = 0;
+  std::uint64_t unsorted_pixels = 0;
+  std::vector<double> z;
+  std::vector<float> slope;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> seen;
+  for (std::size_t b = 0; b < kept_.size();) {
+    std::size_t e = b;
+    while (e < kept_.size() && kept_[e].index == kept_[b].index) ++e;
+    const std::size_t index = kept_[b].index;
+    ++blended_pixels;
+    z.clear();
+    slope.clear();
+    for (std::size_t k = b; k < e; ++k) {
+      const KeptFragment& f = kept_[k];
+      writeColor(index, f.color, true);
+      if (uncertainty_)
+        gaps_.colourWritten(index, true, f.alpha, f.note.dist, f.note.alt, f.note.gain);
+      z.push_back(f.z);
+      slope.push_back(f.slope);
+      if (sorted_ != nullptr) sorted_->push_back({f.id, f.seq, f.z, f.color, storedColor(index)});
+    }
+    frame_.id[index] = kept_[e - 1].id;
+    if (uncertainty_) gaps_.sortedList(index, z.data(), slope.data(), z.size());
+    // Inversions: a farther fragment (earlier in the list) drawn after a nearer one.
+    seen.clear();
+    for (std::size_t i = b; i < e; ++i)
+      for (std::size_t j = i + 1; j < e; ++j)
+        if (kept_[i].seq > kept_[j].seq && kept_[i].id != kept_[j].id)
+          seen.emplace_back(kept_[j].id, kept_[i].id);
+    if (!seen.empty()) {
+      ++unsorted_pixels;
+      std::sort(seen.begin(), seen.end());
+      seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+      for (const auto& p : seen) {
+        PairCount& c = pairs[p];
+        if (c.pixels++ == 0) c.first = static_cast<std::uint32_t>(index);
+      }
+    }
+    b = e;
+  }
+  std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, PairCount>> list(pairs.begin(),
+                                                                                  pairs.end());
+  std::stable_sort(list.begin(), list.end(),
+                   [](const auto& a, const auto& b) { return a.second.pixels > b.second.pixels; });
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t k = 0; k < list.size() && k < kMaxReportedPairs; ++k) {
+    const std::uint32_t first = list[k].second.first;
+    const int x = clip_.x0 + static_cast<int>(first % static_cast<std::uint32_t>(fb_width_));
+    const int y = (scene_.height - clip_.y1) +
+                  static_cast<int>(first / static_cast<std::uint32_t>(fb_width_));
+    out.push_back({{"near", list[k].first.first},
+                   {"far", list[k].first.second},
+                   {"pixels", list[k].second.pixels},
+                   {"first", {x, y}}});
+  }
+  abuffer_meta_ = {{"kept_fragments", kept_.size()},
+                   {"blended_pixels", blended_pixels},
+                   {"unsorted_pixels", unsorted_pixels},
+                   {"out_of_order_pairs", list.size()},
+                   {"out_of_order", std::move(out)}};
+  kept_ = {};
 }
 
 }  // namespace
@@ -751,6 +879,22 @@ std::vector<FragmentTrace> tracePixel(const Scene& scene, const ReferenceOptions
   Renderer renderer(scene, options, PixelRect{x, y, x + 1, y + 1}, &trace);
   renderer.run();
   return trace;
+}
+
+std::vector<SortedFragment> abufferPixel(const Scene& scene, ReferenceOptions options, int x,
+                                         int y_image) {
+  options.abuffer = true;
+  validate(scene, options);
+  if (x < 0 || x >= scene.width || y_image < 0 || y_image >= scene.height)
+    throw InputError(sceneLabel(scene) + ": pixel " + std::to_string(x) + "," +
+                     std::to_string(y_image) + " is outside the " + std::to_string(scene.width) +
+                     "x" + std::to_string(scene.height) + " image");
+  const int y = scene.height - 1 - y_image;
+  std::vector<FragmentTrace> trace;
+  std::vector<SortedFragment> sorted;
+  Renderer renderer(scene, options, PixelRect{x, y, x + 1, y + 1}, &trace, &sorted);
+  renderer.run();
+  return sorted;
 }
 
 }  // namespace rc

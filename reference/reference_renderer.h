@@ -26,7 +26,13 @@ namespace rc {
 struct ReferenceOptions {
   int subpixel_bits = 8;       // vertex snapping grid: 1 / 2^bits px, in [0, 12]
   bool force_painter = false;  // `ref:painter`: draw far-to-near with no depth test
-  bool uncertainty = true;     // compute edge_dist and depth_gap
+  // `ref:abuffer`: exact order-independent transparency. Every fragment of a blending pass
+  // that passes its depth test (against the opaque depth: that pass does not write depth)
+  // is kept in its pixel's list; after the last pass each list is sorted far to near
+  // (window depth, ties in draw order) and blended in that order, and the pixel's id is
+  // its nearest blended fragment. Opaque passes are unchanged.
+  bool abuffer = false;
+  bool uncertainty = true;  // compute edge_dist and depth_gap
 };
 
 // Renders the scene. Throws InputError for options out of range (subpixel_bits outside
@@ -36,7 +42,7 @@ struct ReferenceOptions {
 // frame.meta: {"renderer", "subpixel_bits", "painter_forced", "triangles_rasterized" (fan
 // triangles, after clipping and culling, that covered a pixel centre's bounding box),
 // "fragments" (covered pixel centres, whether they passed the depth test or not),
-// "timing_ms": {"render"}}.
+// "timing_ms": {"render"}}; with options.abuffer also "abuffer" (see abufferMeta below).
 Frame renderReference(const Scene& scene, const ReferenceOptions& options = {});
 
 // One fragment that reached a pixel, in draw order (`rastercheck explain`).
@@ -52,6 +58,20 @@ struct FragmentTrace {
   glm::dvec4 color_written{0.0};  // the colour buffer after this fragment (blended and
                                   // converted; unchanged when the depth test failed)
 };
+
+// A blended fragment of the A-buffer's sorted list at one pixel (`explain`).
+struct SortedFragment {
+  std::uint32_t primitive = 0;   // primitive id (1-based)
+  std::uint32_t draw_order = 0;  // its position in the blending pass (0 = drawn first)
+  double window_z = 0.0;         // clamped, unquantized window depth: the sort key
+  glm::dvec4 color{0.0};         // the fragment's colour and alpha
+  glm::dvec4 color_after{0.0};   // the colour buffer after blending it (stored form)
+};
+
+// The sorted list of image pixel (x, y_image) under options.abuffer (forced on), far to
+// near, exactly as renderReference() blends it there. Errors as tracePixel().
+std::vector<SortedFragment> abufferPixel(const Scene& scene, ReferenceOptions options, int x,
+                                         int y_image);
 
 // Every fragment that covers image pixel (x, y_image) (top-left origin, y down), in draw
 // order, rendered exactly as renderReference() renders it (the same passes and depth

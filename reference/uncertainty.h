@@ -153,6 +153,30 @@ class UncertaintyTracker {
     texel_gain_[index] = (1.0f - alpha) * texel_gain_[index] + texel_gain;
   }
 
+  // The A-buffer's sorted list at a pixel (ReferenceOptions::abuffer): window depths z and
+  // slopes of its n >= 1 blended fragments, far to near, after passed()/failed() saw them
+  // in draw order. The nearest is the id: its test against the stored depth and its order
+  // against the next nearest decide it (depth_gap, kept as the smaller of these and what
+  // the stream gave); every neighbouring pair's order decides the colour, since another
+  // implementation's depths may order them the other way within the gap (blend_gap).
+  void sortedList(std::size_t index, const double* z, const float* slope, std::size_t n) {
+    const std::size_t near = n - 1;
+    if (!std::isinf(stored_z_[index])) {
+      const float g = toSteps(std::fabs(z[near] - stored_z_[index]));
+      if (g < gap_[index]) gap_[index] = g;
+      gap_slope_[index] = std::max({gap_slope_[index], slope[near], depth_slope_[index]});
+    }
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+      const float g = toSteps(z[k] - z[k + 1]);
+      if (g < blend_gap_[index]) blend_gap_[index] = g;
+      blend_slope_[index] = std::max({blend_slope_[index], slope[k], slope[k + 1]});
+      if (k + 1 == near) {
+        if (g < gap_[index]) gap_[index] = g;
+        gap_slope_[index] = std::max({gap_slope_[index], slope[k], slope[near]});
+      }
+    }
+  }
+
   // Ends the frame: clear_gap from each pixel's final id (frame.id).
   void finish(Frame& frame) {
     for (std::size_t i = 0; i < frame.pixelCount(); ++i) {

@@ -1,0 +1,390 @@
+// LDR-FLIP from the formulas of Andersson et al., HPG 2020 (see flip.h): the colour
+// pipeline (CSF filtering in YyCxCz, Hunt-adjusted CIELAB, HyAB distance, remapping), the
+// feature pipeline (edge and point detectors on the achromatic channel), and their
+// combination. Computed in double; the map is stored as float.
+#include "compare/flip.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <fmt/format.h>
+
+#include "fixtures/errors.h"
+
+namespace rc {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The paper's constants.
+constexpr double kQc = 0.7;                 // exponent of the HyAB colour distance
+constexpr double kPc = 0.4;                 // remapping knee, as a fraction of cmax
+constexpr double kPt = 0.95;                // remapped error at the knee
+constexpr double kQf = 0.5;                 // exponent of the feature difference
+constexpr double kFeatureWidthDeg = 0.082;  // w: feature detector width (degrees)
+
+// Contrast sensitivity of one opponent channel, as a spatial filter (x in degrees):
+// S(x) = a1 sqrt(pi / b1) exp(-pi^2 x^2 / b1) + a2 sqrt(pi / b2) exp(-pi^2 x^2 / b2).
+struct Csf {
+  double a1, b1, a2, b2;
+};
+constexpr Csf kCsf[3] = {
+    {1.0, 0.0047, 0.0, 1e-5},   // achromatic (Yy)
+    {1.0, 0.0053, 0.0, 1e-5},   // red-green (Cx)
+    {34.1, 0.04, 13.5, 0.025},  // blue-yellow (Cz)
+};
+constexpr double kCsfMaxB = 0.04;  // the largest b: sets the filter radius for all three
+
+// Linear sRGB (D65 white) to CIE XYZ, IEC 61966-2-1.
+constexpr double kRgbToXyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
+                                    {0.2126729, 0.7151522, 0.0721750},
+                                    {0.0193339, 0.1191920, 0.9503041}};
+
+struct Vec3 {
+  double v[3];
+  double operator[](int i) const { return v[i]; }
+  double& operator[](int i) { return v[i]; }
+};
+
+Vec3 mul(const double m[3][3], const Vec3& x) {
+  Vec3 r{};
+  for (int i = 0; i < 3; ++i) r[i] = m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2];
+  return r;
+}
+
+// The inverse of kRgbToXyz (Cramer's rule) and the reference white: XYZ of RGB (1, 1, 1).
+struct ColorSpace {
+  double xyz_to_rgb[3][3];
+  Vec3 white;
+  ColorSpace() {
+    const auto& m = kRgbToXyz;
+    const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                       m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                       m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const int r0 = (j + 1) % 3, r1 = (j + 2) % 3, c0 = (i + 1) % 3, c1 = (i + 2) % 3;
+        xyz_to_rgb[i][j] = (m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]) / det;
+      }
+    white = mul(kRgbToXyz, Vec3{{1.0, 1.0, 1.0}});
+  }
+};
+const ColorSpace& colorSpace() {
+  static const ColorSpace cs;
+  return cs;
+}
+
+double srgbToLinear(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+// XYZ <-> YyCxCz: CIELAB without its cube root (a linear opponent space where filtering is
+// meaningful): Yy = 116 Y/Yn - 16, Cx = 500 (X/Xn - Y/Yn), Cz = 200 (Y/Yn - Z/Zn).
+Vec3 xyzToYcc(const Vec3& xyz, const Vec3& w) {
+  const double y = xyz[1] / w[1];
+  return {{116.0 * y - 16.0, 500.0 * (xyz[0] / w[0] - y), 200.0 * (y - xyz[2] / w[2])}};
+}
+Vec3 yccToXyz(const Vec3& ycc, const Vec3& w) {
+  const double y = (ycc[0] + 16.0) / 116.0;
+  return {{(ycc[1] / 500.0 + y) * w[0], y * w[1], (y - ycc[2] / 200.0) * w[2]}};
+}
+
+// CIELAB, then the Hunt adjustment of the chroma by lightness: a' = 0.01 L a, b' = 0.01 L b.
+Vec3 huntLab(const Vec3& xyz, const Vec3& w) {
+  constexpr double d = 6.0 / 29.0;
+  auto f = [&](double t) { return t > d * d * d ? std::cbrt(t) : t / (3.0 * d * d) + 4.0 / 29.0; };
+  const double fx = f(xyz[0] / w[0]);
+  const double fy = f(xyz[1] / w[1]);
+  const double fz = f(xyz[2] / w[2]);
+  const double l = 116.0 * fy - 16.0;
+  return {{l, 0.01 * l * 500.0 * (fx - fy), 0.01 * l * 200.0 * (fy - fz)}};
+}
+
+// HyAB: |dL| + Euclidean distance in the (a', b') plane.
+double hyab(const Vec3& p, const Vec3& q) {
+  return std::fabs(p[0] - q[0]) + std::hypot(p[1] - q[1], p[2] - q[2]);
+}
+
+// ---- separable filtering, borders clamped to the edge pixel ------------------------------
+
+using Plane = std::vector<double>;
+
+void filterRows(const Plane& in, int w, int h, const std::vector<double>& k, Plane& out) {
+  const int r = static_cast<int>(k.size() / 2);
+  std::vector<double> row(static_cast<std::size_t>(w + 2 * r));
+  out.assign(in.size(), 0.0);
+  for (int y = 0; y < h; ++y) {
+    const double* src = &in[static_cast<std::size_t>(y) * w];
+    for (int x = -r; x < w + r; ++x) row[x + r] = src[std::clamp(x, 0, w - 1)];
+    double* dst = &out[static_cast<std::size_t>(y) * w];
+    for (std::size_t t = 0; t < k.size(); ++t) {
+      const double kt = k[t];
+      const double* s = &row[t];
+      for (int x = 0; x < w; ++x) dst[x] += kt * s[x];
+    }
+  }
+}
+
+void filterColumns(const Plane& in, int w, int h, const std::vector<double>& k, Plane& out) {
+  const int r = static_cast<int>(k.size() / 2);
+  out.assign(in.size(), 0.0);
+  for (int y = 0; y < h; ++y) {
+    double* dst = &out[static_cast<std::size_t>(y) * w];
+    for (std::size_t t = 0; t < k.size(); ++t) {
+      const int sy = std::clamp(y + static_cast<int>(t) - r, 0, h - 1);
+      const double kt = k[t];
+      const double* s = &in[static_cast<std::size_t>(sy) * w];
+      for (int x = 0; x < w; ++x) dst[x] += kt * s[x];
+    }
+  }
+}
+
+// The CSF filter of one channel, normalized to sum 1 over its (2r+1)^2 support, applied as
+// a weighted sum of separable Gaussians (each term of S is a product in x and y).
+void csfFilter(Plane& channel, int w, int h, const Csf& c, double ppd, int r) {
+  const std::size_t n = static_cast<std::size_t>(2 * r + 1);
+  Plane blurred[2];
+  double weight[2] = {0.0, 0.0};
+  const double a[2] = {c.a1, c.a2};
+  const double b[2] = {c.b1, c.b2};
+  Plane tmp;
+  for (int term = 0; term < 2; ++term) {
+    if (a[term] == 0.0) continue;
+    std::vector<double> g(n);
+    for (int i = -r; i <= r; ++i) {
+      const double x = i / ppd;  // degrees
+      g[i + r] = std::exp(-kPi * kPi * x * x / b[term]);
+    }
+    const double sum = std::accumulate(g.begin(), g.end(), 0.0);
+    for (double& v : g) v /= sum;
+    // The term's share of the 2D kernel's sum.
+    weight[term] = a[term] * std::sqrt(kPi / b[term]) * sum * sum;
+    filterRows(channel, w, h, g, tmp);
+    filterColumns(tmp, w, h, g, blurred[term]);
+  }
+  const double total = weight[0] + weight[1];
+  for (std::size_t i = 0; i < channel.size(); ++i) {
+    double v = 0.0;
+    for (int term = 0; term < 2; ++term)
+      if (weight[term] > 0.0) v += weight[term] / total * blurred[term][i];
+    channel[i] = v;
+  }
+}
+
+// The feature detectors' 1D factors (x in px, sigma = 0.5 w ppd, radius ceil(3 sigma)): the
+// 2D first- and second-derivative-of-Gaussian kernels are products of one of these along
+// the derivative's axis and the normalized Gaussian along the other, and normalizing the
+// 2D kernel's positive weights to 1 and negative ones to -1 normalizes the 1D factor so.
+struct FeatureKernels {
+  std::vector<double> smooth, edge, point;
+};
+FeatureKernels featureKernels(double ppd) {
+  const double sigma = 0.5 * kFeatureWidthDeg * ppd;
+  const int r = static_cast<int>(std::ceil(3.0 * sigma));
+  FeatureKernels k;
+  for (int i = -r; i <= r; ++i) {
+    const double x = i;
+    const double g = std::exp(-x * x / (2.0 * sigma * sigma));
+    k.smooth.push_back(g);
+    k.edge.push_back(-x * g);
+    k.point.push_back((x * x / (sigma * sigma) - 1.0) * g);
+  }
+  const double s = std::accumulate(k.smooth.begin(), k.smooth.end(), 0.0);
+  for (double& v : k.smooth) v /= s;
+  for (std::vector<double>* f : {&k.edge, &k.point}) {
+    double pos = 0.0, neg = 0.0;
+    for (double v : *f) (v > 0.0 ? pos : neg) += v;
+    for (double& v : *f) v = v > 0.0 ? v / pos : v < 0.0 ? v / -neg : 0.0;
+  }
+  return k;
+}
+
+// |gradient| and |(Ixx, Iyy)| of the achromatic channel.
+void features(const Plane& lum, int w, int h, const FeatureKernels& k, Plane& edge, Plane& point) {
+  Plane sx, ex, px, a, b;
+  filterRows(lum, w, h, k.smooth, sx);
+  filterRows(lum, w, h, k.edge, ex);
+  filterRows(lum, w, h, k.point, px);
+  filterColumns(ex, w, h, k.smooth, a);
+  filterColumns(sx, w, h, k.edge, b);
+  edge.resize(lum.size());
+  for (std::size_t i = 0; i < lum.size(); ++i) edge[i] = std::hypot(a[i], b[i]);
+  filterColumns(px, w, h, k.smooth, a);
+  filterColumns(sx, w, h, k.point, b);
+  point.resize(lum.size());
+  for (std::size_t i = 0; i < lum.size(); ++i) point[i] = std::hypot(a[i], b[i]);
+}
+
+struct Prepared {
+  Plane ycc[3];  // filtered
+  Plane lum;     // Y / Yn, unfiltered: the feature detectors' input
+};
+
+Prepared prepare(const FlipImage& img, double ppd) {
+  const ColorSpace& cs = colorSpace();
+  const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
+  Prepared p;
+  for (Plane& c : p.ycc) c.resize(n);
+  p.lum.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 lin{};
+    for (int c = 0; c < 3; ++c)
+      lin[c] = srgbToLinear(std::clamp(static_cast<double>(img.rgb[3 * i + c]), 0.0, 1.0));
+    const Vec3 ycc = xyzToYcc(mul(kRgbToXyz, lin), cs.white);
+    for (int c = 0; c < 3; ++c) p.ycc[c][i] = ycc[c];
+    p.lum[i] = (ycc[0] + 16.0) / 116.0;
+  }
+  const int r = static_cast<int>(std::ceil(3.0 * std::sqrt(kCsfMaxB / (2.0 * kPi * kPi)) * ppd));
+  for (int c = 0; c < 3; ++c) csfFilter(p.ycc[c], img.width, img.height, kCsf[c], ppd, r);
+  return p;
+}
+
+// Filtered YyCxCz -> linear RGB clamped to [0, 1] (filtering may leave the gamut) -> Hunt Lab.
+Vec3 filteredHunt(const Prepared& p, std::size_t i) {
+  const ColorSpace& cs = colorSpace();
+  Vec3 rgb = mul(cs.xyz_to_rgb, yccToXyz(Vec3{{p.ycc[0][i], p.ycc[1][i], p.ycc[2][i]}}, cs.white));
+  for (int c = 0; c < 3; ++c) rgb[c] = std::clamp(rgb[c], 0.0, 1.0);
+  return huntLab(mul(kRgbToXyz, rgb), cs.white);
+}
+
+void checkImage(const FlipImage& img, const char* role) {
+  if (img.width < 1 || img.height < 1 ||
+      img.rgb.size() != 3 * static_cast<std::size_t>(img.width) * img.height)
+    throw InputError(fmt::format("FLIP: the {} image's buffer does not match its size {}x{}", role,
+                                 img.width, img.height));
+}
+
+}  // namespace
+
+double FlipViewing::pixelsPerDegree() const {
+  return distance_m * (monitor_width_px / monitor_width_m) * kPi / 180.0;
+}
+
+std::vector<float> flipError(const FlipImage& reference, const FlipImage& test,
+                             const FlipViewing& viewing) {
+  checkImage(reference, "reference");
+  checkImage(test, "test");
+  if (reference.width != test.width || reference.height != test.height)
+    throw InputError(fmt::format("FLIP: images differ in size ({}x{} and {}x{})", reference.width,
+                                 reference.height, test.width, test.height));
+  const int w = reference.width;
+  const int h = reference.height;
+  const double ppd = viewing.pixelsPerDegree();
+  const Prepared pr = prepare(reference, ppd);
+  const Prepared pt = prepare(test, ppd);
+
+  // cmax: the distance between green and blue, the largest in the sRGB gamut.
+  const ColorSpace& cs = colorSpace();
+  const double cmax = std::pow(hyab(huntLab(mul(kRgbToXyz, Vec3{{0.0, 1.0, 0.0}}), cs.white),
+                                    huntLab(mul(kRgbToXyz, Vec3{{0.0, 0.0, 1.0}}), cs.white)),
+                               kQc);
+
+  const FeatureKernels k = featureKernels(ppd);
+  Plane edge_r, point_r, edge_t, point_t;
+  features(pr.lum, w, h, k, edge_r, point_r);
+  features(pt.lum, w, h, k, edge_t, point_t);
+
+  std::vector<float> out(static_cast<std::size_t>(w) * h);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double e = std::pow(hyab(filteredHunt(pr, i), filteredHunt(pt, i)), kQc);
+    double color = e < kPc * cmax ? kPt / (kPc * cmax) * e
+                                  : kPt + (e - kPc * cmax) / (cmax - kPc * cmax) * (1.0 - kPt);
+    color = std::min(color, 1.0);
+    const double feature =
+        std::pow(std::max(std::fabs(edge_r[i] - edge_t[i]), std::fabs(point_r[i] - point_t[i])) /
+                     std::sqrt(2.0),
+                 kQf);
+    out[i] = static_cast<float>(std::pow(color, 1.0 - std::min(feature, 1.0)));
+  }
+  return out;
+}
+
+FlipImage flipImageOf(const Frame& frame) {
+  FlipImage img;
+  img.width = frame.width;
+  img.height = frame.height;
+  const std::size_t n = frame.pixelCount();
+  img.rgb.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float v = frame.color[4 * i + c];
+      img.rgb[3 * i + c] = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
+    }
+  return img;
+}
+
+FlipStats poolFlip(const std::vector<float>& error) {
+  FlipStats s;
+  if (error.empty()) return s;
+  std::vector<float> sorted(error);
+  std::sort(sorted.begin(), sorted.end());
+  double total = 0.0;
+  for (float v : sorted) total += v;
+  s.mean = total / static_cast<double>(sorted.size());
+  s.min = sorted.front();
+  s.max = sorted.back();
+  if (total <= 0.0) return s;
+  const double fractions[3] = {0.25, 0.5, 0.75};
+  double* targets[3] = {&s.weighted_q1, &s.weighted_median, &s.weighted_q3};
+  double cum = 0.0;
+  int next = 0;
+  for (float v : sorted) {
+    cum += v;
+    while (next < 3 && cum >= fractions[next] * total) *targets[next++] = v;
+    if (next == 3) break;
+  }
+  while (next < 3) *targets[next++] = s.max;  // rounding of the running sum
+  return s;
+}
+
+FlipStats flipFrames(const Frame& expected, const Frame& actual, const Tolerances& tolerances,
+                     std::vector<float>* map) {
+  const FlipViewing viewing;
+  std::vector<float> error = flipError(flipImageOf(expected), flipImageOf(actual), viewing);
+  FlipStats s = poolFlip(error);
+  s.ppd = viewing.pixelsPerDegree();
+  s.threshold = tolerances.flip_mean_fail;
+  if (s.threshold && s.mean > *s.threshold) s.status = Status::Fail;
+  if (map) *map = std::move(error);
+  return s;
+}
+
+std::vector<std::uint8_t> flipHeatRgb(const std::vector<float>& error) {
+  static const std::vector<std::uint8_t> lut = [] {
+    constexpr int kCount = 256;
+    std::vector<float> ramp(kCount);
+    for (int i = 0; i < kCount; ++i) ramp[i] = static_cast<float>(i) / (kCount - 1);
+    OIIO::ImageBuf src(OIIO::ImageSpec(kCount, 1, 1, OIIO::TypeDesc::FLOAT), ramp.data());
+    OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, kFlipColorMap);
+    std::vector<float> rgb(3 * kCount, 0.0f);
+    mapped.get_pixels(mapped.roi(), OIIO::TypeDesc::FLOAT, rgb.data());
+    std::vector<std::uint8_t> out(3 * kCount);
+    for (int i = 0; i < 3 * kCount; ++i)
+      out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i], 0.0f, 1.0f) * 255.0f));
+    return out;
+  }();
+  std::vector<std::uint8_t> out(3 * error.size());
+  for (std::size_t i = 0; i < error.size(); ++i) {
+    const float e = std::isnan(error[i]) ? 1.0f : std::clamp(error[i], 0.0f, 1.0f);
+    const auto k = static_cast<std::size_t>(std::lround(e * 255.0f));
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = lut[3 * k + c];
+  }
+  return out;
+}
+
+nlohmann::json flipJson(const FlipStats& s) {
+  return {{"status", toString(s.status)},
+          {"mean", s.mean},
+          {"weighted_median", s.weighted_median},
+          {"weighted_q1", s.weighted_q1},
+          {"weighted_q3", s.weighted_q3},
+          {"min", s.min},
+          {"max", s.max},
+          {"threshold", s.threshold ? nlohmann::json(*s.threshold) : nlohmann::json(nullptr)},
+          {"pixels_per_degree", s.ppd}};
+}
+
+}  // namespace rc
