@@ -14,7 +14,9 @@ std::optional<OitStats> compareOit(const Frame& expected, const Frame& actual,
   s.threshold = tolerances.shading.warn;
   auto count = [&](const char* key) -> std::uint64_t {
     const auto it = meta->find(key);
-    return it != meta->end() && it->is_number_unsigned() ? it->get<std::uint64_t>() : 0;
+    return it != meta->end() && it->is_number_integer() && it->get<std::int64_t>() >= 0
+               ? it->get<std::uint64_t>()
+               : 0;
   };
   s.unsorted_pixels = count("unsorted_pixels");
   s.pairs_total = count("out_of_order_pairs");
