@@ -15,6 +15,7 @@
 
 #include "fixtures/catalog.h"
 #include "fixtures/loader.h"
+#include "reference/reference_renderer.h"
 #include "tests/conformance/conformance_support.h"
 #include "tests/support/command.h"
 
@@ -31,7 +32,7 @@ const std::vector<std::string> kRequiredTags = {
     "orthographic", "flat",          "gouraud",        "phong",           "blinn-phong",
     "ambient",      "diffuse",       "specular",       "point-light",     "directional-light",
     "attenuation",  "normal-matrix", "vertex-normals", "texture",         "transparency",
-    "real-mesh"};
+    "real-mesh",    "oit"};
 
 std::string joinLines(const std::vector<std::string>& lines) {
   std::string out;
@@ -127,6 +128,46 @@ TEST(FixtureDesign, CyclicOverlapDefeatsPainterAtOneCrossing) {
   EXPECT_EQ(pairs, (std::set<std::pair<std::uint32_t, std::uint32_t>>{{1, 2}}));
   // Where two sticks overlap they are at least ~0.1 apart in eye space: thousands of steps.
   EXPECT_GT(min_gap, 1000.0f);
+}
+
+// The A-buffer fixtures (tag oit): on oit_sorted_exact the sorted alpha pass is already
+// exact, so the plain reference equals ref:abuffer bit for bit; on oit_cyclic they differ
+// exactly where sticks 0 and 1 cross (found here from each stick rendered alone), where
+// the exact answer shows stick 0 (id 1) over stick 1 and the draw order the reverse.
+TEST(FixtureDesign, ABufferEqualsSortingWhereExactAndDiffersAtTheCyclicCrossing) {
+  ReferenceOptions exact;
+  exact.abuffer = true;
+  const Scene sorted = loadScene(catalogDir() / "transparency" / "oit_sorted_exact.json");
+  const Frame plain = rc::renderReference(sorted, ReferenceOptions{});
+  const Frame abuffer = rc::renderReference(sorted, exact);
+  EXPECT_EQ(plain.color, abuffer.color);
+  EXPECT_EQ(plain.id, abuffer.id);
+  EXPECT_EQ(abuffer.meta["abuffer"]["unsorted_pixels"].get<int>(), 0);
+  EXPECT_GT(abuffer.meta["abuffer"]["blended_pixels"].get<int>(), 2000);
+
+  const Scene cyclic = loadScene(catalogDir() / "transparency" / "oit_cyclic.json");
+  ASSERT_EQ(cyclic.objects.size(), 4u);  // three sticks, then the wall
+  auto alone = [&](std::size_t k) {
+    Scene s = cyclic;
+    s.objects = {cyclic.objects[k]};
+    return rc::renderReference(s, ReferenceOptions{});
+  };
+  const Frame s0 = alone(0), s1 = alone(1), s2 = alone(2);
+  const Frame p = rc::renderReference(cyclic, ReferenceOptions{});
+  const Frame x = rc::renderReference(cyclic, exact);
+  std::size_t crossing = 0;
+  for (std::size_t i = 0; i < p.pixelCount(); ++i) {
+    const bool expected_differ = s0.id[i] != 0 && s1.id[i] != 0;
+    bool differ = p.id[i] != x.id[i];
+    for (int c = 0; c < 4; ++c) differ = differ || p.color[4 * i + c] != x.color[4 * i + c];
+    EXPECT_EQ(differ, expected_differ) << "pixel " << i % p.width << "," << i / p.width;
+    if (!expected_differ || s2.id[i] != 0) continue;
+    ++crossing;
+    EXPECT_EQ(x.id[i], 1u);
+    EXPECT_EQ(p.id[i], 2u);
+  }
+  EXPECT_GT(crossing, 100u);
+  EXPECT_EQ(x.meta["abuffer"]["unsorted_pixels"].get<std::size_t>(), crossing);
 }
 
 namespace {

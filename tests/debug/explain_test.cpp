@@ -217,6 +217,30 @@ TEST(Explain, ReferenceBackendsAreComparedAtThePixel) {
   fs::remove_all(dir);
 }
 
+// At a crossing of the cyclic sticks the A-buffer list is far to near, disagrees with the
+// draw order, and ends in ref:abuffer's colour and id there.
+TEST(Explain, ABufferListIsSortedAndEndsInTheExactColour) {
+  const Result r = run("explain " + catalog("transparency/oit_cyclic.json") +
+                       " --pixel 57,93 --backends ref:abuffer --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = json::parse(r.out);
+  const json& list = doc["abuffer"]["fragments"];
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_GT(list[0]["window_z"].get<double>(), list[1]["window_z"].get<double>());
+  EXPECT_FALSE(doc["abuffer"]["draw_order_matches"].get<bool>());
+  const json& exact = doc["backends"]["ref:abuffer"];
+  EXPECT_EQ(exact["id"], list[1]["primitive"]);
+  for (int c = 0; c < 4; ++c)
+    EXPECT_EQ(static_cast<float>(exact["color"][c].get<double>()),
+              static_cast<float>(list[1]["color_after"][c].get<double>()));
+  EXPECT_NE(doc["final"]["id"], exact["id"]);  // the draw order's top fragment differs
+  // Without ref:abuffer there is no list.
+  const Result plain =
+      run("explain " + catalog("transparency/oit_cyclic.json") + " --pixel 57,93 --json");
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_FALSE(json::parse(plain.out).contains("abuffer"));
+}
+
 TEST(Explain, JsonKeysAreTheDocumentedOnes) {
   const std::set<std::string> documented = documentedKeys();
   ASSERT_GT(documented.size(), 100u) << "docs/explain.md's key table was not found";
@@ -226,7 +250,8 @@ TEST(Explain, JsonKeysAreTheDocumentedOnes) {
           " --pixel 32,24 --backends ref:subpixel=4,ref:painter",
       catalog("shading/sphere_gouraud_low.json") + " --pixel 70,70",
       catalog("transparency/alpha_quads.json") + " --pixel 70,70",
-      catalog("shading/sphere_flat_low.json") + " --pixel 0,0 --backends ref"};
+      catalog("shading/sphere_flat_low.json") + " --pixel 0,0 --backends ref",
+      catalog("transparency/oit_cyclic.json") + " --pixel 57,93 --backends ref:abuffer"};
   for (const std::string& call : calls) {
     const Result r = run("explain " + call + " --json");
     ASSERT_EQ(r.code, 0) << call << ": " << r.err;
