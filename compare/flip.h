@@ -3,10 +3,12 @@
 // written here from the paper's formulas, and its pooled statistics for report.json.
 //
 // Input: two RGB images whose values are display-encoded (sRGB) in [0, 1]. A frame's
-// colour is what the framebuffer holds, shown without any sRGB encoding step (as
-// color.png shows it), so it IS the sRGB-encoded value: flipFromFrames() clamps R, G, B
-// to [0, 1] (alpha is ignored: the pixel as shown, opaque) and FLIP linearizes it with
-// the sRGB transfer function. rgba32f frames are not quantized to 8 bits first.
+// colour is what the framebuffer holds, shown without any sRGB encoding step, so FLIP
+// sees each frame as the 8-bit picture color.png (and the report's expected.png /
+// actual.png) shows: flipImageOf() clamps R, G, B to [0, 1] (NaN as 0), rounds to 8 bits
+// as color.png does, and FLIP reads those values as sRGB-encoded (linearizing them with
+// the sRGB transfer function). Alpha is ignored: the pixel as shown, opaque. This is what
+// NVIDIA's FLIP tool computes when given the two PNGs.
 // It does not: HDR-FLIP, or viewing conditions other than those given.
 #pragma once
 
@@ -42,7 +44,7 @@ struct FlipImage {
 std::vector<float> flipError(const FlipImage& reference, const FlipImage& test,
                              const FlipViewing& viewing = {});
 
-// The colour of a frame as FLIP reads it (see the file comment).
+// The colour of a frame as FLIP reads it: color.png's 8-bit values (see the file comment).
 FlipImage flipImageOf(const Frame& frame);
 
 // Pooled statistics of a FLIP error map. weighted_* are value-weighted percentiles: the

@@ -99,6 +99,39 @@ void BM_Compare1080pNoisy(benchmark::State& state) {
 }
 BENCHMARK(BM_Compare1080pNoisy)->Unit(benchmark::kMillisecond);
 
+// LDR-FLIP (compare/flip.h) alone, on the colour of the pair above: the cost `run` and
+// `compare` add per pair (they compute it whenever they write the pair's images).
+void BM_Flip1080p(benchmark::State& state) {
+  const Pair& p = pair1080p();
+  const rc::Tolerances tol = rc::tolerancesForFrames(p.ref, p.gl);
+  std::vector<float> map;
+  for (auto _ : state) {
+    rc::FlipStats s = rc::flipFrames(p.ref, p.gl, tol, &map);
+    benchmark::DoNotOptimize(s);
+  }
+  countPixels(state, p);
+}
+BENCHMARK(BM_Flip1080p)->Unit(benchmark::kMillisecond);
+
+// The catalog's usual size.
+void BM_Flip256(benchmark::State& state) {
+  static const Pair p = [] {
+    Pair q;
+    q.ref = rc::testing::renderRects(256, 256, rc::testing::defaultRects(256, 256));
+    q.gl = q.ref;
+    for (std::size_t i = 0; i < q.gl.pixelCount(); i += 7) q.gl.color[4 * i] += 0.02f;
+    return q;
+  }();
+  const rc::Tolerances tol = rc::tolerancesForFrames(p.ref, p.gl);
+  std::vector<float> map;
+  for (auto _ : state) {
+    rc::FlipStats s = rc::flipFrames(p.ref, p.gl, tol, &map);
+    benchmark::DoNotOptimize(s);
+  }
+  countPixels(state, p);
+}
+BENCHMARK(BM_Flip256)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();

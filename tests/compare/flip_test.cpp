@@ -309,12 +309,17 @@ TEST(Flip, ThresholdFailsAPairWhoseMeanExceedsIt) {
   EXPECT_EQ(flipFrames(e, a, t).status, Status::Pass);
   t.flip_mean_fail = s.mean * 0.99;
   EXPECT_EQ(flipFrames(e, a, t).status, Status::Fail);
-  // Frame colours are clamped to [0, 1] and NaN reads as 0 (what color.png shows).
+  // Frame colours are read as color.png shows them: clamped to [0, 1], NaN as 0, rounded
+  // to 8 bits (halves up).
   a.color[0] = 7.0f;
   a.color[1] = std::nanf("");
+  a.color[2] = 100.5f / 255.0f;
+  a.color[4] = 0.30f;
   const FlipImage img = flipImageOf(a);
   EXPECT_EQ(img.rgb[0], 1.0f);
   EXPECT_EQ(img.rgb[1], 0.0f);
+  EXPECT_EQ(img.rgb[2], 101.0f / 255.0f);
+  EXPECT_EQ(img.rgb[3], std::round(0.30f * 255.0f) / 255.0f);
 }
 
 }  // namespace

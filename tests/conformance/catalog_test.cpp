@@ -26,13 +26,33 @@ using namespace rc::conformance;
 namespace {
 
 // The topics of the lecture notes that the issue asks the catalog to cover.
-const std::vector<std::string> kRequiredTags = {
-    "coverage",     "fill-rule",     "subpixel",       "clipping",        "near-plane",
-    "culling",      "zbuffer",       "painter",        "depth-precision", "perspective",
-    "orthographic", "flat",          "gouraud",        "phong",           "blinn-phong",
-    "ambient",      "diffuse",       "specular",       "point-light",     "directional-light",
-    "attenuation",  "normal-matrix", "vertex-normals", "texture",         "transparency",
-    "real-mesh",    "oit"};
+const std::vector<std::string> kRequiredTags = {"coverage",
+                                                "fill-rule",
+                                                "subpixel",
+                                                "clipping",
+                                                "near-plane",
+                                                "culling",
+                                                "zbuffer",
+                                                "painter",
+                                                "depth-precision",
+                                                "perspective",
+                                                "orthographic",
+                                                "flat",
+                                                "gouraud",
+                                                "phong",
+                                                "blinn-phong",
+                                                "ambient",
+                                                "diffuse",
+                                                "specular",
+                                                "point-light",
+                                                "directional-light",
+                                                "attenuation",
+                                                "normal-matrix",
+                                                "vertex-normals",
+                                                "texture",
+                                                "transparency",
+                                                "real-mesh",
+                                                "oit"};
 
 std::string joinLines(const std::vector<std::string>& lines) {
   std::string out;
