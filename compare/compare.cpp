@@ -886,9 +886,11 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
   r.shading.histogram = ErrorHistogram(int_color ? 1.0 : 1.0 / 4096.0, int_color);
   Comparator(expected, actual, uncertainty, tolerances, r).run(maps);
   r.oit = compareOit(expected, actual, tolerances);
-  if (maps || tolerances.flip_mean_fail) {
+  if ((maps && maps->want_flip) || tolerances.flip_mean_fail) {
     r.flip = flipFrames(expected, actual, tolerances, maps ? &maps->flip : nullptr);
     r.status = worse(r.status, r.flip->status);
+  } else if (maps) {
+    maps->flip.clear();  // no stale map from an earlier comparison
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

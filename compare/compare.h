@@ -188,6 +188,7 @@ struct ClassMaps {
   // channel error - that pixel's largest channel excess over its allowance), else 0.
   std::vector<float> shading_tolerance;
   std::vector<float> flip;  // LDR-FLIP per pixel (every pixel), empty when not computed
+  bool want_flip = true;    // false: compareFrames skips FLIP (unless a threshold is set)
 };
 
 // Compares `actual` with `expected`. `uncertainty` is the reference frame whose

@@ -80,6 +80,7 @@ void BM_Compare1080pWithMaps(benchmark::State& state) {
   const Pair& p = pair1080p();
   const rc::Tolerances tol = rc::tolerancesForFrames(p.ref, p.gl);
   rc::ClassMaps maps;
+  maps.want_flip = false;  // BM_Flip1080p measures it
   for (auto _ : state) {
     rc::PairResult r = rc::compareFrames(p.ref, p.gl, p.ref, tol, &maps);
     benchmark::DoNotOptimize(r);

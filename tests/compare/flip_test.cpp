@@ -283,6 +283,30 @@ TEST(Flip, MatchesADirect2DImplementation) {
   EXPECT_GT(*std::max_element(got.begin(), got.end()), 0.3f);
 }
 
+// Differences in one corner: only the tiles near them are computed (compare/flip.cpp);
+// the answer is still the whole metric's, and exactly 0 beyond the filters' reach.
+TEST(Flip, SparseDifferencesGiveTheWholeImageAnswer) {
+  const int w = 160, h = 140;
+  const FlipImage a = randomImage(w, h, 3);
+  FlipImage b = a;
+  for (int y = 5; y < 20; ++y)
+    for (int x = 8; x < 22; ++x) b.rgb[3 * (static_cast<std::size_t>(y) * w + x) + 2] = 1.0f;
+  const std::vector<float> got = flipError(a, b);
+  const std::vector<double> want = directFlip(a, b);
+  double max_diff = 0;
+  for (std::size_t i = 0; i < got.size(); ++i)
+    max_diff = std::max(max_diff, std::fabs(got[i] - want[i]));
+  EXPECT_LT(max_diff, 1e-5);
+  // Beyond 10 px (the CSF radius at 67 ppd) of the changed block, nothing.
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (x >= 22 + 10 || y >= 20 + 10) {
+        ASSERT_EQ(got[static_cast<std::size_t>(y) * w + x], 0.0f) << x << "," << y;
+        ASSERT_EQ(want[static_cast<std::size_t>(y) * w + x], 0.0) << x << "," << y;
+      }
+  EXPECT_GT(got[static_cast<std::size_t>(10) * w + 12], 0.1f);
+}
+
 TEST(Flip, PoolingIsValueWeighted) {
   const FlipStats a = poolFlip({0.1f, 0.2f, 0.3f, 0.4f});
   EXPECT_NEAR(a.mean, 0.25, 1e-7);
