@@ -385,55 +385,74 @@ std::vector<float> flipError(const FlipImage& reference, const FlipImage& test,
   const int h = reference.height;
   const double ppd = viewing.pixelsPerDegree();
   // A pixel whose neighbourhood (every filter's radius, the halo) is the same in both
-  // images gets exactly 0: equal filtered colours and features. So only tiles with a
-  // differing pixel, and their neighbours, are computed, each from its rectangle plus the
-  // halo: the same sums over the same values as the whole image, bit for bit (the clamped
-  // borders of a cut rectangle reach no pixel of its tile).
+  // images gets exactly 0: equal filtered colours and features. So only the pixels within
+  // the halo of a differing pixel are computed, tile by tile, each from its rectangle plus
+  // the halo: the same sums over the same values as the whole image, bit for bit (the
+  // clamped borders of a cut rectangle reach none of the pixels kept from it).
   const int halo = std::max(csfRadius(ppd), featureRadius(ppd));
+  if (halo > kTile) return flipWhole(reference, test, ppd);
   const int tiles_x = (w + kTile - 1) / kTile;
   const int tiles_y = (h + kTile - 1) / kTile;
-  std::vector<char> differs(static_cast<std::size_t>(tiles_x) * tiles_y, 0);
+  struct Rect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // half-open; empty when x0 >= x1
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+    void add(const Rect& o) {
+      if (o.empty()) return;
+      if (empty()) {
+        *this = o;
+        return;
+      }
+      x0 = std::min(x0, o.x0), y0 = std::min(y0, o.y0);
+      x1 = std::max(x1, o.x1), y1 = std::max(y1, o.y1);
+    }
+    Rect intersect(const Rect& o) const {
+      return {std::max(x0, o.x0), std::max(y0, o.y0), std::min(x1, o.x1), std::min(y1, o.y1)};
+    }
+  };
+  std::vector<Rect> differ(static_cast<std::size_t>(tiles_x) * tiles_y);  // bounding boxes
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = 3 * (static_cast<std::size_t>(y) * w + x);
       if (reference.rgb[i] != test.rgb[i] || reference.rgb[i + 1] != test.rgb[i + 1] ||
           reference.rgb[i + 2] != test.rgb[i + 2])
-        differs[static_cast<std::size_t>(y / kTile) * tiles_x + x / kTile] = 1;
+        differ[static_cast<std::size_t>(y / kTile) * tiles_x + x / kTile].add({x, y, x + 1, y + 1});
     }
-  std::vector<char> needed(differs.size(), 0);
-  std::size_t count = 0;
+  // Per tile, the part within the halo of a difference (differences within the halo of a
+  // tile lie in it or its 8 neighbours: halo <= tile), and the pixels it costs with halo.
+  std::vector<Rect> out_rect(differ.size());
+  double cost = 0.0;
   for (int ty = 0; ty < tiles_y; ++ty)
     for (int tx = 0; tx < tiles_x; ++tx) {
-      bool near = false;
-      for (int dy = -1; dy <= 1 && !near; ++dy)
-        for (int dx = -1; dx <= 1 && !near; ++dx) {
-          const int nx = tx + dx;
-          const int ny = ty + dy;
-          near = nx >= 0 && ny >= 0 && nx < tiles_x && ny < tiles_y &&
-                 differs[static_cast<std::size_t>(ny) * tiles_x + nx];
+      const Rect tile{tx * kTile, ty * kTile, std::min(w, (tx + 1) * kTile),
+                      std::min(h, (ty + 1) * kTile)};
+      Rect r;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int nx = tx + dx, ny = ty + dy;
+          if (nx < 0 || ny < 0 || nx >= tiles_x || ny >= tiles_y) continue;
+          const Rect& d = differ[static_cast<std::size_t>(ny) * tiles_x + nx];
+          if (d.empty()) continue;
+          r.add(Rect{d.x0 - halo, d.y0 - halo, d.x1 + halo, d.y1 + halo}.intersect(tile));
         }
-      needed[static_cast<std::size_t>(ty) * tiles_x + tx] = near;
-      count += near;
+      out_rect[static_cast<std::size_t>(ty) * tiles_x + tx] = r;
+      if (!r.empty())
+        cost += static_cast<double>(std::min(w, r.x1 + halo) - std::max(0, r.x0 - halo)) *
+                (std::min(h, r.y1 + halo) - std::max(0, r.y0 - halo));
     }
   std::vector<float> out(static_cast<std::size_t>(w) * h, 0.0f);
-  if (count == 0) return out;
-  // A tile with its halo costs ~(1 + 2 halo / tile)^2 of its area: past about half the
-  // tiles, the whole image is cheaper.
-  if (halo > kTile || 2 * count >= needed.size()) return flipWhole(reference, test, ppd);
-  for (int ty = 0; ty < tiles_y; ++ty)
-    for (int tx = 0; tx < tiles_x; ++tx) {
-      if (!needed[static_cast<std::size_t>(ty) * tiles_x + tx]) continue;
-      const int x0 = tx * kTile, y0 = ty * kTile;
-      const int x1 = std::min(w, x0 + kTile), y1 = std::min(h, y0 + kTile);
-      const int rx0 = std::max(0, x0 - halo), ry0 = std::max(0, y0 - halo);
-      const int rx1 = std::min(w, x1 + halo), ry1 = std::min(h, y1 + halo);
-      const std::vector<float> part =
-          flipWhole(crop(reference, rx0, ry0, rx1, ry1), crop(test, rx0, ry0, rx1, ry1), ppd);
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x)
-          out[static_cast<std::size_t>(y) * w + x] =
-              part[static_cast<std::size_t>(y - ry0) * (rx1 - rx0) + (x - rx0)];
-    }
+  if (cost == 0.0) return out;
+  if (cost >= 0.9 * w * h) return flipWhole(reference, test, ppd);
+  for (const Rect& r : out_rect) {
+    if (r.empty()) continue;
+    const int rx0 = std::max(0, r.x0 - halo), ry0 = std::max(0, r.y0 - halo);
+    const int rx1 = std::min(w, r.x1 + halo), ry1 = std::min(h, r.y1 + halo);
+    const std::vector<float> part =
+        flipWhole(crop(reference, rx0, ry0, rx1, ry1), crop(test, rx0, ry0, rx1, ry1), ppd);
+    for (int y = r.y0; y < r.y1; ++y)
+      for (int x = r.x0; x < r.x1; ++x)
+        out[static_cast<std::size_t>(y) * w + x] =
+            part[static_cast<std::size_t>(y - ry0) * (rx1 - rx0) + (x - rx0)];
+  }
   return out;
 }
 
