@@ -5,6 +5,7 @@
 #include "compare/flip.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -195,7 +196,7 @@ void filterColumns(const Plane& in, int w, int h, const Kernel& k, Plane& out) {
 // The CSF filter of one channel, normalized to sum 1 over its (2r+1)^2 support, applied as
 // a weighted sum of separable Gaussians (each term of S is a product in x and y).
 void csfFilter(Plane& channel, int w, int h, const Csf& c, double ppd, int r) {
-  const std::size_t n = static_cast<std::size_t>(2 * r + 1);
+  const std::size_t n = 2 * static_cast<std::size_t>(r) + 1;
   Plane blurred[2];
   double weight[2] = {0.0, 0.0};
   const double a[2] = {c.a1, c.a2};
@@ -276,8 +277,8 @@ void features(const Plane& lum, int w, int h, const FeatureKernels& k, Plane& ed
 }
 
 struct Prepared {
-  Plane ycc[3];  // filtered
-  Plane lum;     // Y / Yn, unfiltered: the feature detectors' input
+  std::array<Plane, 3> ycc;  // filtered
+  Plane lum;                 // Y / Yn, unfiltered: the feature detectors' input
 };
 
 Prepared prepare(const FlipImage& img, double ppd) {
@@ -519,9 +520,9 @@ std::vector<std::uint8_t> flipHeatRgb(const std::vector<float>& error) {
     for (int i = 0; i < kCount; ++i) ramp[i] = static_cast<float>(i) / (kCount - 1);
     OIIO::ImageBuf src(OIIO::ImageSpec(kCount, 1, 1, OIIO::TypeDesc::FLOAT), ramp.data());
     OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, kFlipColorMap);
-    std::vector<float> rgb(3 * kCount, 0.0f);
+    std::vector<float> rgb(std::size_t{3} * kCount, 0.0f);
     mapped.get_pixels(mapped.roi(), OIIO::TypeDesc::FLOAT, rgb.data());
-    std::vector<std::uint8_t> out(3 * kCount);
+    std::vector<std::uint8_t> out(std::size_t{3} * kCount);
     for (int i = 0; i < 3 * kCount; ++i)
       out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i], 0.0f, 1.0f) * 255.0f));
     return out;
