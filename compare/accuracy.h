@@ -56,6 +56,17 @@ struct AccuracyPair {
   std::optional<double> psnr_db;
   std::uint64_t shading_over = 0;
   std::optional<PixelRef> shading_worst;
+  // perceptual error (report.json "flip"), when the report has it
+  std::optional<double> flip_mean;
+  double flip_max = 0.0;
+  // against ref:abuffer (report.json "oit"), when the report has it
+  bool oit = false;
+  std::uint64_t oit_blended = 0;
+  std::uint64_t oit_unsorted = 0;
+  std::uint64_t oit_pixels = 0;  // over the shading warn threshold
+  double oit_max_abs = 0.0;
+  double oit_mean_abs = 0.0;
+  std::uint64_t oit_pairs = 0;  // triangle pairs blended out of depth order
 };
 
 struct AccuracyData {

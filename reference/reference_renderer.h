@@ -26,13 +26,13 @@ namespace rc {
 struct ReferenceOptions {
   int subpixel_bits = 8;       // vertex snapping grid: 1 / 2^bits px, in [0, 12]
   bool force_painter = false;  // `ref:painter`: draw far-to-near with no depth test
-  // `ref:abuffer`: exact order-independent transparency. Every fragment of a blending pass
-  // that passes its depth test (against the opaque depth: that pass does not write depth)
-  // is kept in its pixel's list; after the last pass each list is sorted far to near
-  // (window depth, ties in draw order) and blended in that order, and the pixel's id is
-  // its nearest blended fragment. Opaque passes are unchanged.
+  bool uncertainty = true;     // compute edge_dist and depth_gap
+  // `ref:abuffer` (last: positional initialisers keep their meaning): exact order-independent
+  // transparency. Every fragment of a blending pass that passes its depth test (against the opaque
+  // depth: that pass does not write depth) is kept in its pixel's list; after the last pass each
+  // list is sorted far to near (window depth, ties in draw order) and blended in that order, and
+  // the pixel's id is its nearest blended fragment. Opaque passes are unchanged.
   bool abuffer = false;
-  bool uncertainty = true;  // compute edge_dist and depth_gap
 };
 
 // Renders the scene. Throws InputError for options out of range (subpixel_bits outside

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Regenerates docs/accuracy.md: runs the catalog against the four GL backends (each
-# compared with the reference) and softpipe and zink against llvmpipe, then tabulates both
-# runs with `rastercheck accuracy`.
-# Usage: scripts/accuracy.sh [--keep DIR]   (--keep: leave the two run folders in DIR)
+# compared with the reference), softpipe and zink against llvmpipe, and the reference and
+# the four backends on the `oit` fixtures against ref:abuffer (exact transparency), then
+# tabulates the three runs with `rastercheck accuracy`.
+# Usage: scripts/accuracy.sh [--keep DIR]   (--keep: leave the three run folders in DIR)
 # RASTERCHECK names the binary (default: build/release/app/rastercheck); BACKENDS the
 # comma-separated backends to compare with the reference (default: the four below); DRIVERS
 # the backends compared with llvmpipe directly (default: softpipe and zink).
@@ -32,10 +33,12 @@ run() {
 }
 
 cd "$root"
-rm -rf "$work/catalog" "$work/drivers"
+rm -rf "$work/catalog" "$work/drivers" "$work/oit"
 run fixtures/scenes --backends "$backends" --out "$work/catalog"
 run fixtures/scenes --backends "$drivers" --against gl:egl:llvmpipe --out "$work/drivers"
-"$exe" accuracy "$work/catalog" "$work/drivers" \
+run fixtures/scenes/transparency/oit_*.json --backends "ref,$backends" --against ref:abuffer \
+  --no-variants --out "$work/oit"
+"$exe" accuracy "$work/catalog" "$work/drivers" "$work/oit" \
   --expectations fixtures/expectations.json \
-  --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\` and \`rastercheck run fixtures/scenes --backends $drivers --against gl:egl:llvmpipe\`, then \`rastercheck accuracy\` on both run folders)" \
+  --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\`, \`rastercheck run fixtures/scenes --backends $drivers --against gl:egl:llvmpipe\` and \`rastercheck run fixtures/scenes/transparency/oit_*.json --backends ref,$backends --against ref:abuffer\`, then \`rastercheck accuracy\` on the three run folders)" \
   --out docs/accuracy.md

@@ -120,7 +120,7 @@ TEST_F(ReportTest, EveryFileIsWrittenAndNoTemporaryRemains) {
   for (const char* f : {"report.json", "junit.xml", "report.html"})
     EXPECT_TRUE(fs::is_regular_file(*out_ / f)) << f;
   for (std::size_t k = 0; k < 3; ++k) {
-    EXPECT_EQ(report_->results[k].images.size(), 6u);
+    EXPECT_EQ(report_->results[k].images.size(), 7u);  // with flip_heat.png
     for (const auto& [kind, file] : report_->results[k].images)
       EXPECT_TRUE(fs::is_regular_file(file)) << kind << ": " << file;
   }
@@ -283,7 +283,8 @@ TEST_F(ReportTest, HtmlRendersEveryRowAndLoadsEveryImageInChromium) {
   ASSERT_TRUE(s.ready) << "the page's script did not finish";
   EXPECT_EQ(s.rows, 4);
   EXPECT_EQ(s.pairs, 4);
-  EXPECT_EQ(s.images_ok, 3 * 5);  // expected, actual, visibility, two heat maps per pair
+  // expected, actual, visibility, two heat maps and the FLIP map per pair
+  EXPECT_EQ(s.images_ok, 3 * 6);
   EXPECT_EQ(s.images_failed, 0);
 
   // The check can fail: a copy of the page whose one image is missing.
@@ -292,7 +293,7 @@ TEST_F(ReportTest, HtmlRendersEveryRowAndLoadsEveryImageInChromium) {
   fs::remove(pairDirectory(copy, report_->results[1]) / "depth_heat.png");
   const PageState broken = renderInChromium(copy / "report.html");
   fs::remove_all(copy);
-  EXPECT_EQ(broken.images_ok, 3 * 5 - 1);
+  EXPECT_EQ(broken.images_ok, 3 * 6 - 1);
   EXPECT_EQ(broken.images_failed, 1);
 }
 

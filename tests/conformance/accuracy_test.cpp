@@ -73,7 +73,12 @@ Synthetic makeRun(const fs::path& root) {
                   {"mean_abs", 0.25}, {"psnr_db", 50.0}, {"worst", {1, 2}}};
   d["depth"] = {
       {"status", "pass"}, {"compared", 50}, {"max_steps", 3}, {"p99_steps", 2}, {"worst", {5, 6}}};
-  writeJson(s.run / "report.json", {{"results", {a, b, d}}});
+  a["flip"] = {{"mean", 0.25}, {"max", 0.9}};
+  b["flip"] = {{"mean", 0.5}, {"max", 0.75}};
+  json e = pair("t/a", "ref:abuffer", "gl:x:y", "fail");
+  e["oit"] = {{"blended_pixels", 40}, {"unsorted_pixels", 7}, {"pixels", 6},
+              {"max_abs", 44.5},      {"mean_abs", 3.25},     {"out_of_order_pairs", 2}};
+  writeJson(s.run / "report.json", {{"results", {a, b, d, e}}});
   return s;
 }
 
@@ -87,7 +92,7 @@ TEST(Accuracy, TablesShowTheReportsNumbers) {
   const fs::path root = conformance::scratchRoot() / "accuracy_tables";
   const Synthetic s = makeRun(root);
   AccuracyData data = readAccuracyRuns({s.run}, {s.catalog});
-  ASSERT_EQ(data.pairs.size(), 3u);
+  ASSERT_EQ(data.pairs.size(), 4u);
   Expectation known;
   known.id = "bar";
   known.fixture = "t/b";
@@ -120,6 +125,9 @@ TEST(Accuracy, TablesShowTheReportsNumbers) {
                       "[window 1,7])."))
       << md;
   EXPECT_TRUE(hasLine(md, "- Hard visibility differences: none.")) << md;
+  // The perceptual and exact-transparency sections, from the reports' flip and oit blocks.
+  EXPECT_TRUE(hasLine(md, "| `gl:x:y` | `ref` | 2 | 0.375 | 0.5 (`t/b`) | 0.9 |")) << md;
+  EXPECT_TRUE(hasLine(md, "| `t/a` | `gl:x:y` | 40 | 7 | 6 | 44.5 | 3.25 | 2 |")) << md;
   EXPECT_TRUE(
       hasLine(md, "| bar | `t/b` | `gl:*:y` | any | any | visibility | a reason \\| with a bar |"))
       << md;
