@@ -60,7 +60,7 @@ int compareCommand(const CompareArgs& args) {
   report.command = "compare";
   const PairPictures pictures{expected_read.picture, actual_read.picture};
   report.results.push_back(
-      comparePair(expected, actual, *uncertainty, tolerances, folder.staging(), pictures));
+      comparePair(expected, actual, *uncertainty, tolerances, folder, pictures));
   folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);

@@ -9,6 +9,7 @@
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
+#include "fixtures/resource_estimate.h"
 
 namespace rc {
 
@@ -16,6 +17,7 @@ int renderCommand(const RenderArgs& args) {
   // Parse the SPEC before loading so that a typo costs nothing and exits 2.
   const BackendSpec backend = parseBackendSpec(args.backend);
   const Scene scene = loadScene(args.scene);
+  checkResources(scene, rendererKind(backend), ResourceLimits::current());
   const Frame frame = renderWith(backend, scene);
   writeFrameDir(frame, args.out);
   std::cout << fmt::format("{}: {} -> {}\n", scene.name, backend.text, args.out.string());

@@ -13,6 +13,7 @@ packages=(
   libassimp-dev assimp-testmodels
   nlohmann-json3-dev libcli11-dev libfmt-dev
   libpugixml-dev python3-jsonschema
+  strace clang libclang-rt-14-dev
 )
 if [[ "${RASTERCHECK_SETUP_BROWSER:-1}" == 1 ]]; then
   packages+=(chromium)
