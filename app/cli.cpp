@@ -32,8 +32,8 @@ int runCli(int argc, char** argv) {
                  "Refuse a render estimated to need more memory (e.g. 4G; default: the memory "
                  "available when it starts)");
   app.add_option("--max-work", max_work,
-                 "Refuse a render estimated to need more operations (default 2e11, about an "
-                 "hour of the reference)");
+                 "Refuse a render estimated to need more operations (default 1e10, a few "
+                 "minutes of the reference)");
 
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "Render one fixture with one backend");

@@ -101,6 +101,7 @@ int runCommand(const RunArgs& args) {
     const Scene scene = loadScene(file);
     checkResources(scene, RendererKind::Reference, limits);
     if (any_gl) checkResources(scene, RendererKind::Gl, limits);
+    checkComparison(file.string(), scene.width, scene.height, limits);
     std::string slug = fixtureSlug(scene.name);
     for (int k = 2; !slugs.insert(slug).second; ++k)
       slug = fixtureSlug(scene.name) + "~" + std::to_string(k);
@@ -152,6 +153,12 @@ int runCommand(const RunArgs& args) {
         --left[f];
         showRender();
       });
+
+  // A render that exits 2 met bad input the checks above cannot see: its frame could not
+  // be written (a full disk), or a file changed meanwhile. That ends the run the same way:
+  // exit 2, nothing written.
+  for (const Job& job : jobs)
+    if (job.exit_code == kExitInput) throw InputError(childFailure(job));
 
   auto frameDir = [&](std::size_t f, const std::string& spec) {
     return frames_dir / fixtures[f].slug / fixtureSlug(spec);
