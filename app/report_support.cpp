@@ -70,7 +70,7 @@ PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& 
 // ---- ReportFolder ----
 
 const std::vector<std::string>& ReportFolder::ownedNames() {
-  static const std::vector<std::string> names = {"frames",    "pairs",     "variants",
+  static const std::vector<std::string> names = {"frames",      "pairs",     "variants",
                                                  "report.json", "junit.xml", "report.html"};
   return names;
 }

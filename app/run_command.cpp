@@ -216,8 +216,7 @@ int runCommand(const RunArgs& args) {
         // The tolerances were checked up front; an InputError from here on (a fixture
         // changed under us) ends the run with exit 2 and no report.
         const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
-        report.results.push_back(
-            comparePair(expected, actual, *uncertainty, tol, folder));
+        report.results.push_back(comparePair(expected, actual, *uncertainty, tol, folder));
       } catch (const BackendError& e) {
         report.results.push_back(errorResult(fx.name, against.text, b.text, e.what()));
       }

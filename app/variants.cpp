@@ -101,7 +101,8 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
   }
   std::ofstream file(work_dir / "variants.json");
   file << out.dump(2) << '\n';
-  if (!file.flush()) throw InputError(fmt::format("{}: cannot write", (work_dir / "variants.json").string()));
+  if (!file.flush())
+    throw InputError(fmt::format("{}: cannot write", (work_dir / "variants.json").string()));
   return out;
 }
 

@@ -8,7 +8,6 @@
 #include <map>
 #include <set>
 #include <string>
-#include <string>
 #include <vector>
 
 #include "compare/compare.h"

@@ -76,16 +76,14 @@ std::vector<std::string> stagingIn(const fs::path& dir) {
   return out;
 }
 
-bool straceWorks() {
-  return rc::test::runShell("strace -f -qq -o /dev/null true").code == 0;
-}
+bool straceWorks() { return rc::test::runShell("strace -f -qq -o /dev/null true").code == 0; }
 
 // Runs `args` under strace, killing the process (SIGKILL) at the k-th call of any of
 // `calls` (strace counts per thread and child process). Returns the exit code (137 when
 // killed).
 int killAt(const std::string& calls, int k, const std::string& args) {
-  const std::string strace = "strace -f -qq -o /dev/null -e trace=" + calls + " -e inject=" +
-                             calls + ":signal=KILL:when=" + std::to_string(k);
+  const std::string strace = "strace -f -qq -o /dev/null -e trace=" + calls +
+                             " -e inject=" + calls + ":signal=KILL:when=" + std::to_string(k);
   return rc::test::runShell(strace + " " RC_EXE " " + args + " >/dev/null 2>&1").code;
 }
 
@@ -140,7 +138,8 @@ TEST(Reliability, KillingCompareAnywhereLeavesTheOldOrTheNewReport) {
   fs::copy(out, dir / "old", fs::copy_options::recursive);
   const std::string args =
       "compare " + (dir / "a2").string() + " " + (dir / "b2").string() + " --out " + out.string();
-  ASSERT_LE(run(args.substr(0, args.size() - out.string().size()) + (dir / "new").string()).code, 1);
+  ASSERT_LE(run(args.substr(0, args.size() - out.string().size()) + (dir / "new").string()).code,
+            1);
   const std::set<std::string> new_names = names(snapshot(dir / "new"));
 
   int kills = 0;
@@ -226,8 +225,8 @@ TEST(Reliability, KillingRenderOrRunAtEveryRenameLeavesTheOldOrTheNewOutput) {
 
   const fs::path out = dir / "runs" / "out";
   const std::string fixture = catalog("coverage/triangle_fan.json");
-  ASSERT_EQ(run("run " + fixture + " --backends ref:subpixel=8 --jobs 1 --out " + out.string()).code,
-            0);
+  ASSERT_EQ(
+      run("run " + fixture + " --backends ref:subpixel=8 --jobs 1 --out " + out.string()).code, 0);
   fs::copy(out, dir / "old_run", fs::copy_options::recursive);
   const auto old_run = snapshot(out);
   const std::string run_args = "run " + catalog("coverage/jittered_grid.json") +
@@ -254,13 +253,14 @@ TEST(Reliability, KillingRenderOrRunAtEveryRenameLeavesTheOldOrTheNewOutput) {
 TEST(Reliability, ADeadRunsStagingIsRemovedByTheNextRun) {
   const fs::path dir = scratch("dead_run");
   const fs::path out = dir / "out";
-  const std::string args = "run " + catalog("coverage") + " --backends ref:subpixel=4 --jobs 1 --out " +
-                           out.string();
+  const std::string args =
+      "run " + catalog("coverage") + " --backends ref:subpixel=4 --jobs 1 --out " + out.string();
   // Killed once it has begun rendering (its staging folder exists), long before the
   // catalog folder is done.
   const Result killed = rc::test::runShell(
-      "sh -c '" RC_EXE " " + args + " >/dev/null 2>&1 & p=$!; i=0; while [ $i -lt 600 ] && ! ls -A " +
-      dir.string() + " | grep -q rastercheck-staging; do sleep 0.05; i=$((i+1)); done; " +
+      "sh -c '" RC_EXE " " + args +
+      " >/dev/null 2>&1 & p=$!; i=0; while [ $i -lt 600 ] && ! ls -A " + dir.string() +
+      " | grep -q rastercheck-staging; do sleep 0.05; i=$((i+1)); done; " +
       "sleep 0.3; kill -9 $p; wait $p; echo $?'");
   EXPECT_EQ(killed.out.substr(killed.out.size() - 4), "137\n") << killed.out;
   EXPECT_FALSE(fs::exists(out));
@@ -281,17 +281,18 @@ TEST(Reliability, AFailingCommandCreatesNothing) {
   const std::string fan = catalog("coverage/triangle_fan.json");
   EXPECT_EQ(run("run " + fan + " --backends vulkan --out " + deep.string()).code, 2);
   EXPECT_EQ(run("render " + fan + " --backend gl:egl-device:7 --out " + deep.string()).code, 3);
-  EXPECT_EQ(run("compare " + dir.string() + " " + dir.string() + " --out " + deep.string()).code, 2);
+  EXPECT_EQ(run("compare " + dir.string() + " " + dir.string() + " --out " + deep.string()).code,
+            2);
   EXPECT_FALSE(fs::exists(dir / "new"));
 
   // A full disk, as a file size limit: every write past 64 kB fails with EFBIG.
   const fs::path out = dir / "out";
   ASSERT_EQ(run("run " + fan + " --backends ref:subpixel=8 --out " + out.string()).code, 0);
   const auto before = snapshot(out);
-  const Result full = rc::test::runShell("sh -c 'trap \"\" XFSZ; ulimit -f 64; exec " RC_EXE
-                                         " run " +
-                                         catalog("coverage/jittered_grid.json") +
-                                         " --backends ref:subpixel=8 --out " + out.string() + "'");
+  const Result full =
+      rc::test::runShell("sh -c 'trap \"\" XFSZ; ulimit -f 64; exec " RC_EXE " run " +
+                         catalog("coverage/jittered_grid.json") +
+                         " --backends ref:subpixel=8 --out " + out.string() + "'");
   EXPECT_EQ(full.code, 2) << full.out;
   EXPECT_EQ(snapshot(out), before);
   EXPECT_EQ(stagingIn(dir), std::vector<std::string>{});
@@ -315,8 +316,8 @@ void expectOneLine(const fs::path& dir, const std::string& name, const std::stri
                    const std::string& mention, const std::string& shown_name = "") {
   const fs::path file = dir / name;
   writeBytes(file, text);
-  const Result r = run("render '" + file.string() + "' --backend ref --out " + (dir / "o").string(),
-                       true);
+  const Result r =
+      run("render '" + file.string() + "' --backend ref --out " + (dir / "o").string(), true);
   SCOPED_TRACE(name);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(r.out, "");
@@ -342,7 +343,8 @@ TEST(Reliability, EveryRefusalIsOneSafeLine) {
   // 40th byte inside a character.
   std::string long_utf8;
   for (int i = 0; i < 30; ++i) long_utf8 += "\xc3\xa9";
-  expectOneLine(dir, "utf8.json", scene(R"(, "name": ")" + long_utf8 + R"(", "tags": "x)" + long_utf8 + "\""),
+  expectOneLine(dir, "utf8.json",
+                scene(R"(, "name": ")" + long_utf8 + R"(", "tags": "x)" + long_utf8 + "\""),
                 "tags: expected an array");
   expectOneLine(dir, "newline_key.json", scene(R"(, "state": {"shad\ning": "flat"})"),
                 R"(state["shad\ning"]: unknown key)");
@@ -402,10 +404,10 @@ TEST(Reliability, ObjAttributeIndicesAreChecked) {
   expectOneLine(dir, "zero.json", objScene("zero.obj", v + "f 0 1 2\n"), "index 0");
   // In range, forwards and backwards: renders.
   writeBytes(dir / "ok.json", objScene("ok.obj", v + "vt 0 0\nvn 0 0 1\nf 1/1/1 2/-1/-1 3/1/1\n"));
-  EXPECT_EQ(run("render " + (dir / "ok.json").string() + " --backend ref --out " +
-                (dir / "ok").string())
-                .code,
-            0);
+  EXPECT_EQ(
+      run("render " + (dir / "ok.json").string() + " --backend ref --out " + (dir / "ok").string())
+          .code,
+      0);
   fs::remove_all(dir);
 }
 
@@ -414,8 +416,8 @@ TEST(Reliability, RendersOverTheLimitsAreRefusedWithTheEstimate) {
   writeBytes(dir / "huge.json", R"({"format": "rastercheck-scene/1",
     "image": {"width": 16384, "height": 4096}, "camera": {"eye": [0, 0, 5]},
     "objects": [{"mesh": {"generator": "cube"}}]})");
-  Result r = run("render " + (dir / "huge.json").string() + " --backend ref --max-memory 1G --out " +
-                     (dir / "o").string(),
+  Result r = run("render " + (dir / "huge.json").string() +
+                     " --backend ref --max-memory 1G --out " + (dir / "o").string(),
                  true);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("needs about 2.9 GiB"), std::string::npos) << r.err;  // measured: 3.0e9 B

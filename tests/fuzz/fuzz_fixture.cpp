@@ -1,4 +1,5 @@
-// libFuzzer target: fixture files (the loader: JSON, inline meshes, generators, files it names). Built by the fuzz preset, run by scripts/fuzz.sh.
+// libFuzzer target: fixture files (the loader: JSON, inline meshes, generators, files it names).
+// Built by the fuzz preset, run by scripts/fuzz.sh.
 #include <cstddef>
 #include <cstdint>
 

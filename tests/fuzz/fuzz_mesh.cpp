@@ -1,4 +1,5 @@
-// libFuzzer target: mesh files through Assimp (mesh_import.cpp). Built by the fuzz preset, run by scripts/fuzz.sh.
+// libFuzzer target: mesh files through Assimp (mesh_import.cpp). Built by the fuzz preset, run by
+// scripts/fuzz.sh.
 #include <cstddef>
 #include <cstdint>
 

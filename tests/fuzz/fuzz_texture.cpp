@@ -1,4 +1,5 @@
-// libFuzzer target: texture images through OpenImageIO (texture_io.cpp). Built by the fuzz preset, run by scripts/fuzz.sh.
+// libFuzzer target: texture images through OpenImageIO (texture_io.cpp). Built by the fuzz preset,
+// run by scripts/fuzz.sh.
 #include <cstddef>
 #include <cstdint>
 
