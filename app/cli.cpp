@@ -2,6 +2,7 @@
 // ends as one line on stderr and an exit code from fixtures/errors.h.
 #include "app/cli.h"
 
+#include <cstdlib>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -9,6 +10,8 @@
 #include "app/commands.h"
 #include "app/version.h"
 #include "fixtures/errors.h"
+#include "fixtures/message_text.h"
+#include "fixtures/resource_estimate.h"
 
 namespace rc {
 
@@ -22,8 +25,19 @@ int runCli(int argc, char** argv) {
   app.require_subcommand(1);
   // Usage errors in one line, as every other error (CLI11 adds a second by default).
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    return std::string("rastercheck: error: ") + e.what() + " (see --help)\n";
+    return "rastercheck: error: " + oneLineMessage(e.what()) + " (see --help)\n";
   });
+  // Resource limits (fixtures/resource_estimate.h), accepted before or after the command
+  // name; passed on through the environment, so that the renders `run` starts obey them.
+  app.fallthrough();
+  std::string max_memory;
+  std::string max_work;
+  app.add_option("--max-memory", max_memory,
+                 "Refuse a render estimated to need more memory (e.g. 4G; default: the memory "
+                 "available when it starts)");
+  app.add_option("--max-work", max_work,
+                 "Refuse a render estimated to need more operations (default 1e10, a few "
+                 "minutes of the reference)");
 
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "Render one fixture with one backend");
@@ -147,11 +161,19 @@ int runCli(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints help/version or the parse error
+    const int code = app.exit(e);  // prints help/version or the one-line parse error
     return code == 0 ? kExitPass : kExitInput;
   }
 
   try {
+    if (!max_memory.empty()) {
+      parseByteSize(max_memory, "--max-memory");
+      ::setenv("RASTERCHECK_MAX_MEMORY", max_memory.c_str(), 1);
+    }
+    if (!max_work.empty()) {
+      parseWork(max_work, "--max-work");
+      ::setenv("RASTERCHECK_MAX_WORK", max_work.c_str(), 1);
+    }
     if (*render_cmd) return renderCommand(render);
     if (*list_cmd) return listCommand(list);
     if (*generate_cmd) return generateCommand(generate);
@@ -161,13 +183,13 @@ int runCli(int argc, char** argv) {
     if (*explain_cmd) return explainCommand(explain);
     if (*reduce_cmd) return reduceCommand(reduce);
   } catch (const InputError& e) {
-    std::cerr << "rastercheck: error: " << e.what() << '\n';
+    std::cerr << "rastercheck: error: " << oneLineMessage(e.what()) << '\n';
     return kExitInput;
   } catch (const BackendError& e) {
-    std::cerr << "rastercheck: backend error: " << e.what() << '\n';
+    std::cerr << "rastercheck: backend error: " << oneLineMessage(e.what()) << '\n';
     return kExitBackend;
   } catch (const std::exception& e) {
-    std::cerr << "rastercheck: internal error: " << e.what() << '\n';
+    std::cerr << "rastercheck: internal error: " << oneLineMessage(e.what()) << '\n';
     return kExitBackend;
   }
   return kExitInput;

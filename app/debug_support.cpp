@@ -14,20 +14,10 @@
 namespace rc {
 namespace fs = std::filesystem;
 
-ScratchDir::ScratchDir(std::string_view prefix) {
-  std::string pattern =
-      (fs::temp_directory_path() / fmt::format("rastercheck-{}-XXXXXX", prefix)).string();
-  std::vector<char> buf(pattern.begin(), pattern.end());
-  buf.push_back('\0');
-  if (::mkdtemp(buf.data()) == nullptr)
-    throw InputError(fmt::format("cannot create a scratch folder {}", pattern));
-  path_ = buf.data();
-}
+ScratchDir::ScratchDir(std::string_view prefix) : folder_(prefix), path_(folder_.path()) {}
 
 ScratchDir::~ScratchDir() {
-  if (const char* keep = std::getenv("RASTERCHECK_KEEP_SCRATCH"); keep && *keep) return;
-  std::error_code ec;
-  fs::remove_all(path_, ec);
+  if (const char* keep = std::getenv("RASTERCHECK_KEEP_SCRATCH"); keep && *keep) folder_.keep();
 }
 
 Job renderJob(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {

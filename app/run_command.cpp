@@ -99,8 +99,16 @@ int runCommand(const RunArgs& args) {
   // Validate every fixture before rendering anything: bad input exits 2 with no output.
   std::vector<FixtureEntry> fixtures;
   std::set<std::string> slugs;
+  // Every render's estimate within the limits, too (the reference always renders).
+  const ResourceLimits limits = ResourceLimits::current();
+  const bool any_gl = std::any_of(render_specs.begin(), render_specs.end(), [](const auto& s) {
+    return parseBackendSpec(s).kind == BackendSpec::Kind::Gl;
+  });
   for (const fs::path& file : findFixtures(inputs)) {
     const Scene scene = loadScene(file);
+    checkResources(scene, RendererKind::Reference, limits);
+    if (any_gl) checkResources(scene, RendererKind::Gl, limits);
+    checkComparison(file.string(), scene.width, scene.height, limits);
     std::string slug = fixtureSlug(scene.name);
     for (int k = 2; !slugs.insert(slug).second; ++k)
       slug = fixtureSlug(scene.name) + "~" + std::to_string(k);
@@ -153,6 +161,12 @@ int runCommand(const RunArgs& args) {
         showRender();
       });
 
+  // A render that exits 2 met bad input the checks above cannot see: its frame could not
+  // be written (a full disk), or a file changed meanwhile. That ends the run the same way:
+  // exit 2, nothing written.
+  for (const Job& job : jobs)
+    if (job.exit_code == kExitInput) throw InputError(childFailure(job));
+
   auto frameDir = [&](std::size_t f, const std::string& spec) {
     return frames_dir / fixtures[f].slug / fixtureSlug(spec);
   };
@@ -169,7 +183,7 @@ int runCommand(const RunArgs& args) {
   report.command = "run";
   // Which legal variant each GL backend follows, probed once per backend for the run.
   if (args.variants)
-    report.variants = detectVariants(render_specs, args.out / "variants", parallel);
+    report.variants = detectVariants(render_specs, folder.staging() / "variants", parallel);
   for (std::size_t f = 0; f < fixtures.size(); ++f) {
     const FixtureEntry& fx = fixtures[f];
     progress.show(fmt::format("[{}/{}] comparing {}", f + 1, fixtures.size(), fx.name));
@@ -209,8 +223,7 @@ int runCommand(const RunArgs& args) {
         // The tolerances were checked up front; an InputError from here on (a fixture
         // changed under us) ends the run with exit 2 and no report.
         const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
-        report.results.push_back(
-            comparePair(expected, actual, *uncertainty, tol, folder.staging()));
+        report.results.push_back(comparePair(expected, actual, *uncertainty, tol, folder));
       } catch (const BackendError& e) {
         report.results.push_back(errorResult(fx.name, against.text, b.text, e.what()));
       }

@@ -116,7 +116,10 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
     }
     out[spec] = v;
   }
-  std::ofstream(work_dir / "variants.json") << out.dump(2) << '\n';
+  std::ofstream file(work_dir / "variants.json");
+  file << out.dump(2) << '\n';
+  if (!file.flush())
+    throw InputError(fmt::format("{}: cannot write", (work_dir / "variants.json").string()));
   return out;
 }
 

@@ -182,8 +182,17 @@ std::string safeName(const std::string& s) {
                     (ch >= '0' && ch <= '9') || ch == '.' || ch == '_' || ch == '-';
     out += ok ? ch : '_';
   }
+  if (out.size() > 100) out.resize(100);  // ASCII by now; names stay far below NAME_MAX
   if (out.empty() || out == "." || out == "..") out = "_" + out;
   return out;
+}
+
+std::string fixtureFolderName(const PairResult& result) {
+  return safeName(result.fixture.empty() ? "fixture" : result.fixture);
+}
+
+std::string pairFolderName(const PairResult& result) {
+  return safeName(result.expected) + "_vs_" + safeName(result.actual);
 }
 
 }  // namespace
@@ -314,8 +323,23 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
 }
 
 fs::path pairDirectory(const fs::path& out_dir, const PairResult& result) {
-  return out_dir / "pairs" / safeName(result.fixture.empty() ? "fixture" : result.fixture) /
-         (safeName(result.expected) + "_vs_" + safeName(result.actual));
+  return out_dir / "pairs" / fixtureFolderName(result) / pairFolderName(result);
+}
+
+fs::path PairFolders::take(const fs::path& out_dir, const PairResult& result) {
+  auto [slot, fresh] = fixture_folder_.try_emplace(result.fixture);
+  if (fresh) {
+    const std::string wanted = fixtureFolderName(result);
+    std::string name = wanted;
+    for (int k = 2; !fixture_folders_taken_.insert(name).second; ++k)
+      name = fmt::format("{}~{}", wanted, k);
+    slot->second = name;
+  }
+  const std::string wanted = pairFolderName(result);
+  std::string name = wanted;
+  for (int k = 2; !pair_folders_taken_.insert(slot->second + "/" + name).second; ++k)
+    name = fmt::format("{}~{}", wanted, k);
+  return out_dir / "pairs" / slot->second / name;
 }
 
 }  // namespace rc

@@ -5,6 +5,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -55,7 +57,22 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
                      const PairPictures& pictures = {});
 
 // A folder for one pair's images under a report folder: <out>/pairs/<fixture>/<expected>
-// _vs_<actual>, every name reduced to [A-Za-z0-9._-] (fixture "a/b" becomes "a_b").
+// _vs_<actual>, every name reduced to [A-Za-z0-9._-] (fixture "a/b" becomes "a_b") and
+// to at most 100 characters.
 std::filesystem::path pairDirectory(const std::filesystem::path& out_dir, const PairResult& result);
+
+// The pair folders of one report, unique whatever the names: pairDirectory's choice, with
+// "~2", "~3"... added to the fixture folder when another fixture's name reduces to the
+// same one ("dup/a b" and "dup/a_b"), and to the pair folder when a fixture name has the
+// same pair twice (two fixture files with one name). Deterministic in call order.
+class PairFolders {
+ public:
+  std::filesystem::path take(const std::filesystem::path& out_dir, const PairResult& result);
+
+ private:
+  std::map<std::string, std::string> fixture_folder_;  // fixture name -> its folder
+  std::set<std::string> fixture_folders_taken_;
+  std::set<std::string> pair_folders_taken_;  // "<fixture folder>/<pair folder>"
+};
 
 }  // namespace rc
