@@ -101,6 +101,7 @@ class Campaign {
           "the same command again to continue",
           durationText(secondsSince(start)), scenesDone(), scenes_.size(), done_.size(),
           failures_.size()));
+      folder_.removeWork();
       interrupt_.reraise();
     }
     return code;

@@ -102,6 +102,7 @@ class MutationStudy {
           "interrupted after {}: kept {} of {} scenes; run the same command again to continue",
           durationText(std::chrono::duration<double>(Clock::now() - start).count()), scenesDone(),
           scenes_.size()));
+      folder_.removeWork();
       interrupt_.reraise();
     }
     return code;

@@ -196,10 +196,14 @@ CampaignFolder::CampaignFolder(fs::path dir, json identity, const std::string& c
 }
 
 CampaignFolder::~CampaignFolder() {
+  removeWork();
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
+}
+
+void CampaignFolder::removeWork() const {
   std::error_code ec;
   if (const char* keep = std::getenv("RASTERCHECK_KEEP_SCRATCH"); !keep || !*keep)
     fs::remove_all(work(), ec);
-  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
 }
 
 fs::path CampaignFolder::rel(const fs::path& p) const {

@@ -82,6 +82,10 @@ class CampaignFolder {
   // Environment for children: their scratch folders go under work().
   std::vector<std::string> childEnv() const;
 
+  // Removes the work folder (also done by the destructor; call it before ending the
+  // process by a signal, which runs no destructor).
+  void removeWork() const;
+
  private:
   std::filesystem::path dir_;
   int lock_fd_ = -1;

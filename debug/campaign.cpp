@@ -68,7 +68,10 @@ std::string pixelText(const json& v) {
 // One line on the failing class of a report row, from its numbers.
 std::string classMessage(const json& row, const std::string& cls) {
   const json& c = row[cls];
-  auto n = [&](const char* key) { return c.contains(key) ? c[key].dump() : std::string("?"); };
+  auto n = [&](const char* key) {
+    if (!c.contains(key) || c[key].is_null()) return std::string("?");
+    return c[key].is_number() ? fmt::format("{:.4g}", c[key].get<double>()) : c[key].dump();
+  };
   if (cls == "visibility")
     return fmt::format("{} hard px (missing {}, extra {}, wrong_primitive {}), worst {}", n("hard"),
                        n("missing_hard"), n("extra_hard"), n("wrong_primitive_hard"),

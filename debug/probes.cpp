@@ -13,18 +13,20 @@ using nlohmann::json;
 namespace {
 
 // One state key: its default (docs/fixture-format.md) and the alternative a default value
-// is probed at (empty: no alternative that could matter without changing the scene's
-// content, e.g. culling or blending an opaque scene).
+// is probed at (null: no alternative that could matter without changing what is drawn,
+// e.g. culling, or blending an opaque scene). front_face is not probed: without culling
+// it changes nothing, with culling flipping it draws the other triangles, which says
+// nothing about the failure (the cull probe covers culling).
 struct StateKey {
   const char* key;
   json value_default;
   json alternative;
-  enum class Needs { Nothing, Lights, PointLights, Texture, Culling } needs;
+  enum class Needs { Nothing, Lights, PointLights, Texture } needs;
 };
 
-const std::array<StateKey, 12>& stateKeys() {
+const std::array<StateKey, 11>& stateKeys() {
   using N = StateKey::Needs;
-  static const std::array<StateKey, 12> keys = {{
+  static const std::array<StateKey, 11> keys = {{
       {"shading", "phong", "gouraud", N::Lights},
       {"specular_model", "blinn-phong", "phong", N::Lights},
       {"attenuation", "none", "inverse", N::PointLights},
@@ -32,7 +34,6 @@ const std::array<StateKey, 12>& stateKeys() {
       {"depth_format", "d24", "d32f", N::Nothing},
       {"color_format", "rgba32f", "rgba8", N::Nothing},
       {"cull", "none", nullptr, N::Nothing},
-      {"front_face", "ccw", "cw", N::Culling},
       {"blend", "none", nullptr, N::Nothing},
       {"visibility", "zbuffer", "painter", N::Nothing},
       {"texture_filter", "nearest", "linear", N::Texture},
@@ -86,11 +87,10 @@ std::vector<Probe> makeProbes(const json& fixture) {
   const bool lights = hasLights(fixture, false);
   const bool point_lights = hasLights(fixture, true);
   const bool texture = anyMaterial(fixture, textured);
-  const bool culling = state.contains("cull") && state["cull"] != "none";
   for (const StateKey& k : stateKeys()) {
     using N = StateKey::Needs;
     if ((k.needs == N::Lights && !lights) || (k.needs == N::PointLights && !point_lights) ||
-        (k.needs == N::Texture && !texture) || (k.needs == N::Culling && !culling))
+        (k.needs == N::Texture && !texture))
       continue;
     const json current = state.contains(k.key) ? state[k.key] : k.value_default;
     const json probed = current == k.value_default ? k.alternative : k.value_default;

@@ -27,9 +27,9 @@ struct Probe {
 // fails. A state key at a non-default value is probed at its default; a key at its default
 // is probed at one alternative where that can matter (nearest -> linear, repeat -> clamp,
 // depth test on -> off, d24 -> d32f, rgba32f -> rgba8, zbuffer -> painter, phong ->
-// gouraud, blinn-phong -> phong, no attenuation -> 1/r, ccw -> cw when culling); keys
-// that cannot matter (texture keys without a texture, lighting keys without lights) are
-// not probed. A missing state key is its default (docs/fixture-format.md).
+// gouraud, blinn-phong -> phong, no attenuation -> 1/r); keys that cannot matter (texture
+// keys without a texture, lighting keys without lights) and front_face are not probed. A
+// missing state key is its default (docs/fixture-format.md).
 std::vector<Probe> makeProbes(const nlohmann::json& fixture);
 
 // What a failure needs, from whether each probe still fails in the failure's class

@@ -376,7 +376,7 @@ class GlFaultBlend : public GlFault, public ::testing::WithParamInterface<Faults
 TEST_P(GlFaultBlend, WrongBlendFactorChangesOnlyBlendedPixels) {
   Scene s = faultScene();
   s.state.blend = Blend::Alpha;
-  s.materials[1].opacity = 0.5;  // the front quad and the ball
+  s.materials[1].opacity = 0.3;  // the front quad and the ball
   const Frame clean = render(s);
   Faults f;
   f.blend_factor = GetParam();
@@ -389,9 +389,8 @@ TEST_P(GlFaultBlend, WrongBlendFactorChangesOnlyBlendedPixels) {
       EXPECT_TRUE(sameColor(faulted, clean, i)) << "opaque or background pixel " << i;
       continue;
     }
-    // Over the back quad or the black background, src*1 and src*(1-a) with a = 0.5 differ
-    // from src*a only where the transparent fragment has colour; the swapped form also
-    // weighs the destination by a instead of 1 - a (the same for a = 0.5).
+    // src*1 + dst*(1-a) differs from src*a + dst*(1-a) wherever the transparent fragment
+    // has colour; src*(1-a) + dst*a wherever src and dst differ (not at a = 0.5, hence 0.3).
     if (!sameColor(faulted, clean, i, 1e-3)) ++blended;
   }
   EXPECT_GT(blended, 300u);
