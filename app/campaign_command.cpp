@@ -444,7 +444,7 @@ class Campaign {
       json fixture = readJson(set.base);
       absolutizePaths(fixture, fs::absolute(set.base).parent_path());
       fixture["name"] = f->id;  // unique in the probe run, whatever the fixture's name
-      set.probes = makeProbes(fixture);
+      set.probes = makeProbes(fixture, f->cls);
       for (std::size_t k = 0; k < set.probes.size(); ++k) {
         const fs::path file = work / f->id / fmt::format("probe-{:02}.json", k);
         fs::create_directories(file.parent_path(), ec);

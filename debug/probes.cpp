@@ -73,10 +73,22 @@ bool transparent(const json& m) {
 
 }  // namespace
 
-std::vector<Probe> makeProbes(const json& fixture) {
+bool probeMatters(const std::string& key, const std::string& cls) {
+  static const std::vector<std::string> shading = {
+      "shading",        "specular_model", "attenuation", "color_format", "blend",
+      "texture_filter", "texture_wrap",   "texture",     "transparency", "lights"};
+  static const std::vector<std::string> coverage = {"depth_test", "depth_format", "cull",
+                                                    "blend",      "visibility",   "transparency"};
+  if (cls.empty()) return true;
+  const auto& keys = cls == "shading" ? shading : coverage;
+  return std::find(keys.begin(), keys.end(), key) != keys.end();
+}
+
+std::vector<Probe> makeProbes(const json& fixture, const std::string& cls) {
   const std::string name = fixture.value("name", std::string("fixture"));
   std::vector<Probe> out;
   auto add = [&](std::string key, std::string involves, std::string change, json f) {
+    if (!key.empty() && !probeMatters(key, cls)) return;
     f["name"] = fmt::format("{}/probe/{}", name, key.empty() ? "unchanged" : key);
     out.push_back({std::move(key), std::move(involves), std::move(change), std::move(f)});
   };

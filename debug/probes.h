@@ -22,15 +22,23 @@ struct Probe {
   nlohmann::json fixture;
 };
 
-// The probes of `fixture`, named "<its name>/probe/<key>" so that one `run` can hold them
-// all. The first is the fixture itself, unchanged (key empty), which says whether it still
-// fails. A state key at a non-default value is probed at its default; a key at its default
-// is probed at one alternative where that can matter (nearest -> linear, repeat -> clamp,
-// depth test on -> off, d24 -> d32f, rgba32f -> rgba8, zbuffer -> painter, phong ->
-// gouraud, blinn-phong -> phong, no attenuation -> 1/r); keys that cannot matter (texture
-// keys without a texture, lighting keys without lights) and front_face are not probed. A
-// missing state key is its default (docs/fixture-format.md).
-std::vector<Probe> makeProbes(const nlohmann::json& fixture);
+// The probes of `fixture` for a failure in class `cls` (visibility, depth or shading; empty:
+// every probe), named "<its name>/probe/<key>" so that one `run` can hold them all. Only
+// what can change that class is probed (probeMatters): for shading the lighting keys,
+// color_format, blending, textures and lights; for visibility and depth the depth test and
+// format, culling, blending and the visibility mode. Elsewhere a probe would only move
+// pixels around and make a fragile failure vanish by accident. The first is the fixture itself,
+// unchanged (key empty), which says whether it still fails. A state key at a non-default value is
+// probed at its default; a key at its default is probed at one alternative where that can matter
+// (nearest -> linear, repeat -> clamp, depth test on -> off, d24 -> d32f, rgba32f -> rgba8, zbuffer
+// -> painter, phong -> gouraud, blinn-phong -> phong, no attenuation -> 1/r); keys that cannot
+// matter (texture keys without a texture, lighting keys without lights) and front_face are not
+// probed. A missing state key is its default (docs/fixture-format.md).
+std::vector<Probe> makeProbes(const nlohmann::json& fixture, const std::string& cls = "");
+
+// Whether the probe of `key` (a state key, "texture", "transparency" or "lights") can
+// tell something about a failure in class `cls`.
+bool probeMatters(const std::string& key, const std::string& cls);
 
 // What a failure needs, from whether each probe still fails in the failure's class
 // (nullopt: it could not be rendered or compared). Empty when the unchanged fixture does

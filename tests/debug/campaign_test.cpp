@@ -163,8 +163,7 @@ TEST(CampaignGroups, SameSignatureSameGroupLargestFirst) {
   EXPECT_EQ(groupFailures({failures[3]})[0].id, g.id);
   EXPECT_NE(groups[1].id, g.id);
   EXPECT_EQ(groups[1].signature, "gl:egl:llvmpipe | shading | texture");
-  EXPECT_EQ(groups[2].signature,
-            "gl:egl:softpipe | depth | not reproduced by its reduced fixture");
+  EXPECT_EQ(groups[2].signature, "gl:egl:softpipe | depth | not reproduced by its reduced fixture");
 }
 
 TEST(CampaignGroups, AReproducerThatFailsBeatsASmallerOneThatDoesNot) {

@@ -116,6 +116,22 @@ TEST(Probes, TransparencyOnlyWhenBlendedMaterialsAreTransparent) {
   EXPECT_EQ(p->fixture["materials"]["m"]["opacity"], 1.0);
 }
 
+TEST(Probes, OnlyWhatCanChangeTheFailingClass) {
+  json f = baseFixture();
+  f["lights"] = json::array({{{"type", "point"}, {"position", {1, 2, 3}}}});
+  f["materials"]["m"]["texture"] = "textures/a.png";
+  f["state"] = {{"blend", "alpha"}, {"cull", "back"}};
+  EXPECT_EQ(
+      keys(makeProbes(f, "shading")),
+      (std::vector<std::string>{"", "shading", "specular_model", "attenuation", "color_format",
+                                "blend", "texture_filter", "texture_wrap", "texture", "lights"}));
+  EXPECT_EQ(
+      keys(makeProbes(f, "depth")),
+      (std::vector<std::string>{"", "depth_test", "depth_format", "cull", "blend", "visibility"}));
+  EXPECT_EQ(keys(makeProbes(f, "visibility")), keys(makeProbes(f, "depth")));
+  EXPECT_EQ(makeProbes(f).size(), 14u) << "no class: all 11 state keys, texture, lights";
+}
+
 TEST(Probes, InvolvedAreThoseWhoseProbePasses) {
   json f = baseFixture();
   f["state"] = {{"depth_format", "d16"}};
