@@ -141,15 +141,17 @@ namespace {
 
 constexpr const char* kCampaignFile = "campaign.json";
 
-// The first identity key whose value differs, described for the error message.
+// Every identity key whose value differs, described for the error message.
 std::string identityDifference(const json& stored, const json& wanted) {
+  std::string out;
+  auto add = [&](const std::string& text) { out += (out.empty() ? "" : "; ") + text; };
   for (const auto& [key, value] : wanted.items()) {
     const json old = stored.contains(key) ? stored[key] : json(nullptr);
-    if (old != value) return fmt::format("{} was {} there, {} now", key, old.dump(), value.dump());
+    if (old != value) add(fmt::format("{} was {} there, {} now", key, old.dump(), value.dump()));
   }
   for (const auto& [key, value] : stored.items())
-    if (!wanted.contains(key)) return fmt::format("{} was {} there", key, value.dump());
-  return {};
+    if (!wanted.contains(key)) add(fmt::format("{} was {} there", key, value.dump()));
+  return out;
 }
 
 }  // namespace
@@ -159,8 +161,12 @@ CampaignFolder::CampaignFolder(fs::path dir, json identity, const std::string& c
   std::error_code ec;
   if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
     throw InputError(fmt::format("{}: --out names a file; it must be a folder", dir_.string()));
-  const bool existed = fs::is_directory(dir_, ec);
-  if (existed && !fs::is_empty(dir_, ec) && !fs::exists(dir_ / kCampaignFile, ec))
+  // Empty but for a lock file (a campaign stopped before writing campaign.json) is new.
+  bool foreign = false;
+  if (fs::is_directory(dir_, ec))
+    for (const auto& e : fs::directory_iterator(dir_, ec))
+      foreign = foreign || e.path().filename() != ".lock";
+  if (foreign && !fs::exists(dir_ / kCampaignFile, ec))
     throw InputError(fmt::format(
         "{}: --out is a folder that `campaign` did not write (no {}); name a new or empty folder",
         dir_.string(), kCampaignFile));
