@@ -141,7 +141,7 @@ std::string cell(const std::string& s) {
 }
 
 std::string involvedText(const std::vector<std::string>& involved) {
-  return involved.empty() ? std::string("nothing probed")
+  return involved.empty() ? std::string("independent of the probed state")
                           : fmt::format("{}", fmt::join(involved, ", "));
 }
 

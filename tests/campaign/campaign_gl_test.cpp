@@ -122,7 +122,8 @@ TEST(CampaignGl, ShortCampaignFindsGroupsAndReproducesEveryOne) {
         << "a half-written run is left: " << e.path();
     ++runs;
     EXPECT_FALSE(fs::exists(e.path() / "frames")) << "frames are not kept";
-    for (const json& row : readJson(e.path() / "report.json")["results"])
+    const json report = readJson(e.path() / "report.json");
+    for (const json& row : report["results"])
       for (const char* cls : {"visibility", "depth", "shading"})
         if (row["status"] == "fail" && row[cls]["status"] == "fail")
           from_reports.insert(row["fixture"].get<std::string>() + " " +
@@ -182,8 +183,8 @@ TEST(CampaignGl, InjectedFaultsFormGroupsWithTheirSignatureAndReproducers) {
   const fs::path dir = scratch("faults");
   const std::string fault = "RASTERCHECK_GL_FAULT=light_scale=1.5,drop_primitive=1";
   const rc::test::CommandResult r = campaign(
-      "--seed 2 --count 3 --profile generators --max-size 48x36 --backends "
-      "gl:egl:llvmpipe --reduce-seconds 20 --jobs 2 --out " +
+      "--seed 2 --count 2 --profile generators --max-size 48x36 --backends "
+      "gl:egl:llvmpipe --reduce-seconds 10 --jobs 2 --out " +
           dir.string(),
       fault);
   ASSERT_EQ(r.code, 1) << r.out << r.err;

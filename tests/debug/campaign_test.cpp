@@ -129,7 +129,8 @@ TEST(CampaignSignatures, BackendClassAndWhatTheFailureNeeds) {
   EXPECT_EQ(signatureOf(f), "gl:egl:softpipe vs gl:egl:llvmpipe | depth | depth_format=d16");
   f = failure("a", "gl:egl:llvmpipe", "visibility", {});
   f.kind = "missing";
-  EXPECT_EQ(signatureOf(f), "gl:egl:llvmpipe | visibility:missing | nothing probed");
+  EXPECT_EQ(signatureOf(f),
+            "gl:egl:llvmpipe | visibility:missing | independent of the probed state");
   f.reproduces = false;
   EXPECT_EQ(signatureOf(f),
             "gl:egl:llvmpipe | visibility:missing | not reproduced by its reduced fixture");
