@@ -5,7 +5,7 @@
 # docs/accuracy.md to cite. Interrupt it at any time; running it again continues.
 # Usage: scripts/campaign.sh [BACKENDS] [COUNT] [SEED] [extra rastercheck campaign options]
 #   BACKENDS  comma-separated SPECs (default gl:egl:llvmpipe,gl:egl:softpipe, plus
-#             gl:egl:zink where this build knows it)
+#             gl:egl:zink where it starts)
 #   COUNT     scenes (default 2000);  SEED  (default 20261201)
 # RASTERCHECK names the binary (default: build/release/app/rastercheck, built if missing);
 # the campaign folder is out/campaign-s<SEED>-n<COUNT> unless CAMPAIGN_OUT names another.
@@ -17,7 +17,12 @@ if [[ -z $exe ]]; then
   exe=$(bash "$root/scripts/build.sh")/app/rastercheck
 fi
 default_backends=gl:egl:llvmpipe,gl:egl:softpipe
-if "$exe" render --help 2>/dev/null | grep -q zink; then default_backends+=,gl:egl:zink; fi
+probe=$(mktemp -d)
+if "$exe" render "$root/fixtures/scenes/coverage/triangle_fan.json" --backend gl:egl:zink \
+  --out "$probe/zink" >/dev/null 2>&1; then
+  default_backends+=,gl:egl:zink
+fi
+rm -rf "$probe"
 backends=${1:-$default_backends}
 count=${2:-2000}
 seed=${3:-20261201}
