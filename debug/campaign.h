@@ -115,8 +115,8 @@ struct BackendCounts {
 void countReport(const nlohmann::json& report, std::map<std::string, BackendCounts>& counts);
 
 struct CampaignSummary {
-  nlohmann::json options;  // as campaign.json holds them
-  std::string command;     // the command line that (re)started the campaign
+  nlohmann::json options = nlohmann::json::object();  // as campaign.json holds them
+  std::string command;  // the command line that (re)started the campaign
   std::uint64_t scenes_total = 0;
   std::uint64_t scenes_run = 0;
   std::uint64_t failures_done = 0;  // reduced and probed (or skipped)
@@ -124,7 +124,7 @@ struct CampaignSummary {
   std::vector<std::string> runs;  // run folders, relative
   std::map<std::string, BackendCounts> backends;
   std::vector<CampaignFailure> failures;
-  nlohmann::json variants;  // from the first run's report.json, when probed
+  nlohmann::json variants = nlohmann::json::object();  // the first run's, when probed
   // Per group id: the reproducer file (relative to the campaign folder) and its command.
   struct GroupFiles {
     std::string reproducer;

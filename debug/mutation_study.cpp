@@ -62,6 +62,7 @@ const MutationFault& mutationFault(const std::string& name) {
   for (const MutationFault& f : kFaults)
     if (name == f.name) return f;
   std::vector<std::string> names;
+  names.reserve(kFaults.size());
   for (const MutationFault& f : kFaults) names.emplace_back(f.name);
   throw InputError(
       fmt::format("--faults: unknown fault '{}' (valid: {})", name, fmt::join(names, ", ")));
