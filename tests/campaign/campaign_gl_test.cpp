@@ -46,6 +46,11 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
+std::string readText(const fs::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 json readJson(const fs::path& file) {
   std::ifstream in(file);
   return json::parse(in);
@@ -106,6 +111,7 @@ TEST(CampaignGl, ShortCampaignFindsGroupsAndReproducesEveryOne) {
   const rc::test::CommandResult first = campaign(args);
   ASSERT_TRUE(first.code == 0 || first.code == 1) << first.out << first.err;
   EXPECT_THAT(first.err, HasSubstr("starting a campaign in"));
+  EXPECT_EQ(first.err.find('\r'), std::string::npos) << "no status line when not a terminal";
   EXPECT_THAT(first.out, HasSubstr("summary: " + (dir / "summary.md").string()));
   const json summary = readJson(dir / "summary.json");
   EXPECT_EQ(summary["complete"], true);
@@ -216,6 +222,25 @@ TEST(CampaignGl, InjectedFaultsFormGroupsWithTheirSignatureAndReproducers) {
   fs::remove_all(dir);
 }
 
+TEST(CampaignGl, ProgressIsRedrawnInPlaceOnATerminal) {
+  REQUIRE_GL();
+  const fs::path dir = scratch("tty");
+  const fs::path typescript = scratch("tty_typescript");
+  // `script` runs the command on a pseudo-terminal and records what it wrote there.
+  const rc::test::CommandResult r =
+      rc::test::runShell("script -qfec '" RC_EXE
+                         " campaign --seed 4 --count 2 --batch 1 --max-size 32x24 "
+                         "--backends gl:egl:llvmpipe --reduce-seconds 0 --out " +
+                         dir.string() + "' " + typescript.string());
+  EXPECT_TRUE(r.code == 0 || r.code == 1) << r.out;
+  const std::string text = readText(typescript);
+  EXPECT_THAT(text, HasSubstr("\rcampaign: scenes 0/2 (0 %), 0 failures; running 0..0"));
+  EXPECT_THAT(text, HasSubstr("\rcampaign: scenes 1/2 (50 %)"));
+  EXPECT_THAT(text, HasSubstr("; ETA ")) << text;
+  fs::remove_all(dir);
+  fs::remove(typescript);
+}
+
 // Starts the campaign in the background (its own output files), for signals.
 pid_t start(const std::vector<std::string>& args, const fs::path& log) {
   std::vector<std::string> argv = {RC_EXE, "campaign"};
@@ -232,11 +257,6 @@ pid_t start(const std::vector<std::string>& args, const fs::path& log) {
   EXPECT_EQ(posix_spawn(&pid, c[0], &actions, nullptr, c.data(), environ), 0);
   posix_spawn_file_actions_destroy(&actions);
   return pid;
-}
-
-std::string readText(const fs::path& file) {
-  std::ifstream in(file);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 TEST(CampaignGl, CtrlCKeepsFinishedWorkAndTheSameCommandContinues) {
