@@ -230,7 +230,12 @@ class MutationStudy {
       MutationScene facts = sceneFacts(loaded.at(i));
       for (const std::string& b : args_.backends) {
         const fs::path clean = backendDir(i, b) / "clean";
-        if (ok(clean)) facts.visible_ids = visibleIds(readFrameDir(clean));
+        facts.visible_ids.clear();
+        try {
+          if (ok(clean)) facts.visible_ids = visibleIds(readFrameDir(clean));
+        } catch (const InputError&) {
+          // An unreadable frame: the comparison below reports it as an error.
+        }
         for (const MutationFault* f : faults_) {
           Planned p{i, b, f, ok(clean) ? faultSetting(*f, facts, scene_options_.seed, i) : ""};
           if (!p.setting.empty() && ok(sceneDir(i) / "ref")) {
