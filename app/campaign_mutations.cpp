@@ -255,9 +255,14 @@ class MutationStudy {
     std::map<std::pair<std::uint64_t, std::string>, std::optional<Frame>> clean_frames;
     std::map<std::uint64_t, std::optional<Frame>> refs;
     std::map<std::pair<std::uint64_t, std::string>, std::set<std::string>> controls;
+    // A frame that is missing or cannot be read is nullopt: its rows are errors.
     auto readIf = [&](const fs::path& dir) -> std::optional<Frame> {
       if (!ok(dir)) return std::nullopt;
-      return readFrameDir(dir);
+      try {
+        return readFrameDir(dir);
+      } catch (const InputError&) {
+        return std::nullopt;
+      }
     };
     auto failure = [&](const fs::path& dir, const std::string& what) {
       fs::path log = dir;
