@@ -16,8 +16,8 @@ namespace rc {
 namespace {
 
 constexpr const char* kValidSpecs =
-    "ref, ref:painter, ref:subpixel=N, gl, gl:egl[:llvmpipe|:softpipe], "
-    "gl:osmesa[:llvmpipe|:softpipe], gl:egl-device[:N]";
+    "ref, ref:painter, ref:subpixel=N, gl, gl:egl[:llvmpipe|:softpipe|:zink], "
+    "gl:osmesa[:llvmpipe|:softpipe], gl:egl-device[:N], a gl SPEC followed by @MESA_LIB_DIR";
 
 ReferenceOptions parseReferenceSpec(std::string_view spec) {
   ReferenceOptions opts;

@@ -1,6 +1,14 @@
 // `rastercheck render SCENE --backend SPEC --out DIR`: one fixture, one backend, one
-// frame directory (written all-or-nothing).
+// frame directory (written all-or-nothing). A SPEC with another Mesa's folder restarts
+// the process once with that folder first in LD_LIBRARY_PATH.
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -12,9 +20,41 @@
 
 namespace rc {
 
+namespace {
+
+// A GL SPEC naming another Mesa's folder needs LD_LIBRARY_PATH from the process's start
+// (the dynamic loader reads it once): set it and run this same command again, before
+// anything GL is loaded. startupEnvironment() returns the variables unchanged once they
+// are in place, so this happens at most once.
+void restartWithStartupEnvironment(const RenderArgs& args, const BackendSpec& backend) {
+  if (backend.kind != BackendSpec::Kind::Gl) return;
+  bool missing = false;
+  for (const auto& [name, value] : startupEnvironment(backend.gl)) {
+    const char* have = std::getenv(name.c_str());
+    if (have != nullptr && value == have) continue;
+    setenv(name.c_str(), value.c_str(), 1);
+    missing = true;
+  }
+  if (!missing) return;
+  const std::string exe = "/proc/self/exe";
+  std::vector<std::string> argv = {exe,          "render", args.scene.string(), "--backend",
+                                   args.backend, "--out",  args.out.string()};
+  std::vector<char*> raw;
+  raw.reserve(argv.size() + 1);
+  for (std::string& a : argv) raw.push_back(a.data());
+  raw.push_back(nullptr);
+  std::cout.flush();
+  ::execv(exe.c_str(), raw.data());
+  throw BackendError(fmt::format("{}: cannot restart rastercheck with LD_LIBRARY_PATH: {}",
+                                 args.backend, std::strerror(errno)));
+}
+
+}  // namespace
+
 int renderCommand(const RenderArgs& args) {
   // Parse the SPEC before loading so that a typo costs nothing and exits 2.
   const BackendSpec backend = parseBackendSpec(args.backend);
+  restartWithStartupEnvironment(args, backend);
   const Scene scene = loadScene(args.scene);
   const Frame frame = renderWith(backend, scene);
   writeFrameDir(frame, args.out);

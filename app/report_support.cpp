@@ -51,6 +51,23 @@ fs::path readyPicture(const fs::path& frame_dir, const Frame& frame) {
   return fs::is_regular_file(png, ec) ? png : fs::path();
 }
 
+namespace {
+
+// The frame.json keys that say which driver stack drew a GL frame (null for the
+// reference, which has none of them).
+nlohmann::json driverStack(const Frame& frame) {
+  if (!frame.meta.contains("stack")) return nullptr;
+  nlohmann::json out = nlohmann::json::object();
+  for (const char* key :
+       {"stack", "gl_renderer", "gl_version", "platform", "driver", "subpixel_bits",
+        "gl_subpixel_bits", "subpixel_bits_source", "mesa", "vulkan"}) {
+    if (frame.meta.contains(key)) out[key] = frame.meta[key];
+  }
+  return out;
+}
+
+}  // namespace
+
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, const fs::path& out_dir,
                        const PairPictures& pictures) {
@@ -63,6 +80,8 @@ PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& 
   };
   result.expected = name(expected, "expected");
   result.actual = name(actual, "actual");
+  result.expected_stack = driverStack(expected);
+  result.actual_stack = driverStack(actual);
   if (expected.meta.contains("fixture") && expected.meta["fixture"].is_string())
     result.fixture = expected.meta["fixture"].get<std::string>();
   writePairImages(expected, actual, maps, pairDirectory(out_dir, result), result, pictures);
@@ -240,6 +259,13 @@ void printSummary(const Report& report, const fs::path& out_dir, std::ostream& o
     if (r.status != Status::Pass) os << describe(r) << '\n';
   }
   if (!report.results.empty()) os << '\n' << summaryTable(report) << '\n';
+  // What the variant probes found a driver saying about itself that is not so (not a
+  // failure: the comparisons used what the driver really does).
+  for (const auto& [spec, v] : report.variants.items()) {
+    if (!v.is_object() || !v.contains("findings") || !v["findings"].is_array()) continue;
+    for (const nlohmann::json& f : v["findings"])
+      if (f.is_string()) os << "finding: " << spec << ": " << f.get<std::string>() << '\n';
+  }
   const ReportSummary s = report.summary();
   os << fmt::format("{} pairs: {} pass, {} warn, {} fail, {} error\n", s.total(), s.pass, s.warn,
                     s.fail, s.error);

@@ -88,9 +88,26 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
       const Frame tb = readFrameDir(dir / "tie_break");
       const Frame dr = readFrameDir(dir / "depth_rounding");
       if (sub.meta.contains("renderer")) v["renderer"] = sub.meta["renderer"];
+      if (sub.meta.contains("stack")) v["stack"] = sub.meta["stack"];
+      auto key = [&](const char* name) {
+        return sub.meta.contains(name) ? sub.meta[name] : nlohmann::json(nullptr);
+      };
+      // GL's answer; older frames carried it as subpixel_bits only.
       v["subpixel_bits"] =
-          sub.meta.contains("subpixel_bits") ? sub.meta["subpixel_bits"] : nlohmann::json(nullptr);
-      v["subpixel"] = variants::toJson(variants::analyseSubpixel(sub, reference));
+          sub.meta.contains("gl_subpixel_bits") ? key("gl_subpixel_bits") : key("subpixel_bits");
+      v["band_subpixel_bits"] = key("subpixel_bits");
+      const variants::SubpixelResult subpixel = variants::analyseSubpixel(sub, reference);
+      v["subpixel"] = variants::toJson(subpixel);
+      v["findings"] = nlohmann::json::array();
+      if (!subpixel.finding.empty()) v["findings"].push_back("subpixel: " + subpixel.finding);
+      // A band finer than the driver's snapping would call legal edge pixels hard; a
+      // coarser one (softpipe's 4 bits over its float edges) only excuses more.
+      if (subpixel.band >= 0 && subpixel.best >= 0 && !subpixel.band_confirmed &&
+          subpixel.best < subpixel.band)
+        v["findings"].push_back(fmt::format(
+            "subpixel: the driver snaps to {} bits, coarser than the {} bits its frames carry "
+            "for the snap band: legal edge pixels may be reported hard",
+            subpixel.best, subpixel.band));
       v["tie_break"] = variants::toJson(variants::analyseTieBreak(tie, tb));
       v["depth_rounding"] = variants::toJson(variants::analyseDepthRounding(depth, dr));
       v["probe_seconds"] = shared_seconds;

@@ -14,9 +14,12 @@
 namespace rc {
 
 // Returns {"SPEC": {...}} for every GL spec among `specs` (reference specs are skipped;
-// duplicates are probed once): "renderer", "subpixel_bits" (GL_SUBPIXEL_BITS as the
-// driver's frame.json records it), "subpixel", "tie_break", "depth_rounding" (see
-// compare/variants.h toJson) and "probe_seconds"; or "error" when a probe render failed.
+// duplicates are probed once): "renderer", "stack" (frame.json's one-line driver stack),
+// "subpixel_bits" (GL_SUBPIXEL_BITS as the driver answers it), "band_subpixel_bits" (what
+// the backend's frames carry for the comparator's snap band), "subpixel", "tie_break",
+// "depth_rounding" (see compare/variants.h toJson), "findings" (sentences: where the
+// driver's answer and its rasterization disagree) and "probe_seconds"; or "error" when a
+// probe render failed.
 // Writes work_dir/probes/*.json, work_dir/<spec>/<probe>/ frames and
 // work_dir/variants.json. Never throws for a backend that cannot run.
 nlohmann::json detectVariants(const std::vector<std::string>& specs,

@@ -271,6 +271,77 @@ std::vector<std::string> differenceSummary(const std::vector<const AccuracyPair*
   return out;
 }
 
+// A report.json variant summary or value as one table cell.
+std::string variantText(const json& v, const char* key) {
+  if (!v.contains(key)) return "-";
+  const json& x = v[key];
+  if (x.is_object() && x.contains("summary") && x["summary"].is_string())
+    return cell(x["summary"].get<std::string>());
+  if (x.is_null()) return "-";
+  return cell(x.is_string() ? x.get<std::string>() : x.dump());
+}
+
+// A probed rule and whether it is the reference's: "left+bottom (as ref)".
+std::string variantRule(const json& v, const char* key) {
+  if (!v.contains(key) || !v[key].is_object()) return "-";
+  const json& x = v[key];
+  return fmt::format("{}{}", cell(x.value("rule", std::string("-"))),
+                     x.value("matches_reference", false) ? " (as ref)" : " (differs from ref)");
+}
+
+// "Driver stacks and variants": what each GL backend ran on, the legal variants the probes
+// found, and the findings (a driver's answer contradicted by what it does).
+template <typename Line>
+void variantsSection(const AccuracyData& data, const Line& line) {
+  if (data.variants.empty()) return;
+  line();
+  line("## Driver stacks and variants");
+  line();
+  line("Probed once per backend and run (docs/debugging.md, \"Variant detection\").");
+  line("*GL_SUBPIXEL_BITS* is the driver's answer; *rasterizes like* is what the subpixel");
+  line("probe measured; *snap band* is the precision the backend's frames carry, which the");
+  line("comparator's visibility band uses (docs/gl_backend.md: zink's comes from its Vulkan");
+  line("device).");
+  line();
+  line(
+      "| backend | stack | GL_SUBPIXEL_BITS | rasterizes like | snap band | tie-break | depth "
+      "rounding |");
+  line("|---|---|---|---|---|---|---|");
+  std::vector<std::string> findings;
+  for (const auto& [spec, v] : data.variants) {
+    if (!v.is_object()) continue;
+    if (v.contains("error")) {
+      line(fmt::format("| `{}` | error: {} | | | | | |", spec, variantText(v, "error")));
+      continue;
+    }
+    std::string observed = "-";
+    if (v.contains("subpixel") && v["subpixel"].is_object()) {
+      const json& sub = v["subpixel"];
+      if (sub.value("exact", false) && sub.contains("best") && sub["best"].is_number())
+        observed = fmt::format("{} bits", sub["best"].get<int>());
+      else if (sub.contains("best") && sub["best"].is_number())
+        observed = fmt::format("no fixed grid (closest {})", sub["best"].get<int>());
+    }
+    const std::string band = v.contains("band_subpixel_bits") ? variantText(v, "band_subpixel_bits")
+                                                              : variantText(v, "subpixel_bits");
+    line(fmt::format("| `{}` | {} | {} | {} | {} | {} | {} |", spec,
+                     v.contains("stack") ? variantText(v, "stack") : variantText(v, "renderer"),
+                     variantText(v, "subpixel_bits"), observed, band, variantRule(v, "tie_break"),
+                     variantRule(v, "depth_rounding")));
+    if (v.contains("findings") && v["findings"].is_array())
+      for (const json& f : v["findings"])
+        if (f.is_string()) findings.push_back(fmt::format("`{}`: {}", spec, f.get<std::string>()));
+  }
+  line();
+  if (findings.empty()) {
+    line("Findings: none (every driver rasterizes as it says).");
+    return;
+  }
+  line("Findings (not failures: every comparison used what the driver really does):");
+  line();
+  for (const std::string& f : findings) line("- " + f);
+}
+
 }  // namespace
 
 AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
@@ -288,6 +359,11 @@ AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
     for (std::size_t i = 0; i < results.size(); ++i) {
       AccuracyPair p = readPair(r, results[i], fmt::format("results[{}]", i));
       pairs[{p.expected, p.actual, p.fixture}] = std::move(p);
+    }
+    if (doc.contains("variants")) {
+      const json& variants = doc["variants"];
+      if (!variants.is_object()) r.fail("variants", "must be an object");
+      for (const auto& [spec, v] : variants.items()) data.variants[spec] = v;
     }
     collectFixtureFiles(run, files);
   }
@@ -369,6 +445,8 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
                        t.psnr_min ? num(*t.psnr_min) : "identical"));
     }
 
+    variantsSection(data, line);
+
     line();
     line("## Per topic");
     line();
@@ -416,6 +494,8 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
       line(row);
     }
   }
+
+  if (against_ref.empty()) variantsSection(data, line);
 
   for (const Group& g : between_drivers) {
     const auto& list = groups[g];

@@ -7,9 +7,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "compare/compare.h"
 #include "compare/tolerances.h"
@@ -66,6 +69,9 @@ struct AccuracyData {
   std::vector<std::string> sources;  // the run folders, as given
   std::vector<AccuracyPair> pairs;   // sorted by expected, actual, fixture
   std::vector<KnownDifference> known;
+  // report.json "variants" of every run, by backend SPEC (the last run read wins): the
+  // driver stack, the probed legal variants and the findings (app/variants.h).
+  std::map<std::string, nlohmann::json> variants;
 };
 
 // Reads report.json from each run folder. A fixture's tags come from the fixture file

@@ -128,6 +128,10 @@ struct PairResult {
   std::uint64_t pixels = 0;
   int expected_subpixel_bits = 8;
   int actual_subpixel_bits = 8;
+  // The driver stack each side ran on (frame.json "stack", "mesa", "vulkan", ...); null
+  // for the reference or frames that do not say. report.json "stacks".
+  nlohmann::json expected_stack;
+  nlohmann::json actual_stack;
   Tolerances tolerances;  // the ones in effect
   VisibilityStats visibility;
   DepthStats depth;

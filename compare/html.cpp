@@ -421,26 +421,35 @@ std::string variantsTable(const Report& report) {
   };
   std::string out =
       "<h2>Backend variants</h2><table id=\"variants\"><tr><th>backend</th><th>renderer</th>"
-      "<th>GL_SUBPIXEL_BITS</th><th>subpixel precision</th><th>tie-break</th>"
-      "<th>depth rounding</th></tr>";
+      "<th>GL_SUBPIXEL_BITS</th><th>snap band bits</th><th>subpixel precision</th>"
+      "<th>tie-break</th><th>depth rounding</th><th>findings</th></tr>";
   for (const auto& [spec, v] : report.variants.items()) {
     out += fmt::format("<tr><td>{}</td>", esc(spec));
     if (v.contains("error")) {
-      out += fmt::format("<td colspan=\"5\">{} {}</td></tr>", badge(Status::Error),
+      out += fmt::format("<td colspan=\"7\">{} {}</td></tr>", badge(Status::Error),
                          esc(text(v, "error")));
       continue;
     }
-    out += fmt::format("<td>{}</td><td class=\"n\">{}</td>", esc(text(v, "renderer")),
-                       esc(text(v, "subpixel_bits")));
+    const std::string band = text(v, "band_subpixel_bits");
+    out +=
+        fmt::format("<td title=\"{}\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>",
+                    esc(text(v, "stack")), esc(text(v, "renderer")), esc(text(v, "subpixel_bits")),
+                    esc(band.empty() ? text(v, "subpixel_bits") : band));
     out += fmt::format("<td>{} {}</td>",
                        mark(v, "subpixel", "confirmed", "confirmed", "not confirmed"),
                        esc(text(v, "subpixel")));
     out += fmt::format("<td>{} {}</td>",
                        mark(v, "tie_break", "matches_reference", "as ref", "differs"),
                        esc(text(v, "tie_break")));
-    out += fmt::format("<td>{} {}</td></tr>",
+    out += fmt::format("<td>{} {}</td>",
                        mark(v, "depth_rounding", "matches_reference", "as ref", "differs"),
                        esc(text(v, "depth_rounding")));
+    std::string findings;
+    if (v.contains("findings") && v["findings"].is_array()) {
+      for (const nlohmann::json& f : v["findings"])
+        if (f.is_string()) findings += (findings.empty() ? "" : "<br>") + esc(f.get<std::string>());
+    }
+    out += fmt::format("<td>{}</td></tr>", findings);
   }
   return out + "</table>";
 }

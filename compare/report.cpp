@@ -169,6 +169,8 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
   j["width"] = r.width;
   j["height"] = r.height;
   j["subpixel_bits"] = {{"expected", r.expected_subpixel_bits}, {"actual", r.actual_subpixel_bits}};
+  if (!r.expected_stack.is_null() || !r.actual_stack.is_null())
+    j["stacks"] = {{"expected", r.expected_stack}, {"actual", r.actual_stack}};
   j["tolerances"] = {{"depth_format", toString(t.depth_format)},
                      {"color_format", toString(t.color_format)},
                      {"visibility", thresholds(t.visibility)},

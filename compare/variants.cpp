@@ -103,9 +103,15 @@ Scene subpixelProbe(std::uint32_t seed) {
 
 SubpixelResult analyseSubpixel(const Frame& driver, const std::map<int, Frame>& reference) {
   SubpixelResult r;
-  if (const auto it = driver.meta.find("subpixel_bits");
-      it != driver.meta.end() && it->is_number_integer())
-    r.queried = it->get<int>();
+  auto integer = [&](const char* key) {
+    const auto it = driver.meta.find(key);
+    return it != driver.meta.end() && it->is_number_integer() ? it->get<int>() : -1;
+  };
+  r.band = integer("subpixel_bits");
+  r.queried = driver.meta.contains("gl_subpixel_bits") ? integer("gl_subpixel_bits") : r.band;
+  if (const auto it = driver.meta.find("subpixel_bits_source");
+      it != driver.meta.end() && it->is_string())
+    r.band_source = it->get<std::string>();
   for (const auto& [bits, ref] : reference) {
     checkSize(ref, driver.width, driver.height, "subpixel");
     checkSize(driver, ref.width, ref.height, "subpixel");
@@ -120,6 +126,17 @@ SubpixelResult analyseSubpixel(const Frame& driver, const std::map<int, Frame>& 
   r.exact = r.best >= 0 && r.best_mismatches == 0;
   const auto q = r.mismatches.find(r.queried);
   r.confirmed = q != r.mismatches.end() && q->second == 0;
+  const auto b = r.mismatches.find(r.band);
+  r.band_confirmed = b != r.mismatches.end() && b->second == 0;
+  if (r.exact && r.queried >= 0 && !r.confirmed) {
+    r.finding = fmt::format("GL_SUBPIXEL_BITS says {} but the driver rasterizes like {} bits{}",
+                            r.queried, r.best, r.best == kMaxCandidateBits ? " or finer" : "");
+  } else if (!r.exact && r.best >= 0 && r.queried >= 0) {
+    r.finding = fmt::format(
+        "GL_SUBPIXEL_BITS says {} but no fixed grid of {}..{} bits reproduces the driver's "
+        "coverage (closest: {} bits)",
+        r.queried, kMinCandidateBits, kMaxCandidateBits, r.best);
+  }
   return r;
 }
 
@@ -442,11 +459,17 @@ DepthRoundingResult analyseDepthRounding(const DepthProbe& probe, const Frame& d
 nlohmann::json toJson(const SubpixelResult& r) {
   nlohmann::json mismatches = nlohmann::json::object();
   for (const auto& [bits, n] : r.mismatches) mismatches[std::to_string(bits)] = n;
-  return {{"queried", r.queried >= 0 ? nlohmann::json(r.queried) : nlohmann::json(nullptr)},
-          {"best", r.best >= 0 ? nlohmann::json(r.best) : nlohmann::json(nullptr)},
+  auto bits = [](int n) { return n >= 0 ? nlohmann::json(n) : nlohmann::json(nullptr); };
+  return {{"queried", bits(r.queried)},
+          {"best", bits(r.best)},
           {"best_mismatches", r.best_mismatches},
           {"exact", r.exact},
           {"confirmed", r.confirmed},
+          {"band", bits(r.band)},
+          {"band_source",
+           r.band_source.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.band_source)},
+          {"band_confirmed", r.band_confirmed},
+          {"finding", r.finding.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.finding)},
           {"mismatches", mismatches},
           {"summary", describeSubpixel(r)}};
 }
@@ -479,7 +502,9 @@ nlohmann::json toJson(const DepthRoundingResult& r) {
           {"summary", describeDepthRounding(r)}};
 }
 
-std::string describeSubpixel(const SubpixelResult& r) {
+namespace {
+
+std::string describeSubpixelQueried(const SubpixelResult& r) {
   const std::string queried =
       r.queried >= 0 ? fmt::format("GL_SUBPIXEL_BITS {}", r.queried) : "GL_SUBPIXEL_BITS unknown";
   if (r.best < 0) return queried + ", not probed";
@@ -506,6 +531,20 @@ std::string describeSubpixel(const SubpixelResult& r) {
       "in {} px{})",
       kMinCandidateBits, kMaxCandidateBits, queried, at_queried, r.best, r.best_mismatches,
       r.best == kMaxCandidateBits ? ": finer than 2^-12 px, e.g. float edge evaluation" : "");
+}
+
+}  // namespace
+
+std::string describeSubpixel(const SubpixelResult& r) {
+  std::string s = describeSubpixelQueried(r);
+  // Where the frames carry another precision than GL's answer, say which and whether the
+  // probe bears it out: that is the band every comparison of this backend used.
+  if (r.band >= 0 && r.band != r.queried && r.best >= 0) {
+    s += fmt::format("; snap band: {} bits from {} ({})", r.band,
+                     r.band_source.empty() ? std::string("frame.json") : r.band_source,
+                     r.band_confirmed ? "confirmed by the probe" : "NOT confirmed by the probe");
+  }
+  return s;
 }
 
 std::string describeTieBreak(const TieBreakResult& r) {

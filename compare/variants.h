@@ -37,12 +37,21 @@ inline constexpr int kMinCandidateBits = 0;
 inline constexpr int kMaxCandidateBits = 12;
 
 struct SubpixelResult {
-  int queried = -1;                         // GL_SUBPIXEL_BITS from frame.json (-1: absent)
+  int queried = -1;         // GL_SUBPIXEL_BITS from frame.json gl_subpixel_bits (older frames:
+                            // subpixel_bits) (-1: absent)
+  int band = -1;            // frame.json subpixel_bits: what the comparator's snap band assumes
+                            // (differs from queried where the driver stack knows better, e.g.
+                            // zink's Vulkan device) (-1: absent)
+  std::string band_source;  // frame.json subpixel_bits_source ("" if absent)
   std::map<int, std::uint64_t> mismatches;  // N -> pixels whose id differs from ref:subpixel=N
   int best = -1;                            // N with the fewest mismatches (smallest N on ties)
   std::uint64_t best_mismatches = 0;
-  bool exact = false;      // some N reproduces the driver's coverage exactly
-  bool confirmed = false;  // the queried N does
+  bool exact = false;           // some N reproduces the driver's coverage exactly
+  bool confirmed = false;       // the queried N does
+  bool band_confirmed = false;  // the band's N does
+  // One sentence when the driver's answer and its rasterization disagree (e.g. "GL_SUBPIXEL_BITS
+  // says 4 but the driver rasterizes like 8 bits"), else "".
+  std::string finding;
 };
 
 // `driver` is the driver's frame of subpixelProbe(); `reference` maps each candidate N to

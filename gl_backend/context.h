@@ -44,7 +44,9 @@ std::unique_ptr<Context> createEglDeviceContext(int device);
 // the same BackendError when there is no such hardware device.
 int findEglDevice(int device);
 
-// OSMesa with a core-profile context. Throws BackendError when the build has no OSMesa.
-std::unique_ptr<Context> createOsMesaContext();
+// OSMesa with a core-profile context, from `mesa_dir`'s OSMesa library when not empty
+// (the first call in a process decides which library is loaded). Throws BackendError
+// when the build has no OSMesa.
+std::unique_ptr<Context> createOsMesaContext(const std::string& mesa_dir = "");
 
 }  // namespace rc::gl

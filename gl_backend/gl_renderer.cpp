@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,8 +27,10 @@
 #include "gl_backend/gl_backend.h"
 #include "gl_backend/gl_functions.h"
 #include "gl_backend/gl_testing.h"
+#include "gl_backend/mesa_libraries.h"
 #include "gl_backend/shaders.h"
 #include "gl_backend/vertex_data.h"
+#include "gl_backend/vulkan_device.h"
 
 namespace rc {
 
@@ -103,8 +106,10 @@ int glInteger(const gl::Functions& gl, GLenum name) {
   return value;
 }
 
-// "llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe"; a GPU keeps its full renderer string.
+// "llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe", "zink (llvmpipe (...))" -> "zink"; a
+// GPU keeps its full renderer string.
 std::string driverFromRenderer(const std::string& renderer) {
+  if (renderer.rfind("zink", 0) == 0) return "zink";  // before llvmpipe: zink names its device
   if (renderer.find("llvmpipe") != std::string::npos) return "llvmpipe";
   if (renderer.find("softpipe") != std::string::npos) return "softpipe";
   return renderer;
@@ -148,7 +153,16 @@ struct Session {
   std::unique_ptr<gl::Context> context;
   gl::Functions gl;
   std::string vendor, renderer, version, glsl_version, driver;
-  int subpixel_bits = 0;
+  int gl_subpixel_bits = 0;  // GL_SUBPIXEL_BITS, as the driver answers it
+  int subpixel_bits = 0;     // the precision it rasterizes with (chooseSubpixelBits)
+  std::string subpixel_source;
+  gl::LoadedMesa mesa;  // frame.json "mesa"
+  std::string mesa_version;
+  bool zink = false;                       // frame.json "vulkan" only then:
+  std::optional<gl::VulkanDevice> vulkan;  // the device under zink, or
+  std::string vulkan_error;                // why it could not be asked
+  double vulkan_query_ms = 0.0;
+  std::string stack;                        // frame.json "stack": the layers in one line
   std::map<std::string, Program> programs;  // by source text
   std::vector<std::string> debug_errors;    // KHR_debug error messages since the last check
   Framebuffer framebuffer;
@@ -181,15 +195,52 @@ void checkGl(Session& s, const char* stage) {
                                  stage, detail));
 }
 
+// zink's GL_SUBPIXEL_BITS is Gallium's default (4), not its device's: Mesa 22.3.6 answers
+// 4 while lavapipe, which does the rasterizing, snaps to 8 bits (the variant probe sees
+// 8). The comparator's snap band must follow what really happens, so under zink the
+// Vulkan device's subPixelPrecisionBits is used; the GL answer stays in frame.json as
+// gl_subpixel_bits and the variant probe reports the discrepancy.
+void chooseSubpixelBits(Session& s) {
+  s.subpixel_bits = s.gl_subpixel_bits;
+  s.subpixel_source = "GL_SUBPIXEL_BITS";
+  if (s.vulkan && s.vulkan->subpixel_precision_bits >= 0) {
+    s.subpixel_bits = s.vulkan->subpixel_precision_bits;
+    s.subpixel_source = "VkPhysicalDeviceLimits::subPixelPrecisionBits";
+  }
+}
+
+const char* platformName(GlSpec::Platform p) {
+  switch (p) {
+    case GlSpec::Platform::EglSurfaceless:
+      return "EGL surfaceless";
+    case GlSpec::Platform::EglDevice:
+      return "EGL device";
+    case GlSpec::Platform::OSMesa:
+      return "OSMesa";
+  }
+  return "";
+}
+
+// "zink (llvmpipe (...)) | OpenGL 4.6 (Core Profile) Mesa 22.3.6 | EGL surfaceless |
+// Vulkan 1.3.230 llvmpipe (...) [llvmpipe, Mesa 22.3.6 (LLVM 15.0.6)] | driver
+// /usr/lib/x86_64-linux-gnu/dri/swrast_dri.so", plus "(Mesa folder DIR)" for an @DIR spec.
+std::string describeStack(const Session& s, const gl::LoadedMesa& mesa) {
+  std::string out =
+      fmt::format("{} | OpenGL {} | {}", s.renderer, s.version, platformName(s.spec.platform));
+  if (s.vulkan) {
+    out += fmt::format(" | Vulkan {} {}", s.vulkan->api_version, s.vulkan->name);
+    if (!s.vulkan->driver_name.empty())
+      out += fmt::format(" [{}, {}]", s.vulkan->driver_name, s.vulkan->driver_info);
+  }
+  if (!mesa.driver_library.empty()) out += " | driver " + mesa.driver_library;
+  if (!mesa.dir.empty()) out += " (Mesa folder " + mesa.dir + ")";
+  return out;
+}
+
 std::unique_ptr<Session> createSession(const GlSpec& spec) {
   const std::string& forced = gl::testing::hooks().gallium_driver;
   const std::string gallium = forced.empty() ? spec.driver : forced;
-  if (!gallium.empty()) {
-    // Read by Mesa when the first screen is created; later changes have no effect.
-    setenv("GALLIUM_DRIVER", gallium.c_str(), 1);
-    // Surfaceless EGL would prefer a GPU render node; a software driver was asked for.
-    if (spec.platform == GlSpec::Platform::EglSurfaceless) setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
-  }
+  gl::prepareDriverEnvironment(spec, gallium);
   auto s = std::make_unique<Session>();
   s->spec = spec;
   switch (spec.platform) {
@@ -200,7 +251,7 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
       s->context = gl::createEglDeviceContext(spec.device);
       break;
     case GlSpec::Platform::OSMesa:
-      s->context = gl::createOsMesaContext();
+      s->context = gl::createOsMesaContext(spec.mesa_dir);
       break;
   }
   s->context->makeCurrent();
@@ -210,7 +261,7 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
   s->renderer = glString(gl, GL_RENDERER);
   s->version = glString(gl, GL_VERSION);
   s->glsl_version = glString(gl, GL_SHADING_LANGUAGE_VERSION);
-  s->subpixel_bits = glInteger(gl, GL_SUBPIXEL_BITS);
+  s->gl_subpixel_bits = glInteger(gl, GL_SUBPIXEL_BITS);
   s->driver = driverFromRenderer(s->renderer);
   const int major = glInteger(gl, GL_MAJOR_VERSION);
   const int minor = glInteger(gl, GL_MINOR_VERSION);
@@ -220,6 +271,18 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
     throw BackendError(fmt::format("asked for {}, GL_RENDERER is {} (no silent substitution)",
                                    spec.driver, s->renderer));
   }
+  // What was loaded, after the driver created its screen (and zink its Vulkan device).
+  const gl::LoadedMesa loaded = gl::checkLoadedMesa(spec);
+  s->mesa = loaded;
+  s->mesa_version = gl::mesaVersion(s->version);
+  if (s->driver == "zink") {
+    s->zink = true;
+    const auto start = Clock::now();  // a Vulkan instance of its own: part of the context
+    s->vulkan = gl::queryVulkanDevice(gl::zinkDeviceName(s->renderer), s->vulkan_error);
+    s->vulkan_query_ms = msSince(start);
+  }
+  chooseSubpixelBits(*s);
+  s->stack = describeStack(*s, loaded);
   if (gl.DebugMessageCallback != nullptr) {
     gl.Enable(GL_DEBUG_OUTPUT);
     gl.Enable(GL_DEBUG_OUTPUT_SYNCHRONOUS);  // errors arrive inside the failing call
@@ -238,7 +301,7 @@ Session& acquireSession(const GlSpec& spec) {
     return *g_session;
   }
   const Session& have = *g_session;
-  if (have.spec.platform != spec.platform ||
+  if (have.spec.platform != spec.platform || have.spec.mesa_dir != spec.mesa_dir ||
       (spec.platform == GlSpec::Platform::EglDevice && have.spec.device != spec.device)) {
     throw BackendError(fmt::format(
         "this process already renders with {} ({}); one GL provider per process: run {} in its "
@@ -875,9 +938,17 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["gl_renderer"] = s.renderer;
   m["gl_version"] = s.version;
   m["glsl_version"] = s.glsl_version;
-  m["subpixel_bits"] = s.subpixel_bits;
+  m["subpixel_bits"] = s.subpixel_bits;  // what the comparator's snap band uses
+  m["gl_subpixel_bits"] = s.gl_subpixel_bits;
+  m["subpixel_bits_source"] = s.subpixel_source;
   m["platform"] = s.context->platform();
   m["driver"] = s.driver;
+  m["stack"] = s.stack;
+  m["mesa"] = gl::toJson(s.mesa, s.spec, s.mesa_version);
+  if (s.zink) {
+    m["vulkan"] = s.vulkan ? gl::toJson(*s.vulkan) : nlohmann::json{{"error", s.vulkan_error}};
+    m["vulkan"]["query_ms"] = s.vulkan_query_ms;
+  }
   m["skipped_triangles"] = data.skipped_triangles;
   if (faults.any()) m["fault_injected"] = faults.describe();
   m["timing_ms"] = {

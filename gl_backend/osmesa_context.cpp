@@ -30,21 +30,25 @@ struct OsMesaApi {
   decltype(&OSMesaGetProcAddress) get_proc_address = nullptr;
 };
 
-const OsMesaApi& osmesa() {
+// `mesa_dir` counts on the first call only: one OSMesa per process.
+const OsMesaApi& osmesa(const std::string& mesa_dir = "") {
   static OsMesaApi api;
   static std::string error;
   static std::once_flag once;
-  std::call_once(once, [] {
-    void* lib = ::dlopen(RC_OSMESA_SONAME, RTLD_NOW | RTLD_LOCAL);
+  std::call_once(once, [&] {
+    // From another Mesa's folder by its path: the dynamic loader's search (and
+    // LD_LIBRARY_PATH) would find the system's library first when run in-process.
+    const std::string file =
+        mesa_dir.empty() ? std::string(RC_OSMESA_SONAME) : mesa_dir + "/" RC_OSMESA_SONAME;
+    void* lib = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (lib == nullptr) {
       const char* why = ::dlerror();
-      error = std::string("cannot load " RC_OSMESA_SONAME ": ") + (why ? why : "unknown error");
+      error = "cannot load " + file + ": " + (why ? why : "unknown error");
       return;
     }
     auto symbol = [&](auto& fn, const char* name) {
       fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(::dlsym(lib, name));
-      if (fn == nullptr && error.empty())
-        error = std::string(RC_OSMESA_SONAME " does not export ") + name;
+      if (fn == nullptr && error.empty()) error = file + " does not export " + name;
     };
     symbol(api.create_context, "OSMesaCreateContextAttribs");
     symbol(api.destroy_context, "OSMesaDestroyContext");
@@ -59,7 +63,8 @@ ProcAddress osmesaLoader(const char* name) { return osmesa().get_proc_address(na
 
 class OsMesaContext final : public Context {
  public:
-  OsMesaContext() {
+  explicit OsMesaContext(const std::string& mesa_dir) {
+    osmesa(mesa_dir);  // loads the library on the process's first context
     const int attribs[] = {OSMESA_FORMAT,
                            OSMESA_RGBA,
                            OSMESA_DEPTH_BITS,
@@ -101,11 +106,13 @@ class OsMesaContext final : public Context {
 
 }  // namespace
 
-std::unique_ptr<Context> createOsMesaContext() { return std::make_unique<OsMesaContext>(); }
+std::unique_ptr<Context> createOsMesaContext(const std::string& mesa_dir) {
+  return std::make_unique<OsMesaContext>(mesa_dir);
+}
 
 #else
 
-std::unique_ptr<Context> createOsMesaContext() {
+std::unique_ptr<Context> createOsMesaContext(const std::string& /*mesa_dir*/) {
   throw BackendError("this build has no OSMesa (libosmesa6-dev was not found at configure time)");
 }
 

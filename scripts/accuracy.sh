@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Regenerates docs/accuracy.md: runs the catalog against the three GL backends (each
-# compared with the reference) and softpipe against llvmpipe, then tabulates both runs
-# with `rastercheck accuracy`.
+# Regenerates docs/accuracy.md: runs the catalog against the four GL backends (each
+# compared with the reference) and softpipe and zink against llvmpipe, then tabulates both
+# runs with `rastercheck accuracy`.
 # Usage: scripts/accuracy.sh [--keep DIR]   (--keep: leave the two run folders in DIR)
 # RASTERCHECK names the binary (default: build/release/app/rastercheck); BACKENDS the
-# comma-separated backends to compare with the reference (default: the three below).
+# comma-separated backends to compare with the reference (default: the four below); DRIVERS
+# the backends compared with llvmpipe directly (default: softpipe and zink).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 exe=${RASTERCHECK:-$root/build/release/app/rastercheck}
-backends=${BACKENDS:-gl:egl:llvmpipe,gl:egl:softpipe,gl:osmesa:llvmpipe}
+backends=${BACKENDS:-gl:egl:llvmpipe,gl:egl:softpipe,gl:egl:zink,gl:osmesa:llvmpipe}
+drivers=${DRIVERS:-gl:egl:softpipe,gl:egl:zink}
 
 if [[ ${1:-} == --keep ]]; then
   work=${2:?--keep needs a folder}
@@ -32,10 +34,10 @@ run() {
 cd "$root"
 rm -rf "$work/catalog" "$work/drivers"
 run fixtures/scenes --backends "$backends" --out "$work/catalog"
-run fixtures/scenes --backends gl:egl:softpipe --against gl:egl:llvmpipe --out "$work/drivers"
+run fixtures/scenes --backends "$drivers" --against gl:egl:llvmpipe --out "$work/drivers"
 "$exe" accuracy "$work/catalog" "$work/drivers" \
   --expectations tests/conformance/expectations.json \
-  --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\` and \`rastercheck run fixtures/scenes --backends gl:egl:softpipe --against gl:egl:llvmpipe\`, then \`rastercheck accuracy\` on both run folders)" \
+  --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\` and \`rastercheck run fixtures/scenes --backends $drivers --against gl:egl:llvmpipe\`, then \`rastercheck accuracy\` on both run folders)" \
   --out docs/accuracy.md
 
 # The random-scene campaigns and mutation studies (scripts/campaign.sh, scripts/mutations.sh)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The README's main job: installs what is missing and builds (scripts/build.sh), then runs
-# the whole fixture catalog through `rastercheck run` against Mesa's llvmpipe and softpipe
-# (EGL) and prints where report.html is. Extra arguments go to `rastercheck run`, e.g.
+# the whole fixture catalog through `rastercheck run` against Mesa's llvmpipe, softpipe and
+# zink over lavapipe (EGL) and prints where report.html is. Extra arguments go to `rastercheck run`, e.g.
 # `scripts/run.sh --jobs 4` or `scripts/run.sh fixtures/scenes/shading`.
 # Exit code: rastercheck's (0 pass or warn, 1 a comparison failed, 2 bad input, 3 a backend
 # could not run).
@@ -9,7 +9,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=$(bash "$root/scripts/build.sh")
 out=${RASTERCHECK_OUT:-$root/out/catalog}
-backends=${RASTERCHECK_BACKENDS:-gl:egl:llvmpipe,gl:egl:softpipe}
+backends=${RASTERCHECK_BACKENDS:-gl:egl:llvmpipe,gl:egl:softpipe,gl:egl:zink}
 paths=()
 options=()
 for arg in "$@"; do

@@ -10,6 +10,7 @@ packages=(
   libglm-dev libgtest-dev libgmock-dev libbenchmark-dev
   libopenimageio-dev openimageio-tools
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
+  mesa-vulkan-drivers libvulkan-dev
   libassimp-dev assimp-testmodels
   nlohmann-json3-dev libcli11-dev libfmt-dev
   libpugixml-dev python3-jsonschema zlib1g-dev

@@ -117,6 +117,42 @@ TEST(Accuracy, TablesShowTheReportsNumbers) {
   EXPECT_TRUE(hasLine(md, "| `t/b` | `gl:*:y` | visibility | a reason \\| with a bar |")) << md;
 }
 
+TEST(Accuracy, VariantsAndFindingsOfEachStackAreListed) {
+  const fs::path root = conformance::scratchRoot() / "accuracy_variants";
+  const Synthetic s = makeRun(root);
+  std::ifstream in(s.run / "report.json");
+  json doc = json::parse(in);
+  doc["variants"] = {
+      {"gl:x:y",
+       {{"stack", "zink (dev) | OpenGL 4.6 | Vulkan 1.3 dev"},
+        {"subpixel_bits", 4},
+        {"band_subpixel_bits", 8},
+        {"subpixel", {{"best", 8}, {"exact", true}}},
+        {"tie_break", {{"rule", "left+bottom"}, {"matches_reference", true}}},
+        {"depth_rounding", {{"rule", "truncate"}, {"matches_reference", false}}},
+        {"findings", {"subpixel: GL_SUBPIXEL_BITS says 4 but the driver rasterizes like 8 bits"}}}},
+      {"gl:x:z", {{"error", "subpixel probe: cannot start"}}}};
+  writeJson(s.run / "report.json", doc);
+  const AccuracyData data = readAccuracyRuns({s.run}, {s.catalog});
+  ASSERT_EQ(data.variants.size(), 2u);
+  const std::string md = accuracyMarkdown(data, "`make-it`");
+  EXPECT_TRUE(hasLine(md, "## Driver stacks and variants")) << md;
+  EXPECT_TRUE(
+      hasLine(md,
+              "| `gl:x:y` | zink (dev) \\| OpenGL 4.6 \\| Vulkan 1.3 dev | 4 | 8 bits | 8 | "
+              "left+bottom (as ref) | truncate (differs from ref) |"))
+      << md;
+  EXPECT_TRUE(hasLine(md, "| `gl:x:z` | error: subpixel probe: cannot start | | | | | |")) << md;
+  EXPECT_TRUE(hasLine(
+      md, "- `gl:x:y`: subpixel: GL_SUBPIXEL_BITS says 4 but the driver rasterizes like 8 bits"))
+      << md;
+
+  // Runs without probes (older reports, --no-variants) have no such section.
+  EXPECT_EQ(accuracyMarkdown(readAccuracyRuns({makeRun(root / "plain").run}, {}), "`x`")
+                .find("Driver stacks"),
+            std::string::npos);
+}
+
 TEST(Accuracy, MalformedReportsAreRefusedWithTheirPath) {
   const fs::path root = conformance::scratchRoot() / "accuracy_bad";
   json bad = pair("t/a", "ref", "gl:x:y", "pass");

@@ -23,7 +23,7 @@ namespace rc::conformance {
 namespace fs = std::filesystem;
 
 std::vector<std::string> backends() {
-  std::vector<std::string> out = {"gl:egl:llvmpipe", "gl:egl:softpipe"};
+  std::vector<std::string> out = {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:egl:zink"};
 #ifdef RC_HAVE_OSMESA
   out.emplace_back("gl:osmesa:llvmpipe");
 #endif
@@ -31,7 +31,7 @@ std::vector<std::string> backends() {
 }
 
 std::vector<std::string> knownBackends() {
-  return {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:osmesa:llvmpipe"};
+  return {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:egl:zink", "gl:osmesa:llvmpipe"};
 }
 
 namespace {

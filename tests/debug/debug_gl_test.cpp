@@ -1,7 +1,8 @@
-// The debugging tools on real Mesa drivers (llvmpipe and softpipe through EGL): explain
-// with GL backends, a driver-vs-driver run (llvmpipe as the expected side, classified by
-// the reference's uncertainty channels), variant detection on both drivers, and reduce
-// with a GL side in the predicate, including an injected GL fault.
+// The debugging tools on real Mesa drivers (llvmpipe, softpipe and zink through EGL):
+// explain with GL backends, driver-vs-driver runs (llvmpipe as the expected side,
+// classified by the reference's uncertainty channels), variant detection on every driver
+// (zink's GL_SUBPIXEL_BITS finding), and reduce with a GL side in the predicate,
+// including an injected GL fault.
 #include "fixtures/loader.h"
 #include "tests/debug/debug_test_util.h"
 
@@ -10,6 +11,7 @@ namespace {
 
 constexpr const char* kLlvmpipe = "gl:egl:llvmpipe";
 constexpr const char* kSoftpipe = "gl:egl:softpipe";
+constexpr const char* kZink = "gl:egl:zink";
 
 TEST(DebugGl, ExplainComparesEachGlBackendAtThePixel) {
   const fs::path dir = scratch("explain_gl");
@@ -192,6 +194,62 @@ void checkHtml(const fs::path& dir) {
   EXPECT_NE(html.find("Backend variants"), std::string::npos);
   EXPECT_NE(html.find("NOT confirmed"), std::string::npos);
   EXPECT_NE(html.find("left+bottom"), std::string::npos);
+}
+
+// zink against llvmpipe: lavapipe under zink is llvmpipe's rasterizer, so the frames agree
+// up to the snap band, and the probe finds what zink's GL_SUBPIXEL_BITS hides.
+TEST(DebugGl, ZinkAgainstLlvmpipeAndItsSubpixelFinding) {
+  const fs::path dir = scratch("zink");
+  const std::string fixtures =
+      catalog("coverage/triangle_fan.json") + " " + catalog("coverage/slivers_and_centres.json");
+  const Result r = run("run " + fixtures + " --backends " + kZink + " --against " + kLlvmpipe +
+                       " --out " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.out + r.err;
+  const json report = json::parse(std::ifstream(dir / "report.json"));
+  ASSERT_EQ(report["results"].size(), 2u);
+  for (const json& row : report["results"]) {
+    SCOPED_TRACE(row["fixture"].get<std::string>());
+    EXPECT_EQ(row["actual"], kZink);
+    EXPECT_EQ(row["status"], "pass") << row.dump();
+    // The band comes from the bits each frame carries: 8 on both sides, not zink's
+    // GL_SUBPIXEL_BITS 4 (which would widen it fifteen-fold).
+    EXPECT_EQ(row["subpixel_bits"]["actual"], 8);
+    const double snap8 = std::sqrt(2.0) / 2.0 / 256.0;
+    const int side = std::max(row["width"].get<int>(), row["height"].get<int>());
+    EXPECT_NEAR(row["visibility"]["band_px"].get<double>(),
+                snap8 + 16.0 * std::ldexp(1.0, -24) * side, 1e-12);
+    const json& stack = row["stacks"]["actual"];
+    EXPECT_EQ(stack["gl_subpixel_bits"], 4);
+    EXPECT_EQ(stack["vulkan"]["subpixel_precision_bits"], 8);
+    EXPECT_FALSE(row["stacks"]["expected"].contains("vulkan"));  // llvmpipe: no Vulkan
+  }
+  const json& z = report["variants"][kZink];
+  EXPECT_EQ(z["subpixel_bits"], 4);
+  EXPECT_EQ(z["band_subpixel_bits"], 8);
+  EXPECT_EQ(z["subpixel"]["queried"], 4);
+  EXPECT_EQ(z["subpixel"]["best"], 8);
+  EXPECT_FALSE(z["subpixel"]["confirmed"].get<bool>());
+  EXPECT_TRUE(z["subpixel"]["band_confirmed"].get<bool>());
+  EXPECT_GT(z["subpixel"]["mismatches"]["4"].get<int>(), 100);
+  EXPECT_EQ(z["tie_break"]["rule"], "left+bottom");
+  EXPECT_EQ(z["depth_rounding"]["rule"], "nearest");
+  const std::string finding =
+      "subpixel: GL_SUBPIXEL_BITS says 4 but the driver rasterizes like 8 bits";
+  EXPECT_EQ(z["findings"], json::array({finding}));
+  EXPECT_TRUE(report["variants"][kLlvmpipe]["findings"].empty());
+  EXPECT_NE(r.out.find(std::string("finding: ") + kZink + ": " + finding), std::string::npos)
+      << r.out;
+  std::ifstream in(dir / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find(finding), std::string::npos);
+  if (std::system("/usr/bin/python3 -c 'import jsonschema' 2>/dev/null") == 0) {
+    const Result valid = rc::test::runShell(
+        "/usr/bin/python3 -c \"import json,sys,jsonschema; jsonschema.validate(json.load(open("
+        "sys.argv[1])), json.load(open(sys.argv[2])))\" '" +
+        (dir / "report.json").string() + "' '" RC_SOURCE_DIR "/docs/report-schema.json'");
+    EXPECT_EQ(valid.code, 0) << valid.out << valid.err;
+  }
+  fs::remove_all(dir);
 }
 
 TEST(DebugGl, SingleDriverVsDriverPairStillGetsTheMatrix) {

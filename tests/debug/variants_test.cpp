@@ -93,6 +93,40 @@ TEST(Variants, SubpixelQueryThatTheProbeContradictsIsNotConfirmed) {
   EXPECT_NE(describeSubpixel(r).find("NOT confirmed"), std::string::npos);
 }
 
+TEST(Variants, ZinkLikeFrameSeparatesGlAnswerFromSnapBand) {
+  // zink's frames: GL_SUBPIXEL_BITS 4 in gl_subpixel_bits, the Vulkan device's 8 in
+  // subpixel_bits (the comparator's band). The probe must name the GL answer as the one
+  // contradicted, confirm the band, and say so as a finding.
+  const Scene probe = subpixelProbe();
+  const std::map<int, Frame> refs = candidates(probe);
+  Frame zink = refs.at(8);
+  zink.meta["gl_subpixel_bits"] = 4;
+  zink.meta["subpixel_bits"] = 8;
+  zink.meta["subpixel_bits_source"] = "VkPhysicalDeviceLimits::subPixelPrecisionBits";
+  const SubpixelResult r = analyseSubpixel(zink, refs);
+  EXPECT_EQ(r.queried, 4);
+  EXPECT_EQ(r.band, 8);
+  EXPECT_EQ(r.best, 8);
+  EXPECT_FALSE(r.confirmed);
+  EXPECT_TRUE(r.band_confirmed);
+  EXPECT_EQ(r.finding, "GL_SUBPIXEL_BITS says 4 but the driver rasterizes like 8 bits");
+  EXPECT_NE(describeSubpixel(r).find("snap band: 8 bits from "
+                                     "VkPhysicalDeviceLimits::subPixelPrecisionBits (confirmed"),
+            std::string::npos)
+      << describeSubpixel(r);
+  EXPECT_EQ(toJson(r).at("finding"), r.finding);
+
+  // A band the rasterizer does not follow is not confirmed (injected: it really snaps to 6).
+  Frame wrong_band = refs.at(6);
+  wrong_band.meta = zink.meta;
+  const SubpixelResult w = analyseSubpixel(wrong_band, refs);
+  EXPECT_FALSE(w.band_confirmed);
+  EXPECT_NE(describeSubpixel(w).find("NOT confirmed by the probe"), std::string::npos);
+
+  // A driver whose answer is right has no finding.
+  EXPECT_TRUE(analyseSubpixel(refs.at(8), refs).finding.empty());
+}
+
 TEST(Variants, TieBreakCentresLieExactlyOnTheirEdges) {
   // Independent of how the probe enumerated them: each centre is on the line through two
   // vertices of its triangle, strictly between them, and not a vertex.

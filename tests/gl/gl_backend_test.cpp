@@ -2,9 +2,14 @@
 // frame.json metadata, every failure path as BackendError/InputError (with injected
 // faults: a broken shader, a GL error, a driver substitution, a second driver in one
 // process), and bad input that must not crash.
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <set>
 
@@ -17,6 +22,7 @@
 namespace rc::gltest {
 namespace {
 
+namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 TEST(GlSpecParse, AcceptsEveryDocumentedForm) {
@@ -32,6 +38,7 @@ TEST(GlSpecParse, AcceptsEveryDocumentedForm) {
       {"gl:egl", GlSpec::Platform::EglSurfaceless, "", -1, "gl"},
       {"gl:egl:llvmpipe", GlSpec::Platform::EglSurfaceless, "llvmpipe", -1, "gl:egl:llvmpipe"},
       {"gl:egl:softpipe", GlSpec::Platform::EglSurfaceless, "softpipe", -1, "gl:egl:softpipe"},
+      {"gl:egl:zink", GlSpec::Platform::EglSurfaceless, "zink", -1, "gl:egl:zink"},
       {"gl:osmesa", GlSpec::Platform::OSMesa, "", -1, "gl:osmesa"},
       {"gl:osmesa:llvmpipe", GlSpec::Platform::OSMesa, "llvmpipe", -1, "gl:osmesa:llvmpipe"},
       {"gl:osmesa:softpipe", GlSpec::Platform::OSMesa, "softpipe", -1, "gl:osmesa:softpipe"},
@@ -53,10 +60,26 @@ TEST(GlSpecParse, AcceptsEveryDocumentedForm) {
 }
 
 TEST(GlSpecParse, RejectsEverythingElseWithTheValidForms) {
-  for (const char* bad :
-       {"", "g", "GL", "gl:", "gl:egl:", "gl:egl:zink", "gl:egl:llvmpipe:x", "gl:osmesa:swrast",
-        "gl:egl-device:", "gl:egl-device:-1", "gl:egl-device:1x", "gl:egl-device:llvmpipe",
-        "gl:vulkan", "ref", "gl:eglx", " gl"}) {
+  for (const char* bad : {"",
+                          "g",
+                          "GL",
+                          "gl:",
+                          "gl:egl:",
+                          "gl:osmesa:zink",
+                          "gl:egl:llvmpipe:x",
+                          "gl:osmesa:swrast",
+                          "gl:egl-device:",
+                          "gl:egl-device:-1",
+                          "gl:egl-device:1x",
+                          "gl:egl-device:llvmpipe",
+                          "gl:vulkan",
+                          "ref",
+                          "gl:eglx",
+                          " gl",
+                          "gl:egl:llvmpipe@",
+                          "@/usr/lib",
+                          "gl:egl:foo@/tmp",
+                          "ref@/tmp"}) {
     try {
       parseGlSpec(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";
@@ -66,6 +89,83 @@ TEST(GlSpecParse, RejectsEverythingElseWithTheValidForms) {
       EXPECT_THAT(std::string(e.what()), HasSubstr("gl:egl-device:N"));
     }
   }
+}
+
+TEST(GlSpecParse, MesaFolderSuffixOnEveryForm) {
+  // Grammar only: everything after the first '@' is the folder, ':' and '@' included.
+  for (const char* base : {"gl", "gl:egl", "gl:egl:llvmpipe", "gl:egl:zink", "gl:osmesa:softpipe",
+                           "gl:egl-device:1"}) {
+    const std::string text = std::string(base) + "@/opt/mesa:x@y/lib";
+    const GlSpec s = parseGlSpecSyntax(text);
+    const GlSpec plain = parseGlSpecSyntax(base);
+    EXPECT_EQ(s.mesa_dir, "/opt/mesa:x@y/lib") << text;
+    EXPECT_EQ(s.platform, plain.platform) << text;
+    EXPECT_EQ(s.driver, plain.driver) << text;
+    EXPECT_EQ(s.device, plain.device) << text;
+    EXPECT_EQ(toString(s), toString(plain) + "@/opt/mesa:x@y/lib") << text;
+    EXPECT_EQ(parseGlSpecSyntax(toString(s)).mesa_dir, s.mesa_dir);
+  }
+  EXPECT_TRUE(parseGlSpecSyntax("gl:egl:llvmpipe").mesa_dir.empty());
+}
+
+// A folder with empty files of the given names (checkMesaDir looks only at names).
+fs::path fakeMesaDir(const std::string& name, std::initializer_list<const char*> files) {
+  fs::path dir =
+      fs::temp_directory_path() / ("rc_fake_mesa_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const char* f : files) std::ofstream(dir / f) << "";
+  return dir;
+}
+
+TEST(GlSpecParse, MesaFolderMustHoldWhatThePlatformLoads) {
+  const fs::path egl = fakeMesaDir("egl", {"libEGL_mesa.so.0"});
+  const fs::path full = fakeMesaDir("full", {"libEGL.so.1", "libvulkan_lvp.so", "libOSMesa.so.8"});
+  const fs::path empty = fakeMesaDir("empty", {});
+  EXPECT_EQ(parseGlSpec("gl:egl:llvmpipe@" + egl.string()).mesa_dir, egl.string());
+  EXPECT_NO_THROW(parseGlSpec("gl:egl:zink@" + full.string()));
+  EXPECT_NO_THROW(parseGlSpec("gl@" + full.string()));
+  auto error = [](const std::string& spec) {
+    try {
+      parseGlSpec(spec);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string missing = error("gl:egl:llvmpipe@/nonexistent/mesa");
+  EXPECT_THAT(missing, HasSubstr("backend 'gl:egl:llvmpipe@/nonexistent/mesa': Mesa folder "
+                                 "/nonexistent/mesa does not exist"));
+  EXPECT_THAT(error("gl:egl@" + (egl / "libEGL_mesa.so.0").string()), HasSubstr("is not a folder"));
+  EXPECT_THAT(error("gl:egl:softpipe@" + empty.string()),
+              HasSubstr("holds neither libEGL_mesa.so.0 nor libEGL.so.1"));
+  EXPECT_THAT(error("gl:egl:zink@" + egl.string()), HasSubstr("holds no libvulkan_lvp.so"));
+  EXPECT_THAT(error("gl:osmesa:llvmpipe@" + egl.string()), HasSubstr("holds no libOSMesa"));
+  for (const std::string& msg : {missing, error("gl:egl:zink@" + egl.string())})
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+  for (const fs::path& d : {egl, full, empty}) fs::remove_all(d);
+}
+
+TEST(GlSpecParse, StartupEnvironmentPutsTheMesaFolderFirstOnce) {
+  const fs::path dir = fakeMesaDir("startup", {"libEGL_mesa.so.0"});
+  const GlSpec s = parseGlSpec("gl:egl:llvmpipe@" + dir.string());
+  EXPECT_TRUE(startupEnvironment(parseGlSpec("gl:egl:llvmpipe")).empty());
+  const char* had = std::getenv("LD_LIBRARY_PATH");
+  const std::string saved = had != nullptr ? had : "";
+  setenv("LD_LIBRARY_PATH", "/elsewhere", 1);
+  const auto env = startupEnvironment(s);
+  ASSERT_EQ(env.size(), 1u);
+  EXPECT_EQ(env[0].first, "LD_LIBRARY_PATH");
+  EXPECT_EQ(env[0].second, fs::canonical(dir).string() + ":/elsewhere");
+  // Once in place it is returned unchanged: `render` restarts itself at most once.
+  setenv("LD_LIBRARY_PATH", env[0].second.c_str(), 1);
+  EXPECT_EQ(startupEnvironment(s), env);
+  if (had != nullptr) {
+    setenv("LD_LIBRARY_PATH", saved.c_str(), 1);
+  } else {
+    unsetenv("LD_LIBRARY_PATH");
+  }
+  fs::remove_all(dir);
 }
 
 TEST(GlEglDevice, NoGpuIsABackendErrorSayingSo) {
@@ -99,14 +199,42 @@ TEST_F(GlBackend, DriverAndMetadataMatchTheSpec) {
     EXPECT_THAT(renderer, HasSubstr(sp.driver));
     EXPECT_EQ(f.meta.at("driver"), sp.driver);
   }
-  // Measured on Mesa 22.3: llvmpipe snaps to 1/256 px, softpipe to 1/16 px.
+  // Measured on Mesa 22.3: llvmpipe snaps to 1/256 px, softpipe to 1/16 px; zink answers
+  // GL_SUBPIXEL_BITS 4 but lavapipe under it snaps to 1/256 px, what its Vulkan device
+  // says and what the frame carries for the comparator.
   const std::string driver = f.meta.at("driver");
   if (driver == "llvmpipe") {
     EXPECT_EQ(f.meta.at("subpixel_bits"), 8);
+    EXPECT_EQ(f.meta.at("gl_subpixel_bits"), 8);
   }
   if (driver == "softpipe") {
     EXPECT_EQ(f.meta.at("subpixel_bits"), 4);
+    EXPECT_EQ(f.meta.at("subpixel_bits_source"), "GL_SUBPIXEL_BITS");
   }
+  if (driver == "zink") {
+    EXPECT_EQ(f.meta.at("gl_subpixel_bits"), 4);
+    EXPECT_EQ(f.meta.at("subpixel_bits"), 8);
+    EXPECT_EQ(f.meta.at("subpixel_bits_source"), "VkPhysicalDeviceLimits::subPixelPrecisionBits");
+    // The Vulkan device is the one zink names in GL_RENDERER: "zink (<device>)".
+    const nlohmann::json& vk = f.meta.at("vulkan");
+    EXPECT_EQ("zink (" + vk.at("device").get<std::string>() + ")", renderer);
+    EXPECT_EQ(vk.at("device_type"), "cpu");
+    EXPECT_EQ(vk.at("subpixel_precision_bits"), 8);
+    EXPECT_THAT(vk.at("driver_info").get<std::string>(), HasSubstr("Mesa"));
+    EXPECT_THAT(std::string(f.meta.at("stack")), HasSubstr("| Vulkan "));
+  } else {
+    EXPECT_FALSE(f.meta.contains("vulkan"));
+  }
+  // Which Mesa: its version from GL_VERSION, and the driver library really mapped.
+  const nlohmann::json& mesa = f.meta.at("mesa");
+  EXPECT_THAT(std::string(f.meta.at("gl_version")),
+              HasSubstr(mesa.at("version").get<std::string>()));
+  EXPECT_TRUE(mesa.at("dir").is_null());
+  const std::vector<std::string> libs = mesa.at("libraries");
+  const std::string driver_library = mesa.at("driver_library");
+  EXPECT_NE(std::find(libs.begin(), libs.end(), driver_library), libs.end());
+  EXPECT_TRUE(fs::exists(driver_library)) << driver_library;
+  EXPECT_THAT(std::string(f.meta.at("stack")), HasSubstr(renderer));
   EXPECT_EQ(f.meta.at("platform"), sp.platform == GlSpec::Platform::OSMesa ? "osmesa" : "egl");
   EXPECT_THAT(std::string(f.meta.at("gl_version")), HasSubstr("Mesa"));
   EXPECT_FALSE(std::string(f.meta.at("glsl_version")).empty());
@@ -262,6 +390,16 @@ TEST_F(GlProcess, SubstitutedDriverIsABackendError) {
         renderAndExit(parseGlSpec(platformPrefix() + "softpipe"));  // ...softpipe was asked
       },
       ::testing::ExitedWithCode(3), "asked for softpipe, GL_RENDERER is llvmpipe");
+}
+
+TEST_F(GlProcess, ZinkSubstitutedIsABackendErrorNamingWhatLoaded) {
+  if (spec().platform != GlSpec::Platform::EglSurfaceless) GTEST_SKIP() << "zink is EGL only";
+  EXPECT_EXIT(
+      {
+        gl::testing::hooks().gallium_driver = "llvmpipe";  // Mesa loads llvmpipe...
+        renderAndExit(parseGlSpec("gl:egl:zink"));         // ...zink was asked
+      },
+      ::testing::ExitedWithCode(3), "asked for zink, GL_RENDERER is llvmpipe \\(LLVM");
 }
 
 TEST_F(GlProcess, SecondDriverInOneProcessIsRefused) {

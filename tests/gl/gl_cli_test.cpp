@@ -1,17 +1,23 @@
 // The GL backend through the `rastercheck render` command, in a child process as a user
 // (or `rastercheck run`) meets it: a shader that does not compile and a platform that
 // is not there exit 3 with one line naming the fixture; RASTERCHECK_GL_FAULT reaches the
-// child, is recorded in frame.json and warned about once; a bad fault list exits 2.
+// child, is recorded in frame.json and warned about once; a bad fault list exits 2; zink
+// starts without a word from the Vulkan loader; a copy of the system's Mesa named with
+// "@DIR" is what really loads, and a folder that cannot be used says so in one line.
 
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include "fixtures/frame_io.h"
 #include "tests/support/command.h"
 
@@ -65,7 +71,7 @@ fs::path scratch(const std::string& name) {
 }
 
 std::vector<std::string> specs() {
-  std::vector<std::string> s = {"gl:egl:llvmpipe", "gl:egl:softpipe"};
+  std::vector<std::string> s = {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:egl:zink"};
 #ifdef RC_HAVE_OSMESA
   s.insert(s.end(), {"gl:osmesa:llvmpipe", "gl:osmesa:softpipe"});
 #endif
@@ -173,6 +179,157 @@ TEST(GlCli, InjectedFaultIsRecordedAndWarnedOnce) {
     fs::remove_all(dir);
   }
   if (ran == 0) GTEST_SKIP() << "no GL driver starts here";
+}
+
+TEST(GlCli, ZinkStartsQuietlyWithoutXdgRuntimeDir) {
+  // Without XDG_RUNTIME_DIR the Vulkan loader's window-system code prints "error:
+  // XDG_RUNTIME_DIR is invalid or not set in the environment." twice on every start; the
+  // backend gives zink a private one, so a normal render says exactly its one line.
+  const fs::path out = scratch("zink_quiet") / "frame";
+  const Result r = run(renderArgs("gl:egl:zink", out), "env -u XDG_RUNTIME_DIR");
+  if (r.code != 0 && !requireGl()) GTEST_SKIP() << "zink does not start here: " << r.out;
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(lines(r.out),
+            std::vector<std::string>{kFixtureName + ": gl:egl:zink -> " + out.string()})
+      << r.out;
+  const rc::Frame f = rc::readFrameDir(out);
+  EXPECT_EQ(f.meta.at("driver"), "zink");
+  const std::string stack = f.meta.at("stack");
+  EXPECT_NE(stack.find("zink ("), std::string::npos) << stack;
+  EXPECT_NE(stack.find("| Vulkan 1."), std::string::npos) << stack;
+  EXPECT_EQ(f.meta.at("vulkan").at("subpixel_precision_bits"), 8);
+  fs::remove_all(out.parent_path());
+}
+
+// "libEGL_mesa.so.0.0.0" -> "libEGL_mesa.so.0": the name the dynamic loader asks for.
+std::string sonameOf(const std::string& file) {
+  std::smatch m;
+  return std::regex_search(file, m, std::regex(R"(^.*?\.so(\.[0-9]+)?)")) ? m.str(0) : file;
+}
+
+// Copies the Mesa libraries a system render of `spec` loaded (frame.json mesa.libraries)
+// into dir (the DRI driver into dir/dri), under the names the loader looks for. Only
+// `keep` (name prefixes) are copied: the Vulkan loader maps every installed ICD.
+void copyMesaOf(const nlohmann::json& mesa, const fs::path& dir,
+                const std::vector<std::string>& keep) {
+  fs::create_directories(dir / "dri");
+  for (const std::string lib : mesa.at("libraries")) {
+    const std::string name = fs::path(lib).filename().string();
+    if (std::none_of(keep.begin(), keep.end(),
+                     [&](const std::string& k) { return name.rfind(k, 0) == 0; }))
+      continue;
+    const bool dri = fs::path(lib).parent_path().filename() == "dri";
+    fs::copy_file(lib, (dri ? dir / "dri" : dir) / sonameOf(name), fs::copy_options::skip_existing);
+  }
+}
+
+TEST(GlCli, MesaFolderCopyIsWhatLoads) {
+  // The system's own Mesa, copied into a temporary folder, stands in for a Mesa build.
+  const fs::path dir = scratch("mesa_copy");
+  std::vector<std::string> mesa_specs = {"gl:egl:llvmpipe", "gl:egl:zink"};
+#ifdef RC_HAVE_OSMESA
+  mesa_specs.emplace_back("gl:osmesa:llvmpipe");
+#endif
+  const fs::path copy = dir / "mesa";
+  for (const std::string& spec : mesa_specs) {
+    const Result sys = run(renderArgs(spec, dir / ("system_" + spec)));
+    if (sys.code != 0 && !requireGl()) GTEST_SKIP() << spec << " does not start: " << sys.out;
+    ASSERT_EQ(sys.code, 0) << sys.out;
+    const rc::Frame f = rc::readFrameDir(dir / ("system_" + spec));
+    copyMesaOf(f.meta.at("mesa"), copy,
+               {"libEGL_mesa", "libgbm", "libglapi", "libOSMesa", "libvulkan_lvp", "swrast_dri"});
+  }
+  const std::string real = fs::canonical(copy).string();
+  for (const std::string& spec : mesa_specs) {
+    const std::string asked = spec + "@" + copy.string();
+    const fs::path out = dir / ("copy_" + spec);
+    const Result r = run(renderArgs(asked, out));
+    ASSERT_EQ(r.code, 0) << asked << ": " << r.out;
+    EXPECT_EQ(lines(r.out).size(), 1u) << r.out;
+    const rc::Frame f = rc::readFrameDir(out);
+    const nlohmann::json& mesa = f.meta.at("mesa");
+    EXPECT_EQ(mesa.at("asked"), copy.string());
+    EXPECT_EQ(mesa.at("dir"), real);
+    EXPECT_EQ(mesa.at("driver_library").get<std::string>().rfind(real + "/", 0), 0u) << mesa.dump();
+    for (const std::string lib : mesa.at("libraries"))
+      EXPECT_EQ(lib.rfind(real + "/", 0), 0u) << asked << " loaded " << lib;
+    EXPECT_NE(std::string(f.meta.at("stack")).find("(Mesa folder " + real + ")"),
+              std::string::npos);
+    // The same driver as the system's: the same frame.
+    const rc::Frame sys = rc::readFrameDir(dir / ("system_" + spec));
+    EXPECT_EQ(f.id, sys.id) << asked;
+    EXPECT_EQ(f.color, sys.color) << asked;
+  }
+
+  // One run compares the system's llvmpipe with the copy's; report.json says which Mesa
+  // each side used.
+  const std::string copied = "gl:egl:llvmpipe@" + copy.string();
+  const Result r = run("run " + kFixture + " --backends gl:egl:llvmpipe," + copied +
+                       " --against gl:egl:llvmpipe --no-variants --out " + (dir / "run").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream in(dir / "run" / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  ASSERT_EQ(report.at("results").size(), 1u);
+  const nlohmann::json& row = report.at("results")[0];
+  EXPECT_EQ(row.at("expected"), "gl:egl:llvmpipe");
+  EXPECT_EQ(row.at("actual"), copied);
+  EXPECT_TRUE(row.at("stacks").at("expected").at("mesa").at("dir").is_null());
+  EXPECT_EQ(row.at("stacks").at("actual").at("mesa").at("dir"), real);
+  EXPECT_EQ(row.at("stacks")
+                .at("actual")
+                .at("mesa")
+                .at("driver_library")
+                .get<std::string>()
+                .rfind(real + "/", 0),
+            0u);
+  if (std::system("/usr/bin/python3 -c 'import jsonschema' 2>/dev/null") == 0) {
+    const Result valid = rc::test::runShell(
+        "/usr/bin/python3 -c \"import json,sys,jsonschema; jsonschema.validate(json.load(open("
+        "sys.argv[1])), json.load(open(sys.argv[2])))\" '" +
+        (dir / "run" / "report.json").string() + "' '" RC_SOURCE_DIR "/docs/report-schema.json'");
+    EXPECT_EQ(valid.code, 0) << "report.json with stacks against docs/report-schema.json: "
+                             << valid.out;
+  }
+
+  // What was asked is not what loaded: without dri/ the copy's libEGL_mesa finds the
+  // system's driver. Exit 3, one line naming the stray library, nothing written.
+  fs::remove_all(copy / "dri");
+  const fs::path out = dir / "stray";
+  const Result stray = run(renderArgs("gl:egl:llvmpipe@" + copy.string(), out));
+  EXPECT_EQ(stray.code, 3) << stray.out;
+  EXPECT_EQ(lines(stray.out).size(), 1u) << stray.out;
+  EXPECT_NE(stray.out.find("asked for the Mesa in " + real + ", but this process loaded "),
+            std::string::npos)
+      << stray.out;
+  EXPECT_NE(stray.out.find("_dri.so from outside it"), std::string::npos) << stray.out;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+TEST(GlCli, UnusableMesaFolderExitsTwoInOneLine) {
+  const fs::path dir = scratch("mesa_bad");
+  fs::create_directories(dir / "empty");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"gl:egl:llvmpipe@" + (dir / "missing").string(), "does not exist"},
+      {"gl:egl:softpipe@" + (dir / "empty").string(), "holds neither libEGL_mesa.so.0"},
+      {"gl:egl:bogus", "unknown GL backend 'gl:egl:bogus'"},
+  };
+  for (const auto& [spec, what] : cases) {
+    const Result r = run(renderArgs(spec, dir / "frame"));
+    EXPECT_EQ(r.code, 2) << spec << ": " << r.out;
+    EXPECT_EQ(lines(r.out).size(), 1u) << r.out;
+    EXPECT_NE(r.out.find(what), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir / "frame"));
+    // `run` checks every SPEC before rendering anything.
+    std::string args = "run " + kFixture;
+    args += " --backends gl:egl:llvmpipe," + spec;
+    args += " --out " + (dir / "run").string();
+    const Result rr = run(args);
+    EXPECT_EQ(rr.code, 2) << rr.out;
+    EXPECT_EQ(lines(rr.out).size(), 1u) << rr.out;
+    EXPECT_FALSE(fs::exists(dir / "run"));
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace
