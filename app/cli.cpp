@@ -9,12 +9,12 @@
 
 #include "app/commands.h"
 #include "app/version.h"
+#include "debug/campaign.h"
 #include "fixtures/errors.h"
 #include "fixtures/message_text.h"
 #include "fixtures/resource_estimate.h"
 
 namespace rc {
-
 int runCli(int argc, char** argv) {
   CLI::App app{
       "rastercheck: renders fixtures with a scalar CPU reference and with OpenGL drivers, and "
@@ -146,6 +146,47 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   reduce_cmd->add_option("--tolerance,-t", reduce.tolerance, "As for compare; repeatable");
 
+  CampaignArgs campaign;
+  CLI::App* campaign_cmd = app.add_subcommand(
+      "campaign",
+      "Generate random scenes, run them on backends, reduce and group every failure "
+      "(docs/campaigns.md); --mutations: measure how often injected GL faults are caught");
+  campaign_cmd->add_option("--seed,-s", campaign.seed, "Seed of the random scenes (0 to 2^64 - 1)")
+      ->required()
+      ->type_name("UINT");
+  campaign_cmd->add_option("--count,-n", campaign.count, "Number of scenes")->capture_default_str();
+  campaign_cmd->add_option("--backends,-b", campaign.backends, "Backend SPECs, comma separated")
+      ->required()
+      ->delimiter(',');
+  campaign_cmd->add_option("--against,-a", campaign.against, "SPEC every backend is compared with")
+      ->capture_default_str();
+  campaign_cmd
+      ->add_option("--out,-o", campaign.out,
+                   "Campaign folder (the same command on the same folder continues it)")
+      ->required();
+  campaign_cmd
+      ->add_option("--reduce-seconds", campaign.reduce_seconds,
+                   "Time limit of each failure's reduction (0: do not reduce)")
+      ->capture_default_str();
+  campaign_cmd->add_option("--jobs,-j", campaign.jobs,
+                           "Children at a time (default: one per core)");
+  campaign_cmd->add_option("--batch", campaign.batch, "Scenes per `run` child")
+      ->capture_default_str();
+  campaign_cmd->add_option("--profile", campaign.profile, "Feature mix, as for generate")
+      ->capture_default_str();
+  campaign_cmd->add_option("--max-size", campaign.max_size, "Largest image, WxH")
+      ->capture_default_str();
+  campaign_cmd->add_option("--meshes", campaign.meshes, "Folder of assimp-testmodels' models");
+  campaign_cmd->add_option("--tolerance,-t", campaign.tolerance, "As for compare; repeatable");
+  campaign_cmd->add_flag("--mutations", campaign.mutations,
+                         "The mutation study: inject each GL fault into every scene and report "
+                         "how often it is caught in its class");
+  campaign_cmd
+      ->add_option("--faults", campaign.faults,
+                   "--mutations: faults to inject, comma separated (default: light_scale, "
+                   "depth_bias, drop_primitive, move_vertex, texel_offset, blend_factor)")
+      ->delimiter(',');
+
   AccuracyArgs accuracy;
   CLI::App* accuracy_cmd = app.add_subcommand(
       "accuracy", "Write the accuracy report (Markdown) from the report.json of run folders");
@@ -182,6 +223,11 @@ int runCli(int argc, char** argv) {
     if (*accuracy_cmd) return accuracyCommand(accuracy);
     if (*explain_cmd) return explainCommand(explain);
     if (*reduce_cmd) return reduceCommand(reduce);
+    if (*campaign_cmd) {
+      campaign.command_line = "rastercheck";
+      for (int i = 1; i < argc; ++i) campaign.command_line += " " + shellQuote(argv[i]);
+      return campaignCommand(campaign);
+    }
   } catch (const InputError& e) {
     std::cerr << "rastercheck: error: " << oneLineMessage(e.what()) << '\n';
     return kExitInput;

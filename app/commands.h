@@ -26,6 +26,9 @@ struct GenerateArgs {
   std::filesystem::path meshes;  // empty: /usr/share/assimp/models
 };
 int generateCommand(const GenerateArgs& args);
+struct RandomSceneOptions;
+// The generator's options from the arguments, checked (InputError names the option).
+RandomSceneOptions generateOptions(const GenerateArgs& args);
 
 struct ListArgs {
   std::vector<std::filesystem::path> paths;
@@ -95,5 +98,25 @@ struct ReduceArgs {
   std::vector<std::string> tolerance;
 };
 int reduceCommand(const ReduceArgs& args);
+
+struct CampaignArgs {
+  std::string seed;  // as for generate
+  std::int64_t count = 100;
+  std::string profile = "all";
+  std::string max_size = "200x150";
+  std::filesystem::path meshes;
+  std::vector<std::string> backends;
+  std::string against = "ref";
+  std::filesystem::path out;
+  std::vector<std::string> tolerance;
+  double reduce_seconds = 60.0;     // per failure; 0: do not reduce (probe the original)
+  int jobs = 0;                     // 0: one per core
+  int batch = 20;                   // scenes per `run`
+  bool mutations = false;           // the mutation study instead of a failure campaign
+  std::vector<std::string> faults;  // --mutations: the faults to inject (default: all)
+  std::string command_line;         // as typed, for the summary
+};
+int campaignCommand(const CampaignArgs& args);
+int mutationCampaign(const CampaignArgs& args);
 
 }  // namespace rc

@@ -29,7 +29,7 @@ std::uint64_t parseUnsigned(const std::string& text, const char* option) {
 
 }  // namespace
 
-int generateCommand(const GenerateArgs& args) {
+RandomSceneOptions generateOptions(const GenerateArgs& args) {
   RandomSceneOptions options;
   options.seed = parseUnsigned(args.seed, "--seed");
   options.first = parseUnsigned(args.first, "--first");
@@ -51,6 +51,11 @@ int generateCommand(const GenerateArgs& args) {
   options.profile = parseRandomProfile(args.profile);
   if (!args.meshes.empty()) options.mesh_root = fs::absolute(args.meshes).lexically_normal();
   checkRandomMeshFiles(options);
+  return options;
+}
+
+int generateCommand(const GenerateArgs& args) {
+  const RandomSceneOptions options = generateOptions(args);
 
   // "DIR/" and "DIR/." name DIR itself.
   fs::path out = fs::absolute(args.out).lexically_normal();

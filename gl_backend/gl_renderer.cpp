@@ -124,7 +124,8 @@ struct Program {
   GLint light_intensity = -1, specular_model = -1, attenuation = -1;
   GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
   GLint opacity = -1, has_texture = -1, texture = -1;
-  GLint fault_depth_bias = -1, fault_shift_ndc = -1;  // -1 unless compiled with the fault
+  GLint fault_depth_bias = -1, fault_shift_ndc = -1,
+        fault_texel_offset = -1;  // -1 unless compiled with the fault
 };
 
 // The FBO of the last render, kept for the next one of the same size and formats:
@@ -343,6 +344,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   shader_faults.depth_bias = faults.depth_bias_steps != 0;
   shader_faults.shift_x = faults.shift_x_px != 0.0;
   shader_faults.compile_error = faults.shader_compile_error;
+  shader_faults.texel_offset = faults.texel_offset != 0.0;
   gl::ProgramSource source = gl::programSource(max_lights, shader_faults);
   const gl::testing::Hooks& hooks = gl::testing::hooks();
   if (!hooks.vertex_shader.empty()) source.vertex = hooks.vertex_shader;
@@ -402,6 +404,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   p.texture = loc("u_texture");
   p.fault_depth_bias = loc("u_fault_depth_bias");
   p.fault_shift_ndc = loc("u_fault_shift_ndc");
+  p.fault_texel_offset = loc("u_fault_texel_offset");
   return s.programs.emplace(key, p).first->second;
 }
 
@@ -625,6 +628,9 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
   if (p.fault_shift_ndc >= 0) {
     gl.Uniform1f(p.fault_shift_ndc, static_cast<GLfloat>(2.0 * faults.shift_x_px / scene.width));
   }
+  if (p.fault_texel_offset >= 0) {
+    gl.Uniform1f(p.fault_texel_offset, static_cast<GLfloat>(faults.texel_offset));
+  }
   if (p.fault_depth_bias >= 0) {
     const int bits = depthBits(scene.state.depth_format);  // d32f: one step is 2^-24
     const double step = bits > 0 ? 1.0 / (std::ldexp(1.0, bits) - 1.0) : std::ldexp(1.0, -24);
@@ -681,6 +687,13 @@ void setFixedState(const gl::Functions& gl, const Scene& scene) {
   gl.BlendEquation(GL_FUNC_ADD);
   gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   gl.Disablei(GL_BLEND, 1);  // R32UI ids never blend (GL ignores blending on integer buffers)
+}
+
+// The test-only fault blend_factor: the classic wrong blend functions.
+void setFaultedBlend(const gl::Functions& gl, const gl::testing::Faults& faults) {
+  using Blend = gl::testing::Faults::Blend;
+  if (faults.blend_factor == Blend::One) gl.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (faults.blend_factor == Blend::Swapped) gl.BlendFunc(GL_ONE_MINUS_SRC_ALPHA, GL_SRC_ALPHA);
 }
 
 void clearFramebuffer(const gl::Functions& gl, const Scene& scene) {
@@ -904,6 +917,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
 
   start = Clock::now();
   setFixedState(gl, scene);
+  setFaultedBlend(gl, faults);
   clearFramebuffer(gl, scene);
   drawPassesGl(gl, program, scene, data, textures);
   gl.Finish();
