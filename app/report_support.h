@@ -26,10 +26,16 @@ ToleranceOverrides fixtureTolerance(const Frame& expected, const Frame& actual);
 Tolerances pairTolerances(const Frame& expected, const Frame& actual,
                           const ToleranceOverrides& fixture, const CommandLineTolerances& cli);
 
-// Compares and writes the pair's images under out_dir (pairDirectory).
+// Compares without writing anything: the result named from the frames' frame.json
+// (fixture, backends, fixture file, tags), with its heat scales; `maps` as compareFrames.
+PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                        const Tolerances& tolerances, ClassMaps* maps);
+
+// Compares and writes the pair's images under out_dir (pairDirectory); diff.exr only when
+// the pair does not pass, unless diff_exr_when_passing.
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, const std::filesystem::path& out_dir,
-                       const PairPictures& pictures = {});
+                       const PairPictures& pictures = {}, bool diff_exr_when_passing = true);
 
 // A frame folder's color.png when it shows `frame` (frame.json's "color_digest", written
 // by `render`, matches the frame that was read), else empty: then the comparator encodes

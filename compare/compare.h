@@ -119,7 +119,9 @@ inline constexpr std::array<const char*, 5> kFrameChannels = {"R", "G", "B", "A"
 
 struct PairResult {
   std::string fixture;
-  std::string expected;  // backend specs, e.g. "ref", "gl:egl:llvmpipe"
+  std::string fixture_file;       // the fixture file, when the frames name it (frame.json)
+  std::vector<std::string> tags;  // the fixture's tags, when the frames name them
+  std::string expected;           // backend specs, e.g. "ref", "gl:egl:llvmpipe"
   std::string actual;
   Status status = Status::Pass;
   std::string error;  // status Error: why the pair could not be compared

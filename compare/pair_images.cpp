@@ -249,8 +249,15 @@ std::vector<Rgb8> heatColorStops(int count) {
   return stops;
 }
 
+void setHeatScales(PairResult& result) {
+  result.depth_heat_scale = std::max({result.depth.max_steps, result.tolerances.depth.fail, 1.0});
+  result.shading_heat_scale =
+      std::max({result.shading.max_abs, result.tolerances.shading.fail, 1.0});
+}
+
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
-                     const fs::path& dir, PairResult& result, const PairPictures& pictures) {
+                     const fs::path& dir, PairResult& result, const PairPictures& pictures,
+                     bool with_diff_exr) {
   const int w = maps.width;
   const int h = maps.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
@@ -274,10 +281,8 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
   const fs::path tmp_visibility = files.stage(visibility_png);
   const fs::path tmp_depth = files.stage(depth_png);
   const fs::path tmp_shading = files.stage(shading_png);
-  const fs::path tmp_diff = files.stage(diff_exr);
-  result.depth_heat_scale = std::max({result.depth.max_steps, result.tolerances.depth.fail, 1.0});
-  result.shading_heat_scale =
-      std::max({result.shading.max_abs, result.tolerances.shading.fail, 1.0});
+  const fs::path tmp_diff = with_diff_exr ? files.stage(diff_exr) : fs::path();
+  setHeatScales(result);
   heatLut();  // built once, before the threads that share it
 
   runAll({
@@ -304,13 +309,18 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
         writeRgb8(tmp_shading, w, h, heatImage(maps, maps.shading_abs, result.shading_heat_scale),
                   shading_png);
       },
-      [&] { writeDiffExr(expected, actual, maps, result, tmp_diff, diff_exr); },
+      [&] {
+        if (with_diff_exr) writeDiffExr(expected, actual, maps, result, tmp_diff, diff_exr);
+      },
   });
 
   files.commit();
-  result.images = {{"expected", expected_png},     {"actual", actual_png},
-                   {"visibility", visibility_png}, {"depth_heat", depth_png},
-                   {"shading_heat", shading_png},  {"diff_exr", diff_exr}};
+  result.images = {{"expected", expected_png},
+                   {"actual", actual_png},
+                   {"visibility", visibility_png},
+                   {"depth_heat", depth_png},
+                   {"shading_heat", shading_png}};
+  if (with_diff_exr) result.images["diff_exr"] = diff_exr;
 }
 
 fs::path pairDirectory(const fs::path& out_dir, const PairResult& result) {

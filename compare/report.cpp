@@ -148,6 +148,8 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
             {"actual", r.actual},
             {"status", toString(r.status)},
             {"pixels", r.pixels}};
+  if (!r.fixture_file.empty()) j["fixture_file"] = r.fixture_file;
+  if (!r.tags.empty()) j["tags"] = r.tags;
   if (r.status == Status::Error) {
     // The contract's shape with nothing compared: every class "error", zero counts.
     const char* e = toString(Status::Error);
@@ -261,6 +263,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
             {"exit_code", exitCodeFor(report)}};
   if (!report.command.empty()) j["command"] = report.command;
   if (!report.variants.empty()) j["variants"] = report.variants;
+  if (!report.shard.empty()) j["shard"] = report.shard;
   return j;
 }
 

@@ -15,7 +15,7 @@ namespace {
 
 constexpr const char* kValidFaults =
     "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
-    "shader_compile_error";
+    "shader_compile_error, hang=FIXTURE|*, crash=FIXTURE|*";
 
 [[noreturn]] void badFault(std::string_view entry, std::string_view why) {
   throw InputError(
@@ -38,8 +38,12 @@ T number(std::string_view entry, std::string_view value) {
 
 bool Faults::any() const {
   return drop_primitive != 0 || depth_bias_steps != 0 || light_scale != 1.0 ||
-         no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error;
+         no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || !hang.empty() ||
+         !crash.empty();
 }
+
+bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }
+bool Faults::crashes(const std::string& fixture) const { return crash == "*" || crash == fixture; }
 
 std::string Faults::describe() const {
   std::vector<std::string> parts;
@@ -49,6 +53,8 @@ std::string Faults::describe() const {
   if (no_inverse_transpose) parts.emplace_back("no_inverse_transpose");
   if (shift_x_px != 0.0) parts.push_back(fmt::format("shift_x={}", shift_x_px));
   if (shader_compile_error) parts.emplace_back("shader_compile_error");
+  if (!hang.empty()) parts.push_back("hang=" + hang);
+  if (!crash.empty()) parts.push_back("crash=" + crash);
   return fmt::format("{}", fmt::join(parts, ","));
 }
 
@@ -65,7 +71,7 @@ Faults parseFaults(std::string_view text) {
     const std::string_view value = has_value ? entry.substr(eq + 1) : std::string_view{};
     const bool flag = name == "no_inverse_transpose" || name == "shader_compile_error";
     const bool valued = name == "drop_primitive" || name == "depth_bias" || name == "light_scale" ||
-                        name == "shift_x";
+                        name == "shift_x" || name == "hang" || name == "crash";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
     if (name == "drop_primitive") {
@@ -77,6 +83,9 @@ Faults parseFaults(std::string_view text) {
       f.light_scale = number<double>(entry, value);
     } else if (name == "shift_x") {
       f.shift_x_px = number<double>(entry, value);
+    } else if (name == "hang" || name == "crash") {
+      if (value.empty()) badFault(entry, "needs a fixture name or *");
+      (name == "hang" ? f.hang : f.crash) = std::string(value);
     } else if (name == "no_inverse_transpose") {
       f.no_inverse_transpose = true;
     } else {

@@ -1,9 +1,12 @@
 // renderGl: the process-wide GL session, the FBO, the draw sequence of drawPasses() and
 // the readback into a Frame (top row first). See gl_backend.h and docs/gl_backend.md.
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -778,6 +781,19 @@ gl::testing::Faults activeFaults() {
   return faults;
 }
 
+// The test-only hang and crash faults: what a driver stuck in a fence or faulting in its
+// rasterizer looks like from outside (gl_testing.h).
+void injectStall(const gl::testing::Faults& faults, const std::string& fixture) {
+  if (faults.crashes(fixture)) {
+    std::signal(SIGSEGV, SIG_DFL);  // a sanitizer's handler would turn it into an exit code
+    std::raise(SIGSEGV);
+  }
+  if (faults.hangs(fixture)) {
+    std::fflush(nullptr);
+    for (;;) ::pause();
+  }
+}
+
 Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   if (scene.width <= 0 || scene.height <= 0) {
     throw InputError(
@@ -844,6 +860,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   clearFramebuffer(gl, scene);
   drawPassesGl(gl, program, scene, data, textures);
   gl.Finish();
+  injectStall(faults, scene.name);
   checkGl(s, "draw");
   const double draw_ms = msSince(start);
 

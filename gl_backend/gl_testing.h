@@ -24,8 +24,16 @@ struct Faults {
   bool no_inverse_transpose = false;  // normals by the model matrix, not its inverse transpose
   double shift_x_px = 0.0;            // shift_x=PX: geometry moved PX pixels right (window)
   bool shader_compile_error = false;  // shader_compile_error: the fragment shader breaks
+  // hang=NAME / crash=NAME: the render of the fixture named NAME ("*": every fixture) never
+  // returns (blocks after the draw, as a driver stuck in a fence would) or dies with
+  // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.
+  std::string hang;
+  std::string crash;
 
   bool any() const;
+  // Whether hang / crash apply to the fixture named `fixture`.
+  bool hangs(const std::string& fixture) const;
+  bool crashes(const std::string& fixture) const;
   // The canonical comma-separated form (parseFaults(describe()) gives the same faults).
   std::string describe() const;
 };
