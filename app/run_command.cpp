@@ -175,8 +175,8 @@ int runCommand(const RunArgs& args) {
   if (!(args.timeout_seconds >= 0.0))
     throw InputError(fmt::format("--timeout {}: must be a number of seconds >= 0 (0: none)",
                                  args.timeout_seconds));
-  const std::optional<ShardSpec> shard =
-      args.shard.empty() ? std::nullopt : std::optional(parseShard(args.shard));
+  const bool sharded = !args.shard.empty();
+  const ShardSpec shard = sharded ? parseShard(args.shard) : ShardSpec{};
   std::error_code ec;
   if (fs::exists(args.out, ec) && !fs::is_directory(args.out, ec))
     throw InputError(fmt::format("{}: --out names a file; it must be a folder", args.out.string()));
@@ -204,7 +204,7 @@ int runCommand(const RunArgs& args) {
   // The reference renders too when --against has no uncertainty channels of its own.
   const bool needs_ref = against.kind == BackendSpec::Kind::Gl;
   nlohmann::json shard_block = nlohmann::json::object();
-  if (shard) {
+  if (sharded) {
     std::vector<ShardUnit> units;
     for (const PairPlan& p : pairs)
       units.push_back(
@@ -212,21 +212,21 @@ int runCommand(const RunArgs& args) {
     std::vector<double> shared;
     for (const FixtureEntry& fx : fixtures)
       shared.push_back(fx.cost * (backendWeight(against.text) + (needs_ref ? 1.0 : 0.0)));
-    const std::vector<int> plan = assignShards(units, shared, shard->count);
-    std::vector<std::string> digest_parts = {against.text, std::to_string(shard->count)};
+    const std::vector<int> plan = assignShards(units, shared, shard.count);
+    std::vector<std::string> digest_parts = {against.text, std::to_string(shard.count)};
     for (const BackendSpec& b : backends) digest_parts.push_back(b.text);
     for (const std::string& t : args.tolerance) digest_parts.push_back(t);
     for (const FixtureEntry& fx : fixtures) digest_parts.push_back(fx.name);
     nlohmann::json indices = nlohmann::json::array();
     std::vector<PairPlan> mine;
     for (std::size_t i = 0; i < pairs.size(); ++i) {
-      if (plan[i] != shard->index - 1) continue;
+      if (plan[i] != shard.index - 1) continue;
       mine.push_back(pairs[i]);
       indices.push_back(pairs[i].index);
     }
     pairs = std::move(mine);
-    shard_block = {{"index", shard->index},
-                   {"count", shard->count},
+    shard_block = {{"index", shard.index},
+                   {"count", shard.count},
                    {"pairs", total_pairs},
                    {"plan", planDigest(digest_parts)},
                    {"pair_indices", indices}};

@@ -2,10 +2,12 @@
 // relative files beside it), built to stay usable at tens of thousands of pairs: the
 // summary, per-backend counts, a fixture x backend matrix (only fixtures with a
 // non-passing pair when there are many), then the pairs table with failures first, grouped
-// by signature (what failed, how), passing pairs collapsed into a count, filters by text,
-// status, backend, class and tag; per pair the images side by side with legends and the
-// numbers, images loaded only when the pair is opened. Small reports carry every pair's
-// section in the page; large ones keep the sections as data and build one when opened.
+// by signature (what failed, how), passing pairs one group with a count per backend,
+// filters by text, status, backend, class and tag; per pair the images side by side with
+// legends and the numbers, images loaded only when the pair is opened. The page carries
+// the pairs as data and its script builds rows and sections from them: every one at once
+// for small reports, a group's rows when it is opened and a pair's section when that is
+// opened for large ones (docs/reports.md, docs/scaling.md).
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -72,29 +74,11 @@ std::string relativeUrl(const fs::path& file, const fs::path& base) {
   return urlPath(rel.generic_string());
 }
 
-std::string number(double v) {
-  if (std::isnan(v)) return "NaN";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  return fmt::format("{:.4g}", v);
-}
-
 std::string hex(const Rgb8& c) { return fmt::format("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]); }
 
 std::string badge(Status s) {
   return fmt::format("<span class=\"badge {0}\">{0}</span>", toString(s));
 }
-
-// One table cell with a sort key: numbers sort numerically, text alphabetically.
-std::string cell(const std::string& text, const std::string& key, bool numeric) {
-  return fmt::format("<td data-v=\"{}\"{}>{}</td>", esc(key), numeric ? " class=\"n\"" : "", text);
-}
-std::string numCell(double v) {
-  return cell(esc(number(v)), std::isfinite(v) ? fmt::format("{}", v) : "1e308", true);
-}
-std::string countCell(std::uint64_t v) {
-  return cell(fmt::format("{}", v), fmt::format("{}", v), true);
-}
-std::string emptyCell() { return cell("&mdash;", "-1", true); }
 
 constexpr const char* kStyle = R"CSS(
 body{font:14px/1.4 system-ui,sans-serif;margin:0 24px 48px;color:#222;background:#fafafa}
@@ -139,13 +123,16 @@ tr.group-head .by{color:#666;font-weight:normal;font-size:12px}
 tbody.collapsed tr.pair-row,tbody.collapsed tr.detail-row{display:none}
 tbody.collapsed .fold::before{content:"\25B8 "}tbody .fold::before{content:"\25BE "}
 tr.detail-row > td{white-space:normal;background:#f6f6f6}
+tr.group-head:hover th{background:#f4f4f4}
 .hidden{display:none}
 )CSS";
-
 constexpr const char* kScript = R"JS(
 (function () {
   var D = JSON.parse(document.getElementById('report-data').textContent);
-  var P = D.pairs;  // per pair: fixture, expected, actual, status, column, classes, tags, group, numbers
+  // Per pair: fixture, expected, actual, status, column, classes not passing, tag ids,
+  // group, the row's 12 numbers (null for error rows).
+  var P = D.pairs;
+  var X = D.details;  // per pair: what its section shows (null: a passing pair without images)
   var table = document.getElementById('results');
   var filter = document.getElementById('filter');
   var statusF = document.getElementById('status-filter');
@@ -154,6 +141,20 @@ constexpr const char* kScript = R"JS(
   var tagF = document.getElementById('tag-filter');
   var shown = document.getElementById('shown');
   var pending = 0, ready = false;
+
+  function esc(t) {
+    return String(t).replace(/[&<>"']/g, function (c) {
+      return {'&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;'}[c];
+    });
+  }
+  // Numbers as the C++ side prints them (4 significant digits); strings are non-finite.
+  function num(v) {
+    if (v === null || v === undefined) return '&mdash;';
+    if (typeof v === 'string') return v;
+    return String(+v.toPrecision(4));
+  }
+  function badge(s) { return '<span class="badge ' + s + '">' + s + '</span>'; }
+  function at(x, y, h) { return x < 0 ? '(none)' : '(' + x + ',' + y + ') window (' + x + ',' + (h - 1 - y) + ')'; }
 
   function matches(k) {
     var p = P[k], text = filter.value.toLowerCase(), st = statusF.value;
@@ -173,13 +174,14 @@ constexpr const char* kScript = R"JS(
       if (!img.getAttribute('src')) continue;
       if (img.complete && img.naturalWidth > 0) ok++; else bad++;
     }
-    document.body.setAttribute('data-images-ok', ok);
-    document.body.setAttribute('data-images-failed', bad);
-    document.body.setAttribute('data-rows-rendered', document.querySelectorAll('tr.pair-row').length);
-    document.body.setAttribute('data-pairs-rendered', document.querySelectorAll('details.pair').length);
-    if (ready && pending === 0 && !document.body.hasAttribute('data-ready')) {
-      document.body.setAttribute('data-ready', '1');
-      document.body.setAttribute('data-ready-ms', Math.round(performance.now()));
+    var b = document.body;
+    b.setAttribute('data-images-ok', ok);
+    b.setAttribute('data-images-failed', bad);
+    b.setAttribute('data-rows-rendered', table.querySelectorAll('tr.pair-row').length);
+    b.setAttribute('data-pairs-rendered', document.querySelectorAll('details.pair').length);
+    if (ready && pending === 0 && !b.hasAttribute('data-ready')) {
+      b.setAttribute('data-ready', '1');
+      b.setAttribute('data-ready-ms', Math.round(performance.now()));
     }
   }
   function settled(e) {
@@ -204,23 +206,94 @@ constexpr const char* kScript = R"JS(
     details.addEventListener('toggle', function () { if (details.open) loadImages(details); });
   }
 
-  function cell(text, key, numeric) {
+  // ---- one pair's section: images with legends, then the numbers ----
+  function figure(x, kind, caption, legend) {
+    if (!x.f || !x.f[kind]) return '';
+    var url = x.img + x.f[kind];
+    var h = x.wh[0] > 0 ? Math.floor(240 * x.wh[1] / x.wh[0]) : 240;
+    return '<figure><a href="' + url + '"><img data-src="' + url + '" alt="' + esc(caption) +
+        '" width="240" height="' + h + '"></a><figcaption>' + esc(caption) + '</figcaption>' +
+        (legend || '') + '</figure>';
+  }
+  function sw(cls, label) { return '<span><i class="sw ' + cls + '"></i>' + label + '</span>'; }
+  function heatLegend(scale, unit) {
+    return '<div class="ramp"></div><div class="ramp-labels"><span>0</span><span>log scale</span><span>' +
+        num(scale) + ' ' + unit + '</span></div><div class="legend">' + sw('nc', 'not compared') +
+        sw('nf', 'NaN/Inf') + '</div>';
+  }
+  function table2(title, status, rows) {
+    var out = '<table><tr><th colspan="2">' + title + ' ' + badge(status) + '</th></tr>';
+    for (var i = 0; i < rows.length; i++)
+      out += '<tr><td>' + esc(rows[i][0]) + '</td><td class="n">' + esc(rows[i][1]) + '</td></tr>';
+    return out + '</table>';
+  }
+  function section(k) {
+    var p = P[k], x = X[k] || {}, open = p[3] !== 'pass';
+    var out = '<details class="pair" id="pair-' + k + '"' + (open ? ' open' : '') + '><summary><h3>' +
+        esc(p[0]) + ' &mdash; ' + esc(p[1]) + ' vs ' + esc(p[2]) + ' ' + badge(p[3]) + '</h3></summary>';
+    out += '<div class="describe">' + esc(x.d || ('PASS ' + p[0] + ' ' + p[1] + ' vs ' + p[2])) + '</div>';
+    if (p[3] === 'error') return out + '</details>';
+    var v = x.v;
+    var vis = v ? '<div class="legend">' + sw('c1', 'match') + sw('c3', 'missing ' + v[4]) +
+        sw('c2', 'missing (ambiguous) ' + (v[3] - v[4])) + sw('c5', 'extra ' + v[6]) +
+        sw('c4', 'extra (ambiguous) ' + (v[5] - v[6])) + sw('c7', 'wrong_primitive ' + v[8]) +
+        sw('c6', 'wrong_primitive (ambiguous) ' + (v[7] - v[8])) + sw('c0', 'background') + '</div>' : '';
+    var hs = x.hs || [1, 1];
+    out += '<div class="images">' + figure(x, 'expected', 'expected: ' + p[1]) +
+        figure(x, 'actual', 'actual: ' + p[2]) + figure(x, 'visibility', 'visibility classes', vis) +
+        figure(x, 'depth_heat', 'depth |dZ| (steps)', heatLegend(hs[0], 'steps')) +
+        figure(x, 'shading_heat', 'shading max |dC| (8-bit units)', heatLegend(hs[1], 'units')) + '</div>';
+    if (x.f && x.f.diff_exr)
+      out += '<div class="meta">float channels: <a href="' + x.img + x.f.diff_exr + '">' +
+          esc(x.f.diff_exr) + '</a></div>';
+    if (!v) {
+      // A passing pair of a large report: the row's numbers.
+      var n = p[8];
+      return out + '<div class="numbers">' + table2('key numbers', p[3], [
+        ['hard px', num(n[0])], ['ambiguous px', num(n[1])], ['depth max (steps)', num(n[5])],
+        ['depth p99', num(n[6])], ['shading max (8-bit)', num(n[8])], ['PSNR (dB)', num(n[10])]]) +
+        '</div><div class="meta">every number of this pair is in report.json</div></details>';
+    }
+    var z = x.z, s = x.s, t = x.t, h = x.wh[1], cs = x.cs;
+    out += '<div class="numbers">';
+    out += table2('visibility', cs[0], [
+      ['mismatched', v[0]], ['ambiguous', v[1]], ['hard', v[2]],
+      ['missing (hard)', v[3] + ' (' + v[4] + ')'], ['extra (hard)', v[5] + ' (' + v[6] + ')'],
+      ['wrong_primitive (hard)', v[7] + ' (' + v[8] + ')'], ['excused by depth_gap', v[9]],
+      ['band (px)', num(v[10])], ['uncertainty channels', v[11] ? 'yes' : 'no'],
+      ['thresholds warn / fail', t[0] + ' / ' + t[1]], ['worst', at(v[12], v[13], h)]]);
+    out += table2('depth', cs[1], [
+      ['compared', z[0]], ['max (steps)', num(z[1])], ['mean', num(z[2])], ['p99', num(z[3])],
+      ['over tolerance', z[4]], ['over fail', z[5]], ['non-finite', z[6]], ['slope unknown', z[7]],
+      ['slope from plane fit', z[8]], ['slope band (px)', num(z[9])], ['format', x.fmt[0]],
+      ['thresholds warn / fail', t[2] + ' / ' + t[3] + ' + ' + t[4] + ' x slope x band'],
+      ['worst', at(z[10], z[11], h)], ['worst steps / allowance', num(z[12]) + ' / ' + num(z[13])]]);
+    out += table2('shading', cs[2], [
+      ['compared', s[0]], ['max abs (8-bit)', num(s[1])], ['mean abs', num(s[2])], ['rmse', num(s[3])],
+      ['psnr (dB)', num(s[4]) + (s[3] > 0 ? '' : ' (identical)')], ['p99', num(s[5])],
+      ['over warn', s[6]], ['over fail', s[7]], ['non-finite', s[8]],
+      ['max R G B A', num(s[9]) + ' ' + num(s[10]) + ' ' + num(s[11]) + ' ' + num(s[12])],
+      ['format', x.fmt[1]], ['thresholds warn / fail', num(t[5]) + ' / ' + num(t[6]) + ' + allowance'],
+      ['allowance', x.a], ['worst', at(s[13], s[14], h)],
+      ['worst error / allowance', num(s[15]) + ' / ' + num(s[16])]]);
+    if (x.nf) {
+      var names = ['R', 'G', 'B', 'A', 'Z'], rows = [];
+      for (var c = 0; c < 5; c++)
+        rows.push([names[c], x.nf[0][c] + '/' + x.nf[1][c] + ' | ' + x.nf[2][c] + '/' + x.nf[3][c]]);
+      out += table2('NaN/Inf: expected | actual', 'fail', rows);
+    }
+    return out + '</div></details>';
+  }
+
+  // ---- the pairs table ----
+  function cell(html, key, numeric) {
     var td = document.createElement('td');
     td.setAttribute('data-v', key);
     if (numeric) td.className = 'n';
-    td.innerHTML = text;
+    td.innerHTML = html;
     return td;
   }
-  function fmt(v) {
-    if (v === null) return '&mdash;';
-    return Math.abs(v) >= 1e4 || (v !== 0 && Math.abs(v) < 1e-3) ? v.toPrecision(4) : String(+v.toPrecision(4));
-  }
-  function esc(t) {
-    return String(t).replace(/[&<>"']/g, function (c) {
-      return {'&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;'}[c];
-    });
-  }
-  // A row of a pair the page carries as data only (passing pairs of large reports).
+  var ORDER = {pass: 0, warn: 1, fail: 2, error: 3};
   function buildRow(k) {
     var p = P[k], tr = document.createElement('tr');
     tr.className = 'pair-row';
@@ -228,49 +301,43 @@ constexpr const char* kScript = R"JS(
     tr.appendChild(cell('<a href="#pair-' + k + '">' + esc(p[0]) + '</a>', p[0], false));
     tr.appendChild(cell(esc(p[1]), p[1], false));
     tr.appendChild(cell(esc(p[2]), p[2], false));
-    tr.appendChild(cell('<span class="badge ' + p[3] + '">' + p[3] + '</span>', '0', true));
+    tr.appendChild(cell(badge(p[3]), String(ORDER[p[3]]), true));
     for (var i = 0; i < 12; i++) {
       var v = p[8] ? p[8][i] : null;
-      tr.appendChild(cell(fmt(v), v === null ? '-1' : String(v), true));
+      tr.appendChild(cell(num(v), v === null ? '-1' : (typeof v === 'string' ? '1e308' : String(v)), true));
     }
     return tr;
   }
-  function fillLazy(body) {
+  // A group's rows are built the first time it is opened.
+  function fill(body) {
     if (!body.hasAttribute('data-lazy')) return;
     body.removeAttribute('data-lazy');
-    var frag = document.createDocumentFragment();
-    for (var k = 0; k < P.length; k++) if (P[k][7] === +body.getAttribute('data-group')) frag.appendChild(buildRow(k));
+    var g = +body.getAttribute('data-group'), frag = document.createDocumentFragment();
+    for (var k = 0; k < P.length; k++) if (P[k][7] === g) frag.appendChild(buildRow(k));
     body.appendChild(frag);
     apply();
   }
   function rowOf(k) { return table.querySelector('tr.pair-row[data-k="' + k + '"]'); }
 
-  // Opens pair k: its section (small reports) or a detail row under its table row.
+  // Opens pair k: its section below the table (small reports) or a row under its table row.
   function openPair(k) {
+    if (!(k >= 0 && k < P.length)) return null;
     var el = document.getElementById('pair-' + k);
     if (!el && D.big) {
-      var row = rowOf(k);
-      if (!row) {
-        var body = table.querySelector('tbody[data-group="' + P[k][7] + '"]');
-        if (body) { fillLazy(body); row = rowOf(k); }
-      }
-      if (!row) return null;
-      row.parentNode.classList.remove('collapsed');
-      var tr = document.createElement('tr'), td = document.createElement('td');
+      var body = table.querySelector('tbody[data-group="' + P[k][7] + '"]');
+      fill(body);
+      body.classList.remove('collapsed');
+      var row = rowOf(k), tr = document.createElement('tr'), td = document.createElement('td');
       tr.className = 'detail-row';
       tr.setAttribute('data-k', k);
       td.colSpan = 16;
-      var p = P[k];
-      td.innerHTML = D.details[k] || ('<details class="pair" id="pair-' + k + '"><summary><h3>' + esc(p[0]) +
-          ' &mdash; ' + esc(p[1]) + ' vs ' + esc(p[2]) + ' <span class="badge ' + p[3] + '">' + p[3] +
-          '</span></h3></summary><div class="describe">Every class passes; the numbers are in the row above ' +
-          'and in report.json (run with --keep-frames for images of passing pairs).</div></details>');
+      td.innerHTML = section(k);
       tr.appendChild(td);
       row.parentNode.insertBefore(tr, row.nextSibling);
       el = document.getElementById('pair-' + k);
       watch(el);
     }
-    if (el && el.tagName === 'DETAILS') el.open = true;
+    if (el) el.open = true;
     return el;
   }
   function openTarget() {
@@ -280,9 +347,11 @@ constexpr const char* kScript = R"JS(
       return;
     }
     var m = /^pair-(\d+)$/.exec(h);
-    if (!m) return;
-    var el = openPair(+m[1]);
-    if (el) el.scrollIntoView();
+    var el = m ? openPair(+m[1]) : null;
+    // Large reports: the pair's row, with its section under it, below the sticky header.
+    var row = el && D.big ? rowOf(+m[1]) : null;
+    if (row) window.scrollTo(0, row.getBoundingClientRect().top + window.scrollY - 40);
+    else if (el) el.scrollIntoView();
   }
 
   function apply() {
@@ -299,8 +368,7 @@ constexpr const char* kScript = R"JS(
     for (var g = 0; g < groups.length; g++) {
       var n = per[groups[g].getAttribute('data-group')] || 0;
       groups[g].classList.toggle('hidden', n === 0);
-      var c = groups[g].querySelector('.count');
-      if (c) c.textContent = n;
+      groups[g].querySelector('.count').textContent = n;
     }
     shown.textContent = visible + ' of ' + P.length + ' pairs shown';
   }
@@ -328,14 +396,22 @@ constexpr const char* kScript = R"JS(
     }
   }
 
+  // Small reports: every row and every section now; large ones: on demand.
+  var bodies = table.tBodies;
+  for (var b = 0; b < bodies.length; b++) if (!D.big) fill(bodies[b]);
+  if (!D.big) {
+    var html = '';
+    for (var k = 0; k < P.length; k++) html += section(k);
+    document.getElementById('details').innerHTML = html;
+  }
   var ths = table.tHead.rows[0].cells;
   for (var i = 0; i < ths.length; i++)
     ths[i].addEventListener('click', function (e) { sortBy(e.currentTarget); });
-  var heads = table.querySelectorAll('tr.group-head');
-  for (var j = 0; j < heads.length; j++)
-    heads[j].addEventListener('click', function (e) {
+  var gheads = table.querySelectorAll('tr.group-head');
+  for (var j = 0; j < gheads.length; j++)
+    gheads[j].addEventListener('click', function (e) {
       var body = e.currentTarget.parentNode;
-      fillLazy(body);
+      fill(body);
       body.classList.toggle('collapsed');
     });
   [filter, statusF, backendF, classF, tagF].forEach(function (el) {
@@ -351,159 +427,107 @@ constexpr const char* kScript = R"JS(
 })();
 )JS";
 
-std::string visibilityLegend(const PairResult& r) {
-  const VisibilityStats& v = r.visibility;
-  struct Entry {
-    PixelClass cls;
-    std::uint64_t count;
-  };
-  const std::uint64_t missing_amb = v.missing - v.missing_hard;
-  const std::uint64_t extra_amb = v.extra - v.extra_hard;
-  const std::uint64_t wrong_amb = v.wrong_primitive - v.wrong_primitive_hard;
-  const Entry entries[] = {{PixelClass::Match, 0},
-                           {PixelClass::MissingHard, v.missing_hard},
-                           {PixelClass::MissingAmbiguous, missing_amb},
-                           {PixelClass::ExtraHard, v.extra_hard},
-                           {PixelClass::ExtraAmbiguous, extra_amb},
-                           {PixelClass::WrongHard, v.wrong_primitive_hard},
-                           {PixelClass::WrongAmbiguous, wrong_amb},
-                           {PixelClass::Background, 0}};
-  std::string out = "<div class=\"legend\">";
-  for (const Entry& e : entries) {
-    const bool counted = e.cls != PixelClass::Match && e.cls != PixelClass::Background;
-    out += fmt::format("<span><i class=\"sw\" style=\"background:{}\"></i>{}{}</span>",
-                       hex(classColor(e.cls)), esc(toString(e.cls)),
-                       counted ? fmt::format(" {}", e.count) : std::string());
+// Colours of the legends, from the same tables the images use.
+std::string legendStyle() {
+  std::string gradient;
+  for (const Rgb8& c : heatColorStops(9)) {
+    if (!gradient.empty()) gradient += ',';
+    gradient += hex(c);
   }
-  return out + "</div>";
+  std::string out = fmt::format(".ramp{{background:linear-gradient(to right,{})}}", gradient);
+  for (int c = 0; c < kPixelClassCount; ++c)
+    out += fmt::format(".sw.c{}{{background:{}}}", c, hex(classColor(static_cast<PixelClass>(c))));
+  out += fmt::format(".sw.nc{{background:{}}}.sw.nf{{background:{}}}", hex(kNotComparedColor),
+                     hex(kNonFiniteColor));
+  return out;
 }
 
-std::string heatLegend(double scale, const char* unit, const std::string& gradient) {
-  return fmt::format(
-      "<div class=\"ramp\" style=\"background:linear-gradient(to right,{})\"></div>"
-      "<div class=\"ramp-labels\"><span>0</span><span>log scale</span><span>{} {}</span></div>"
-      "<div class=\"legend\"><span><i class=\"sw\" style=\"background:{}\"></i>not compared</span>"
-      "<span><i class=\"sw\" style=\"background:{}\"></i>NaN/Inf</span></div>",
-      gradient, esc(number(scale)), unit, hex(kNotComparedColor), hex(kNonFiniteColor));
+// JSON has no NaN or Inf: those are the strings the page prints for them. Six
+// significant digits are more than the page shows (four) and keep the data small.
+nlohmann::json jnum(double v) {
+  if (std::isnan(v)) return "NaN";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return std::stod(fmt::format("{:.6g}", v));
 }
 
-std::string figure(const PairResult& r, const char* kind, const char* caption,
-                   const fs::path& report_dir, const std::string& legend) {
-  const auto it = r.images.find(kind);
-  if (it == r.images.end()) return "";
-  const std::string url = relativeUrl(it->second, report_dir);
-  return fmt::format(
-      "<figure><a href=\"{0}\"><img data-src=\"{0}\" alt=\"{1}\" width=\"{2}\" height=\"{3}\"></a>"
-      "<figcaption>{1}</figcaption>{4}</figure>",
-      url, esc(caption), 240, r.width > 0 ? 240 * r.height / r.width : 240, legend);
-}
-
-std::string rowsTable(const char* title, Status status,
-                      const std::vector<std::pair<std::string, std::string>>& rows) {
-  std::string out =
-      fmt::format("<table><tr><th colspan=\"2\">{} {}</th></tr>", title, badge(status));
-  for (const auto& [k, v] : rows)
-    out += fmt::format("<tr><td>{}</td><td class=\"n\">{}</td></tr>", esc(k), esc(v));
-  return out + "</table>";
-}
-
-std::string at(const PixelRef& p, int height) { return where(p, height); }
-
-std::string pairSection(const PairResult& r, std::size_t k, const fs::path& report_dir,
-                        const std::string& gradient) {
-  // Passing pairs start folded so that a large run shows what needs attention.
-  std::string out = fmt::format(
-      "<details class=\"pair\" id=\"pair-{}\" data-status=\"{}\"{}><summary><h3>{} &mdash; {} "
-      "vs {} {}</h3></summary>",
-      k, toString(r.status), r.status == Status::Pass ? "" : " open", esc(r.fixture),
-      esc(r.expected), esc(r.actual), badge(r.status));
-  out += fmt::format("<div class=\"describe\">{}</div>", esc(describe(r)));
-  if (r.status == Status::Error) return out + "</details>";
-
-  out += "<div class=\"images\">";
-  out += figure(r, "expected", ("expected: " + r.expected).c_str(), report_dir, "");
-  out += figure(r, "actual", ("actual: " + r.actual).c_str(), report_dir, "");
-  out += figure(r, "visibility", "visibility classes", report_dir, visibilityLegend(r));
-  out += figure(r, "depth_heat", "depth |dZ| (steps)", report_dir,
-                heatLegend(r.depth_heat_scale, "steps", gradient));
-  out += figure(r, "shading_heat", "shading max |dC| (8-bit units)", report_dir,
-                heatLegend(r.shading_heat_scale, "units", gradient));
-  out += "</div>";
-  if (const auto it = r.images.find("diff_exr"); it != r.images.end())
-    out += fmt::format("<div class=\"meta\">float channels: <a href=\"{0}\">{1}</a></div>",
-                       relativeUrl(it->second, report_dir), esc(it->second.filename().string()));
-
+// What pair k's section shows. `full`: every number (pairs that did not pass, and every
+// pair of a small report); else only the images and their scales (null without images),
+// the section then shows the row's numbers.
+nlohmann::json sectionData(const PairResult& r, const fs::path& report_dir, bool full) {
+  using nlohmann::json;
+  json x = json::object();
+  if (!r.images.empty()) {
+    // One folder per pair: its URL once, the file names per kind.
+    std::string dir;
+    bool one_dir = true;
+    for (const auto& [kind, file] : r.images) {
+      const std::string d = relativeUrl(file.parent_path(), report_dir) + "/";
+      if (dir.empty()) dir = d;
+      one_dir = one_dir && d == dir;
+    }
+    json files = json::object();
+    for (const auto& [kind, file] : r.images)
+      files[kind] = one_dir ? urlPath(file.filename().string()) : relativeUrl(file, report_dir);
+    x["img"] = one_dir ? dir : "";
+    x["f"] = files;
+  }
+  if (r.status == Status::Error) {
+    x["d"] = describe(r);
+    return x;
+  }
+  x["wh"] = {r.width, r.height};
+  x["hs"] = {jnum(r.depth_heat_scale), jnum(r.shading_heat_scale)};
+  if (!full) return r.images.empty() ? json() : x;
   const VisibilityStats& v = r.visibility;
   const DepthStats& d = r.depth;
   const ShadingStats& s = r.shading;
   const Tolerances& t = r.tolerances;
-  out += "<div class=\"numbers\">";
-  out += rowsTable(
-      "visibility", v.status,
-      {{"mismatched", fmt::format("{}", v.mismatched)},
-       {"ambiguous", fmt::format("{}", v.ambiguous)},
-       {"hard", fmt::format("{}", v.hard)},
-       {"missing (hard)", fmt::format("{} ({})", v.missing, v.missing_hard)},
-       {"extra (hard)", fmt::format("{} ({})", v.extra, v.extra_hard)},
-       {"wrong_primitive (hard)",
-        fmt::format("{} ({})", v.wrong_primitive, v.wrong_primitive_hard)},
-       {"excused by depth_gap", fmt::format("{}", v.ambiguous_by_depth_gap)},
-       {"band (px)", number(v.band_px)},
-       {"uncertainty channels", v.uncertainty_available ? "yes" : "no"},
-       {"thresholds warn / fail", fmt::format("{} / {}", t.visibility.warn, t.visibility.fail)},
-       {"worst", at(v.worst, r.height)}});
-  out +=
-      rowsTable("depth", d.status,
-                {{"compared", fmt::format("{}", d.compared)},
-                 {"max (steps)", number(d.max_steps)},
-                 {"mean", number(d.mean_steps)},
-                 {"p99", number(d.p99_steps)},
-                 {"over tolerance", fmt::format("{}", d.over_tolerance)},
-                 {"over fail", fmt::format("{}", d.over_fail)},
-                 {"non-finite", fmt::format("{}", d.nonfinite)},
-                 {"slope unknown", fmt::format("{}", d.slope_unknown)},
-                 {"slope from plane fit", fmt::format("{}", d.slope_fitted)},
-                 {"slope band (px)", number(d.band_px)},
-                 {"format", toString(t.depth_format)},
-                 {"thresholds warn / fail", fmt::format("{} / {} + {} x slope x band", t.depth.warn,
-                                                        t.depth.fail, t.depth_slope_factor)},
-                 {"worst", at(d.worst, r.height)},
-                 {"worst steps / allowance",
-                  fmt::format("{} / {}", number(d.worst_steps), number(d.worst_allowance))}});
-  out += rowsTable(
-      "shading", s.status,
-      {{"compared", fmt::format("{}", s.compared)},
-       {"max abs (8-bit)", number(s.max_abs)},
-       {"mean abs", number(s.mean_abs)},
-       {"rmse", number(s.rmse)},
-       {"psnr (dB)", s.rmse > 0.0 ? number(s.psnr_db) : number(s.psnr_db) + " (identical)"},
-       {"p99", number(s.p99_abs)},
-       {"over warn", fmt::format("{}", s.over_tolerance)},
-       {"over fail", fmt::format("{}", s.over_fail)},
-       {"non-finite", fmt::format("{}", s.nonfinite)},
-       {"max R G B A",
-        fmt::format("{} {} {} {}", number(s.max_abs_rgba[0]), number(s.max_abs_rgba[1]),
-                    number(s.max_abs_rgba[2]), number(s.max_abs_rgba[3]))},
-       {"format", toString(t.color_format)},
-       {"thresholds warn / fail",
-        fmt::format("{:.4g} / {:.4g} + allowance", t.shading.warn, t.shading.fail)},
-       {"allowance", shadingAllowanceText(t, r.depth.band_px)},
-       {"worst", at(s.worst, r.height)},
-       {"worst error / allowance",
-        fmt::format("{} / {}", number(s.worst_abs), number(s.worst_allowance))}});
-  const std::uint64_t nf_e = r.nonfinite_expected.total();
-  const std::uint64_t nf_a = r.nonfinite_actual.total();
-  if (nf_e || nf_a) {
-    std::vector<std::pair<std::string, std::string>> rows;
-    for (std::size_t c = 0; c < kFrameChannels.size(); ++c)
-      rows.emplace_back(
-          kFrameChannels[c],
-          fmt::format("{}/{} | {}/{}", r.nonfinite_expected.nan[c], r.nonfinite_expected.inf[c],
-                      r.nonfinite_actual.nan[c], r.nonfinite_actual.inf[c]));
-    out += rowsTable("NaN/Inf: expected | actual", Status::Fail, rows);
-  }
-  out += "</div></details>";
-  return out;
+  if (r.status != Status::Pass) x["d"] = describe(r);
+  x["cs"] = {toString(v.status), toString(d.status), toString(s.status)};
+  x["v"] = {v.mismatched,
+            v.ambiguous,
+            v.hard,
+            v.missing,
+            v.missing_hard,
+            v.extra,
+            v.extra_hard,
+            v.wrong_primitive,
+            v.wrong_primitive_hard,
+            v.ambiguous_by_depth_gap,
+            jnum(v.band_px),
+            v.uncertainty_available ? 1 : 0,
+            v.worst.x,
+            v.worst.y};
+  x["z"] = {
+      d.compared,  jnum(d.max_steps), jnum(d.mean_steps),  jnum(d.p99_steps),      d.over_tolerance,
+      d.over_fail, d.nonfinite,       d.slope_unknown,     d.slope_fitted,         jnum(d.band_px),
+      d.worst.x,   d.worst.y,         jnum(d.worst_steps), jnum(d.worst_allowance)};
+  x["s"] = {s.compared,
+            jnum(s.max_abs),
+            jnum(s.mean_abs),
+            jnum(s.rmse),
+            jnum(s.psnr_db),
+            jnum(s.p99_abs),
+            s.over_tolerance,
+            s.over_fail,
+            s.nonfinite,
+            jnum(s.max_abs_rgba[0]),
+            jnum(s.max_abs_rgba[1]),
+            jnum(s.max_abs_rgba[2]),
+            jnum(s.max_abs_rgba[3]),
+            s.worst.x,
+            s.worst.y,
+            jnum(s.worst_abs),
+            jnum(s.worst_allowance)};
+  x["t"] = {jnum(t.visibility.warn), jnum(t.visibility.fail),    jnum(t.depth.warn),
+            jnum(t.depth.fail),      jnum(t.depth_slope_factor), jnum(t.shading.warn),
+            jnum(t.shading.fail)};
+  x["fmt"] = {toString(t.depth_format), toString(t.color_format)};
+  x["a"] = shadingAllowanceText(t, d.band_px);
+  if (r.nonfinite_expected.total() + r.nonfinite_actual.total() > 0)
+    x["nf"] = {r.nonfinite_expected.nan, r.nonfinite_expected.inf, r.nonfinite_actual.nan,
+               r.nonfinite_actual.inf};
+  return x;
 }
 
 // Reports up to this many pairs carry every pair's row and section in the page; larger
@@ -551,18 +575,30 @@ std::string matrix(const Report& report, const Columns& columns) {
   // A run renders at least two backends (the compared one and --against), so it always
   // gets the matrix; a single `compare` does not.
   if (columns.names.empty() || (columns.names.size() < 2 && report.command != "run")) return "";
+  // Many fixtures: only those with a pair that did not pass, the worst first, at most
+  // kMatrixRows of them (the pairs table lists them all).
   std::vector<std::string> rows = fixtures;
-  if (fixtures.size() > kMatrixRows)
+  std::size_t not_passing = fixtures.size();
+  if (fixtures.size() > kMatrixRows) {
     std::erase_if(rows, [&](const std::string& f) { return all_pass[f]; });
+    not_passing = rows.size();
+    std::map<std::string, int> worst;
+    for (const auto& [key, cell] : cells)
+      worst[key.first] = std::max(worst[key.first], static_cast<int>(cell.first));
+    std::stable_sort(rows.begin(), rows.end(), [&](const std::string& a, const std::string& b) {
+      return worst[a] > worst[b];
+    });
+    if (rows.size() > kMatrixRows) rows.resize(kMatrixRows);
+  }
   std::string out = "<h2>Fixture &times; backend</h2>";
   if (columns.one_expected)
     out += fmt::format("<div class=\"meta\">every backend compared against {}</div>",
                        esc(report.results.front().expected));
   if (rows.size() < fixtures.size())
     out += fmt::format(
-        "<div class=\"meta\">only the {} fixtures with a pair that did not pass; {} fixtures "
-        "pass on every backend</div>",
-        rows.size(), fixtures.size() - rows.size());
+        "<div class=\"meta\">{} of the {} fixtures with a pair that did not pass, the worst "
+        "first ({} fixtures pass on every backend; the pairs table below lists every pair)</div>",
+        rows.size(), not_passing, fixtures.size() - not_passing);
   out += "<table id=\"matrix\"><tr><th>fixture</th>";
   for (const std::string& b : columns.names) out += fmt::format("<th>{}</th>", esc(b));
   out += "</tr>";
@@ -635,34 +671,6 @@ std::string signature(const PairResult& r) {
   return fmt::format("{}", fmt::join(parts, " + "));
 }
 
-// The table row of pair k.
-std::string pairRow(const PairResult& r, std::size_t k) {
-  std::string out = fmt::format("<tr class=\"pair-row\" data-k=\"{}\">", k);
-  out += cell(fmt::format("<a href=\"#pair-{}\">{}</a>", k, esc(r.fixture)), r.fixture, false);
-  out += cell(esc(r.expected), r.expected, false);
-  out += cell(esc(r.actual), r.actual, false);
-  out += cell(badge(r.status), fmt::format("{}", static_cast<int>(r.status)), true);
-  if (r.status == Status::Error) {
-    for (int c = 0; c < 12; ++c) out += emptyCell();
-  } else {
-    out += countCell(r.visibility.hard);
-    out += countCell(r.visibility.ambiguous);
-    out += countCell(r.visibility.missing);
-    out += countCell(r.visibility.extra);
-    out += countCell(r.visibility.wrong_primitive);
-    out += numCell(r.depth.max_steps);
-    out += numCell(r.depth.p99_steps);
-    out += countCell(r.depth.over_tolerance);
-    out += numCell(r.shading.max_abs);
-    out += numCell(r.shading.mean_abs);
-    out += numCell(r.shading.psnr_db);
-    out += countCell(r.shading.over_tolerance);
-  }
-  return out + "</tr>";
-}
-
-nlohmann::json finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
 // The legal variants each GL backend follows (report.variants, see docs/debugging.md).
 std::string variantsTable(const Report& report) {
   if (!report.variants.is_object() || report.variants.empty()) return "";
@@ -710,15 +718,9 @@ std::string variantsTable(const Report& report) {
 std::string reportHtml(const Report& report, const fs::path& report_dir) {
   const ReportSummary sum = report.summary();
   const bool big = report.results.size() > kStaticPairs;
-  std::string gradient;
-  for (const Rgb8& c : heatColorStops(9)) {
-    if (!gradient.empty()) gradient += ',';
-    gradient += hex(c);
-  }
   const Columns columns = columnsOf(report);
 
-  // Groups: one per (status, signature) of the pairs that did not pass, worst status
-  // first, then the largest; then one for every passing pair.
+  // Groups: one per (status, signature); the worst status first, then the largest.
   struct Group {
     Status status;
     std::string signature;
@@ -726,7 +728,6 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
   };
   std::vector<Group> groups;
   std::map<std::pair<int, std::string>, std::size_t> group_of_key;
-  std::vector<std::size_t> group_of(report.results.size());
   for (std::size_t k = 0; k < report.results.size(); ++k) {
     const PairResult& r = report.results[k];
     const auto key = std::make_pair(static_cast<int>(r.status), signature(r));
@@ -737,15 +738,12 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
     }
     groups[it->second].pairs.push_back(k);
   }
-  std::vector<std::size_t> order(groups.size());
-  for (std::size_t g = 0; g < order.size(); ++g) order[g] = g;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    if (groups[a].status != groups[b].status)
-      return static_cast<int>(groups[a].status) > static_cast<int>(groups[b].status);
-    if (groups[a].pairs.size() != groups[b].pairs.size())
-      return groups[a].pairs.size() > groups[b].pairs.size();
-    return groups[a].signature < groups[b].signature;
+  std::stable_sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) {
+    if (a.status != b.status) return static_cast<int>(a.status) > static_cast<int>(b.status);
+    if (a.pairs.size() != b.pairs.size()) return a.pairs.size() > b.pairs.size();
+    return a.signature < b.signature;
   });
+  std::vector<std::size_t> group_of(report.results.size());
   for (std::size_t g = 0; g < groups.size(); ++g)
     for (std::size_t k : groups[g].pairs) group_of[k] = g;
   std::vector<std::string> tags;
@@ -755,8 +753,8 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
   std::sort(tags.begin(), tags.end());
 
   std::string out = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">";
-  out += fmt::format("<title>{} report</title><style>{}</style></head><body>",
-                     esc(report.tool_name), kStyle);
+  out += fmt::format("<title>{} report</title><style>{}{}</style></head><body>",
+                     esc(report.tool_name), kStyle, legendStyle());
   out += fmt::format("<h1>{} report</h1><div class=\"meta\">{} {}{}</div>", esc(report.tool_name),
                      esc(report.tool_name), esc(report.tool_version),
                      report.command.empty() ? "" : " &middot; " + esc(report.command));
@@ -766,8 +764,8 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       "<div>exit code<b>{}</b></div></div>",
       sum.total(), sum.pass, sum.warn, sum.fail, sum.error, exitCodeFor(report));
   out += backendCounts(report, columns);
-  out += matrix(report, columns);
-  out += variantsTable(report);
+  // Large reports: the groups of failures come before the (shortened) matrix.
+  if (!big) out += matrix(report, columns) + variantsTable(report);
 
   out +=
       "<h2>Pairs</h2><div class=\"controls\"><input id=\"filter\" type=\"search\" "
@@ -795,31 +793,29 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
   for (const auto& [name, numeric] : heads)
     out += fmt::format("<th data-type=\"{}\">{}</th>", numeric ? "num" : "text", name);
   out += "</tr></thead>";
-  for (const std::size_t g : order) {
+  // Group heads only: the script builds the rows (all of them at once for small reports).
+  for (std::size_t g = 0; g < groups.size(); ++g) {
     const Group& group = groups[g];
-    const bool pass = group.status == Status::Pass;
-    const bool lazy = pass && big;  // passing rows of large reports: built when opened
     std::map<std::size_t, std::size_t> per_column;
     for (std::size_t k : group.pairs) ++per_column[columns.of[k]];
     std::string by;
     for (const auto& [b, n] : per_column)
       by += fmt::format("{}{} {}", by.empty() ? "" : ", ", columns.names[b], n);
     out += fmt::format(
-        "<tbody data-group=\"{}\"{}{}><tr class=\"group-head\"><th colspan=\"16\"><span "
-        "class=\"fold\"></span>{} <span class=\"sig\">{}</span> &mdash; <span "
-        "class=\"count\">{}</span> pairs <span class=\"by\">({})</span></th></tr>",
-        g, lazy ? " class=\"collapsed\"" : "", lazy ? " data-lazy=\"1\"" : "", badge(group.status),
-        esc(pass ? std::string("every class passes") : group.signature), group.pairs.size(),
-        esc(by));
-    if (!lazy)
-      for (std::size_t k : group.pairs) out += pairRow(report.results[k], k);
-    out += "</tbody>";
+        "<tbody data-group=\"{}\" data-lazy=\"1\"{}><tr class=\"group-head\"><th colspan=\"16\">"
+        "<span class=\"fold\"></span>{} <span class=\"sig\">{}</span> &mdash; <span "
+        "class=\"count\">{}</span> pairs <span class=\"by\">({})</span></th></tr></tbody>",
+        g, big ? " class=\"collapsed\"" : "", badge(group.status),
+        esc(group.status == Status::Pass ? std::string("every class passes") : group.signature),
+        group.pairs.size(), esc(by));
   }
   out += "</table>";
+  if (!big) out += "<h2>Details</h2><div id=\"details\"></div>";
+  if (big) out += matrix(report, columns) + variantsTable(report);
 
-  // Every pair as data: what the filters, counts and built rows need.
+  // Every pair as data: the rows, the filters, and what each section shows.
   nlohmann::json pairs = nlohmann::json::array();
-  nlohmann::json details = nlohmann::json::array();
+  nlohmann::json sections = nlohmann::json::array();
   for (std::size_t k = 0; k < report.results.size(); ++k) {
     const PairResult& r = report.results[k];
     nlohmann::json classes = nlohmann::json::array();
@@ -833,30 +829,20 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       tag_ids.push_back(std::find(tags.begin(), tags.end(), t) - tags.begin());
     nlohmann::json numbers;
     if (r.status != Status::Error)
-      numbers = {
-          r.visibility.hard,          r.visibility.ambiguous,       r.visibility.missing,
-          r.visibility.extra,         r.visibility.wrong_primitive, finite(r.depth.max_steps),
-          finite(r.depth.p99_steps),  r.depth.over_tolerance,       finite(r.shading.max_abs),
-          finite(r.shading.mean_abs), finite(r.shading.psnr_db),    r.shading.over_tolerance};
+      numbers = {r.visibility.hard,        r.visibility.ambiguous,       r.visibility.missing,
+                 r.visibility.extra,       r.visibility.wrong_primitive, jnum(r.depth.max_steps),
+                 jnum(r.depth.p99_steps),  r.depth.over_tolerance,       jnum(r.shading.max_abs),
+                 jnum(r.shading.mean_abs), jnum(r.shading.psnr_db),      r.shading.over_tolerance};
     pairs.push_back({r.fixture, r.expected, r.actual, toString(r.status), columns.of[k], classes,
                      tag_ids, group_of[k], numbers});
-    if (big)
-      details.push_back(r.status == Status::Pass && r.images.empty()
-                            ? nlohmann::json()
-                            : nlohmann::json(pairSection(r, k, report_dir, gradient)));
+    sections.push_back(sectionData(r, report_dir, !big || r.status != Status::Pass));
   }
-  if (!big) {
-    out += "<h2>Details</h2>";
-    for (std::size_t k = 0; k < report.results.size(); ++k)
-      out += pairSection(report.results[k], k, report_dir, gradient);
-  }
-  nlohmann::json data = {{"big", big}, {"pairs", pairs}};
-  if (big) data["details"] = details;
+  const nlohmann::json data = {{"big", big}, {"pairs", pairs}, {"details", sections}};
   // Inside <script>, "</script>" or "<!--" in a name would end or confuse the element:
   // JSON may spell every '<' as \u003c (it can only occur inside strings).
-  std::string text = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  const std::string text = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   std::string safe;
-  safe.reserve(text.size());
+  safe.reserve(text.size() + text.size() / 64);
   for (const char ch : text) {
     if (ch == '<')
       safe += "\\u003c";

@@ -166,7 +166,7 @@ MergedRuns mergeRunReports(const std::vector<fs::path>& run_dirs) {
 
   const bool sharded = !parts.front().report.shard.empty();
   for (const Part& p : parts) {
-    if (p.report.shard.empty() == sharded) continue;
+    if (p.report.shard.empty() != sharded) continue;
     throw InputError(fmt::format("{}: {} a shard, but {} {}", p.file.string(),
                                  sharded ? "is not" : "is", parts.front().file.string(),
                                  sharded ? "is" : "is not"));

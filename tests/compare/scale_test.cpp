@@ -277,8 +277,8 @@ TEST(BigReport, TenThousandPairsOpenQuicklyWithFailuresFirst) {
   EXPECT_NE(html.substr(error_group, 400).find("badge error"), std::string::npos);
   EXPECT_LT(html.find("badge fail\">fail</span> <span class=\"sig\">visibility (missing)"),
             html.find("badge warn\">warn</span> <span class=\"sig\">shading"));
-  EXPECT_NE(html.find("class=\"collapsed\" data-lazy=\"1\""), std::string::npos);
-  EXPECT_NE(html.find("only the 2625 fixtures with a pair that did not pass"), std::string::npos)
+  EXPECT_NE(html.find("data-lazy=\"1\" class=\"collapsed\""), std::string::npos);
+  EXPECT_NE(html.find("40 of the 1700 fixtures with a pair that did not pass"), std::string::npos)
       << "the matrix lists only fixtures that did not pass";
   EXPECT_EQ(html.find(" src=\""), std::string::npos) << "no image loads with the page";
   EXPECT_LT(html.size(), 8u * 1024 * 1024);
@@ -289,7 +289,7 @@ TEST(BigReport, TenThousandPairsOpenQuicklyWithFailuresFirst) {
   const Page empty = openInChromium(dir / "empty.html");
   const Page page = openInChromium(dir / "report.html");
   ASSERT_EQ(page.attrs.count("data-ready"), 1u) << "the page's script did not finish";
-  EXPECT_EQ(page.attrs.at("data-rows-rendered"), static_cast<double>(s.total() - s.pass));
+  EXPECT_EQ(page.attrs.at("data-rows-rendered"), 0) << "rows are built when a group opens";
   EXPECT_EQ(page.attrs.at("data-images-ok"), 0);
   // How long the page took to be ready, from navigation start (performance.now()).
   ASSERT_EQ(page.attrs.count("data-ready-ms"), 1u);
@@ -303,7 +303,11 @@ TEST(BigReport, TenThousandPairsOpenQuicklyWithFailuresFirst) {
   EXPECT_NE(page.dom.find(std::to_string(s.total()) + " of " + std::to_string(s.total()) +
                           " pairs shown"),
             std::string::npos);
-  fs::remove_all(dir);
+  // RC_KEEP_OUTPUT=1 keeps the page for people to look at.
+  if (std::getenv("RC_KEEP_OUTPUT"))
+    std::printf("report kept in %s\n", dir.c_str());
+  else
+    fs::remove_all(dir);
 }
 
 }  // namespace

@@ -124,8 +124,8 @@ TEST(GlWorkers, TheFaultsHangAndCrashARenderOnTheirOwn) {
                              " --backend gl:egl:llvmpipe --out " + (dir / "f").string();
   const Result crashed = run(render, std::string("RASTERCHECK_GL_FAULT=crash=") + kVictim);
   EXPECT_EQ(crashed.code, 128 + 11) << crashed.out;  // SIGSEGV
-  const Result hung = run("timeout -s KILL 3 " RC_EXE " " + render.substr(0),
-                          std::string("RASTERCHECK_GL_FAULT=hang=") + kVictim);
+  const Result hung = rc::test::runShell(std::string("RASTERCHECK_GL_FAULT=hang=") + kVictim +
+                                         " timeout -s KILL 3 " RC_EXE " " + render);
   EXPECT_EQ(hung.code, 128 + 9) << hung.out;  // killed by timeout(1)
   // Another fixture is not hit.
   const Result other = run("render " + catalog("coverage/triangle_fan.json") +
