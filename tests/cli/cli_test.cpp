@@ -185,7 +185,15 @@ TEST(CliCompare, IdenticalFramesPassWithTheSummaryAndReportPath) {
   EXPECT_NE(r.out.find("1 pairs: 1 pass"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.substr(r.out.size() - 5), "PASS\n") << r.out;
   expectReportFiles(out);
-  EXPECT_TRUE(fs::is_directory(out / "pairs" / "coverage_triangle_fan"));
+  const fs::path pair = out / "pairs" / "coverage_triangle_fan" / "ref_vs_ref_subpixel_8";
+  EXPECT_TRUE(fs::is_regular_file(pair / "visibility.png"));
+  // A passing pair gets no diff.exr (75 MB at 1080p) unless asked for.
+  EXPECT_FALSE(fs::exists(pair / "diff.exr"));
+  EXPECT_EQ(readFile(out / "report.json").find("diff_exr"), std::string::npos);
+  const Result forced = run("compare " + a.string() + " " + b.string() + " --diff-exr --out " +
+                            out.string());
+  EXPECT_EQ(forced.code, 0) << forced.out;
+  EXPECT_TRUE(fs::is_regular_file(pair / "diff.exr"));
 }
 
 TEST(CliCompare, AFailingPairExitsOne) {
