@@ -47,7 +47,7 @@ struct FixtureEntry {
   std::string name;
   std::string slug;  // unique folder name
   ToleranceOverrides tolerance;
-  double cost = 0.0;  // renderCost (compare/shards.h)
+  double raster = 0.0;  // rasterCost (compare/shards.h)
 };
 
 // One compared pair of the whole run: fixture, actual backend, place in the report.
@@ -191,7 +191,7 @@ int runCommand(const RunArgs& args) {
     std::string slug = fixtureSlug(scene.name);
     for (int k = 2; !slugs.insert(slug).second; ++k)
       slug = fixtureSlug(scene.name) + "~" + std::to_string(k);
-    fixtures.push_back({fs::absolute(file), scene.name, slug, scene.tolerance, renderCost(scene)});
+    fixtures.push_back({fs::absolute(file), scene.name, slug, scene.tolerance, rasterCost(scene)});
   }
   if (fixtures.empty()) throw InputError("run: no fixtures found in the given paths");
 
@@ -208,10 +208,11 @@ int runCommand(const RunArgs& args) {
     std::vector<ShardUnit> units;
     for (const PairPlan& p : pairs)
       units.push_back(
-          {p.fixture, fixtures[p.fixture].cost * backendWeight(backends[p.backend].text)});
+          {p.fixture, renderCost(fixtures[p.fixture].raster, backends[p.backend].text)});
     std::vector<double> shared;
     for (const FixtureEntry& fx : fixtures)
-      shared.push_back(fx.cost * (backendWeight(against.text) + (needs_ref ? 1.0 : 0.0)));
+      shared.push_back(renderCost(fx.raster, against.text) +
+                       (needs_ref ? renderCost(fx.raster, "ref") : 0.0));
     const std::vector<int> plan = assignShards(units, shared, shard.count);
     std::vector<std::string> digest_parts = {against.text, std::to_string(shard.count)};
     for (const BackendSpec& b : backends) digest_parts.push_back(b.text);

@@ -34,12 +34,15 @@ ShardSpec parseShard(std::string_view text);
 // does not). Throws InputError when none is set or a value is malformed.
 ShardSpec shardFromEnvironment();
 
-// Expected render cost of a fixture, in arbitrary units comparable between fixtures: a
-// fixed part per render plus pixels and triangles (docs/scaling.md gives the measurements).
-double renderCost(const Scene& scene);
-// How much slower than llvmpipe a backend renders the same fixture (softpipe rasterizes
-// on one thread with no JIT).
+// The expected cost of rasterizing a fixture, in units of one pixel's shading on llvmpipe
+// (comparable between fixtures): pixels x (1 + lights / 2) + 50 x triangles.
+double rasterCost(const Scene& scene);
+// How long a backend takes for the same fixture, relative to llvmpipe (softpipe
+// rasterizes on one thread with no JIT; the reference is scalar but has no driver).
 double backendWeight(std::string_view spec);
+// The expected cost of one render of a fixture with raster cost `raster` by `spec`: a
+// fixed part per render plus the weighted rasterization (docs/scaling.md).
+double renderCost(double raster, std::string_view spec);
 
 // One pair of the whole run: its fixture and the cost of its own render (the actual
 // backend); `shared` below is the cost of the renders every pair of a fixture needs
