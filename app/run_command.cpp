@@ -206,10 +206,12 @@ int runCommand(const RunArgs& args) {
   nlohmann::json shard_block = nlohmann::json::object();
   if (sharded) {
     std::vector<ShardUnit> units;
+    units.reserve(pairs.size());
     for (const PairPlan& p : pairs)
       units.push_back(
           {p.fixture, renderCost(fixtures[p.fixture].raster, backends[p.backend].text)});
     std::vector<double> shared;
+    shared.reserve(fixtures.size());
     for (const FixtureEntry& fx : fixtures)
       shared.push_back(renderCost(fx.raster, against.text) +
                        (needs_ref ? renderCost(fx.raster, "ref") : 0.0));
@@ -240,7 +242,7 @@ int runCommand(const RunArgs& args) {
     std::vector<std::string>& n = needed[p.fixture];
     if (n.empty()) {
       n.push_back(against.text);
-      if (needs_ref && against.text != "ref") n.push_back("ref");
+      if (needs_ref && against.text != "ref") n.emplace_back("ref");
     }
     if (std::find(n.begin(), n.end(), backends[p.backend].text) == n.end())
       n.push_back(backends[p.backend].text);
@@ -293,7 +295,7 @@ int runCommand(const RunArgs& args) {
       std::set<std::string> kept;
       // Frames (and what the worker printed) of the renders a non-passing pair shows.
       auto keepFrame = [&](const std::string& spec) -> fs::path {
-        const fs::path frame_dir = dir / fixtureSlug(spec);
+        fs::path frame_dir = dir / fixtureSlug(spec);
         if (kept.insert(spec).second) {
           const RenderOutcome& o = outs.at(spec);
           if (o.ok) writeFrameDir(o.frame, frame_dir);
@@ -363,7 +365,7 @@ int runCommand(const RunArgs& args) {
         std::count_if(left.begin(), left.end(), [](std::size_t n) { return n > 0; }));
     while (pool.outstanding() > 0) {
       // Frames wait in memory until compared: do not render far ahead of the comparator.
-      const bool start_more = comparer.backlog() < static_cast<std::size_t>(2 * parallel + 2);
+      const bool start_more = comparer.backlog() < 2 * static_cast<std::size_t>(parallel) + 2;
       for (auto& [ticket, outcome] : pool.poll(start_more ? 200 : 20, start_more)) {
         if (const auto it = std::find(probe_tickets.begin(), probe_tickets.end(), ticket);
             it != probe_tickets.end()) {

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // What a log slice may contribute: a driver printing megabytes must not fill memory.
-constexpr std::uintmax_t kMaxLogBytes = 64 * 1024;
+constexpr std::uintmax_t kMaxLogBytes = std::uintmax_t{64} * 1024;
 
 void closeFd(int& fd) {
   if (fd >= 0) ::close(fd);
@@ -122,6 +122,7 @@ WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
   const std::string exe = selfExecutable().string();
   std::vector<std::string> args = {exe, "worker", "--backend", spec};
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   const int err = posix_spawn(&w->pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
@@ -315,6 +316,7 @@ std::vector<std::pair<std::size_t, RenderOutcome>> WorkerPool::poll(int wait_ms,
 
 std::vector<RenderOutcome> WorkerPool::renderAll(const std::vector<RenderRequest>& requests) {
   std::vector<std::size_t> tickets;
+  tickets.reserve(requests.size());
   for (const RenderRequest& r : requests) tickets.push_back(submit(r));
   std::vector<RenderOutcome> out(requests.size());
   std::size_t left = requests.size();

@@ -258,7 +258,7 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
   }
   if (row.contains("images") && row["images"].is_object()) {
     for (const auto& [kind, file] : row["images"].items()) {
-      if (!file.is_string()) r.fail(at + ".images." + kind, "must be a string");
+      if (!file.is_string()) r.fail(fmt::format("{}.images.{}", at, kind), "must be a string");
       p.images[kind] = report_dir / fs::path(file.get<std::string>());
     }
   }
