@@ -20,6 +20,10 @@ int runCli(int argc, char** argv) {
       "3 a backend could not run."};
   app.set_version_flag("--version", std::string("rastercheck ") + kVersion);
   app.require_subcommand(1);
+  // Usage errors in one line, as every other error (CLI11 adds a second by default).
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("rastercheck: error: ") + e.what() + " (see --help)\n";
+  });
 
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "Render one fixture with one backend");
@@ -37,6 +41,30 @@ int runCli(int argc, char** argv) {
   list_cmd->add_option("paths", list.paths, "Fixture files or folders (default: the catalog)");
   list_cmd->add_flag("--json", list.json, "Print JSON");
   list_cmd->add_flag("--markdown", list.markdown, "Print a Markdown table");
+
+  GenerateArgs generate;
+  CLI::App* generate_cmd =
+      app.add_subcommand("generate", "Write reproducible random fixtures (docs/random-scenes.md)");
+  generate_cmd->add_option("--seed,-s", generate.seed, "Seed (0 to 2^64 - 1)")
+      ->required()
+      ->type_name("UINT");
+  generate_cmd->add_option("--count,-n", generate.count, "Number of fixtures")
+      ->capture_default_str();
+  generate_cmd
+      ->add_option("--first", generate.first,
+                   "Index of the first fixture (scene i is the same whatever the count)")
+      ->capture_default_str();
+  generate_cmd->add_option("--out,-o", generate.out, "Output folder (replaced whole if generated)")
+      ->required();
+  generate_cmd->add_option("--max-size", generate.max_size, "Largest image, WxH")
+      ->capture_default_str();
+  generate_cmd
+      ->add_option("--profile", generate.profile,
+                   "Feature mix: all, generators, soups, meshes, textures, blend")
+      ->capture_default_str();
+  generate_cmd->add_option(
+      "--meshes", generate.meshes,
+      "Folder of assimp-testmodels' models (default /usr/share/assimp/models)");
 
   CompareArgs compare;
   CLI::App* compare_cmd =
@@ -158,6 +186,7 @@ int runCli(int argc, char** argv) {
   try {
     if (*render_cmd) return renderCommand(render);
     if (*list_cmd) return listCommand(list);
+    if (*generate_cmd) return generateCommand(generate);
     if (*compare_cmd) return compareCommand(compare);
     if (*run_cmd) return runCommand(run);
     if (*accuracy_cmd) return accuracyCommand(accuracy);

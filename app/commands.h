@@ -2,6 +2,7 @@
 // and throws InputError / BackendError for the caller to report in one line.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -14,6 +15,17 @@ struct RenderArgs {
   std::filesystem::path out;
 };
 int renderCommand(const RenderArgs& args);
+
+struct GenerateArgs {
+  std::string seed;         // 0 .. 2^64 - 1, decimal (checked here: CLI11 wraps "-1")
+  std::string first = "0";  // index of the first fixture, same range
+  std::int64_t count = 100;
+  std::filesystem::path out;
+  std::string max_size = "200x150";  // WxH
+  std::string profile = "all";
+  std::filesystem::path meshes;  // empty: /usr/share/assimp/models
+};
+int generateCommand(const GenerateArgs& args);
 
 struct ListArgs {
   std::vector<std::filesystem::path> paths;

@@ -12,7 +12,7 @@ packages=(
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
   libassimp-dev assimp-testmodels
   nlohmann-json3-dev libcli11-dev libfmt-dev
-  libpugixml-dev python3-jsonschema
+  libpugixml-dev python3-jsonschema zlib1g-dev
 )
 if [[ "${RASTERCHECK_SETUP_BROWSER:-1}" == 1 ]]; then
   packages+=(chromium)
