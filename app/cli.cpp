@@ -92,6 +92,8 @@ int runCli(int argc, char** argv) {
   compare_cmd->add_option("--tolerance,-t", compare.tolerance,
                           "Override a threshold: CLASS.KEY=VALUE (visibility|depth|shading . "
                           "warn|fail, depth.slope_factor); repeatable");
+  compare_cmd->add_flag("--diff-exr", compare.diff_exr,
+                        "Write diff.exr also when the pair passes (by default only when not)");
 
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand(
@@ -108,6 +110,18 @@ int runCli(int argc, char** argv) {
   run_cmd->add_option("--expectations", run.expectations,
                       "Known driver differences to mark as known failures: a file, or 'none' "
                       "(default: fixtures/expectations.json)");
+  run_cmd
+      ->add_option("--timeout", run.timeout_seconds,
+                   "Seconds one render may take before its worker is killed and the pair is an "
+                   "error row (0: no watchdog)")
+      ->capture_default_str();
+  run_cmd->add_flag("--keep-frames", run.keep_frames,
+                    "Write frames and pair images of passing pairs too (by default only of "
+                    "pairs that warn, fail or error)");
+  run_cmd->add_option("--shard", run.shard,
+                      "Run part K of N (K/N, 1-based) of the whole run, or `env`: from "
+                      "RASTERCHECK_SHARD, CI_NODE_INDEX/CI_NODE_TOTAL or "
+                      "JOB_COMPLETION_INDEX/JOB_COMPLETIONS; join the parts with `merge`");
   run_cmd->add_flag("!--no-variants", run.variants,
                     "Skip the variant probes (subpixel precision, tie-break, depth rounding) "
                     "of each GL backend");
@@ -199,6 +213,27 @@ int runCli(int argc, char** argv) {
   accuracy_cmd->add_option("--command", accuracy.command,
                            "How the document says it was made (Markdown)");
 
+  MergeArgs merge;
+  CLI::App* merge_cmd =
+      app.add_subcommand("merge", "Join the folders of `run --shard K/N` into one run's report");
+  merge_cmd->add_option("runs", merge.runs, "Folders written by `run --shard`")->required();
+  merge_cmd->add_option("--out,-o", merge.out, "Report folder")->required();
+
+  DiffRunsArgs diff_runs;
+  CLI::App* diff_runs_cmd = app.add_subcommand(
+      "diff-runs", "Regressions, fixes, new and vanished pairs between two run folders");
+  diff_runs_cmd->add_option("old", diff_runs.old_run, "The earlier run folder")->required();
+  diff_runs_cmd->add_option("new", diff_runs.new_run, "The later run folder")->required();
+  diff_runs_cmd->add_flag("--json", diff_runs.json, "Print JSON instead of text");
+  diff_runs_cmd->add_option("--out,-o", diff_runs.out,
+                            "Also write diff.txt, diff.json and diff.html into this folder");
+
+  // `run`'s workers (app/worker.h); not for people, so not in --help.
+  std::string worker_spec;
+  CLI::App* worker_cmd = app.add_subcommand("worker", "");
+  worker_cmd->group("");
+  worker_cmd->add_option("--backend", worker_spec)->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -228,6 +263,9 @@ int runCli(int argc, char** argv) {
       for (int i = 1; i < argc; ++i) campaign.command_line += " " + shellQuote(argv[i]);
       return campaignCommand(campaign);
     }
+    if (*merge_cmd) return mergeCommand(merge);
+    if (*diff_runs_cmd) return diffRunsCommand(diff_runs);
+    if (*worker_cmd) return workerCommand(worker_spec);
   } catch (const InputError& e) {
     std::cerr << "rastercheck: error: " << oneLineMessage(e.what()) << '\n';
     return kExitInput;

@@ -3,11 +3,13 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "app/paths.h"
+#include "app/worker_pool.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 
@@ -30,15 +32,8 @@ Job renderJob(const fs::path& scene_file, const std::string& spec, const fs::pat
 
 std::string childFailure(const Job& job, const std::vector<std::string>& also_strip) {
   std::ifstream in(job.log);
-  std::string line;
-  std::string last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  for (const char* prefix :
-       {"rastercheck: backend error: ", "rastercheck: error: ", "rastercheck: internal error: "}) {
-    if (last.rfind(prefix, 0) == 0) last = last.substr(std::string(prefix).size());
-  }
+  std::string last = lastErrorLine(
+      std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
   for (const std::string& prefix : also_strip) {
     if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
   }

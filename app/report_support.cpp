@@ -66,23 +66,33 @@ nlohmann::json driverStack(const Frame& frame) {
 
 }  // namespace
 
-PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
-                       const Tolerances& tolerances, ReportFolder& folder,
-                       const PairPictures& pictures) {
-  ClassMaps maps;
-  PairResult result = compareFrames(expected, actual, uncertainty, tolerances, &maps);
-  auto name = [](const Frame& f, const char* fallback) {
-    return f.meta.contains("backend") && f.meta["backend"].is_string()
-               ? f.meta["backend"].get<std::string>()
-               : std::string(fallback);
+PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                        const Tolerances& tolerances, ClassMaps* maps) {
+  PairResult result = compareFrames(expected, actual, uncertainty, tolerances, maps);
+  auto text = [](const Frame& f, const char* key, const char* fallback) {
+    return f.meta.contains(key) && f.meta[key].is_string() ? f.meta[key].get<std::string>()
+                                                           : std::string(fallback);
   };
-  result.expected = name(expected, "expected");
-  result.actual = name(actual, "actual");
+  result.expected = text(expected, "backend", "expected");
+  result.actual = text(actual, "backend", "actual");
   result.expected_stack = driverStack(expected);
   result.actual_stack = driverStack(actual);
-  if (expected.meta.contains("fixture") && expected.meta["fixture"].is_string())
-    result.fixture = expected.meta["fixture"].get<std::string>();
-  writePairImages(expected, actual, maps, folder.pairDirectory(result), result, pictures);
+  result.fixture = text(expected, "fixture", "");
+  result.fixture_file = text(expected, "fixture_file", "");
+  if (expected.meta.contains("tags") && expected.meta["tags"].is_array())
+    for (const nlohmann::json& t : expected.meta["tags"])
+      if (t.is_string()) result.tags.push_back(t.get<std::string>());
+  setHeatScales(result);
+  return result;
+}
+
+PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                       const Tolerances& tolerances, ReportFolder& folder,
+                       const PairPictures& pictures, bool diff_exr_when_passing) {
+  ClassMaps maps;
+  PairResult result = compareNamed(expected, actual, uncertainty, tolerances, &maps);
+  writePairImages(expected, actual, maps, folder.pairDirectory(result), result, pictures,
+                  diff_exr_when_passing || result.status != Status::Pass);
   return result;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <mutex>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -31,11 +32,18 @@ Tolerances pairTolerances(const Frame& expected, const Frame& actual,
 
 class ReportFolder;
 
+// Compares without writing anything: the result named from the frames' frame.json
+// (fixture, backends, fixture file, tags, driver stacks), with its heat scales; `maps` as
+// compareFrames.
+PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                        const Tolerances& tolerances, ClassMaps* maps);
+
 // Compares and writes the pair's images into the report folder (a folder of its own for
-// every pair: ReportFolder::pairDirectory).
+// every pair: ReportFolder::pairDirectory); diff.exr only when the pair does not pass,
+// unless diff_exr_when_passing.
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, ReportFolder& folder,
-                       const PairPictures& pictures = {});
+                       const PairPictures& pictures = {}, bool diff_exr_when_passing = true);
 
 // A frame folder's color.png when it shows `frame` (frame.json's "color_digest", written
 // by `render`, matches the frame that was read), else empty: then the comparator encodes
@@ -58,13 +66,16 @@ class ReportFolder {
   const std::filesystem::path& path() const { return folder_.target(); }
   const std::filesystem::path& staging() const { return folder_.staging(); }
   // A fresh folder under staging() for one pair's images, unique whatever the names.
+  // Thread-safe: `run` compares fixtures on several threads.
   std::filesystem::path pairDirectory(const PairResult& result) {
+    const std::lock_guard lock(pairs_mutex_);
     return pairs_.take(staging(), result);
   }
   void commit(const Report& report);
 
  private:
   OutputFolder folder_;
+  std::mutex pairs_mutex_;
   PairFolders pairs_;
 };
 

@@ -34,8 +34,16 @@ struct Faults {
   // or src*(1-a) + dst*a, instead of src*a + dst*(1-a).
   enum class Blend { Correct, One, Swapped };
   Blend blend_factor = Blend::Correct;
+  // hang=NAME / crash=NAME: the render of the fixture named NAME ("*": every fixture) never
+  // returns (blocks after the draw, as a driver stuck in a fence would) or dies with
+  // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.
+  std::string hang;
+  std::string crash;
 
   bool any() const;
+  // Whether hang / crash apply to the fixture named `fixture`.
+  bool hangs(const std::string& fixture) const;
+  bool crashes(const std::string& fixture) const;
   // The canonical comma-separated form (parseFaults(describe()) gives the same faults).
   std::string describe() const;
 };

@@ -459,12 +459,25 @@ TEST(GlFaultParse, CanonicalFormRoundTrips) {
   EXPECT_FALSE(gl::testing::parseFaults("").any());
 }
 
+TEST(GlFaultParse, HangAndCrashNameTheFixtureTheyHit) {
+  const Faults f = gl::testing::parseFaults("hang=coverage/triangle_fan,crash=*");
+  EXPECT_TRUE(f.any());
+  EXPECT_TRUE(f.hangs("coverage/triangle_fan"));
+  EXPECT_FALSE(f.hangs("coverage/other"));
+  EXPECT_TRUE(f.crashes("anything"));
+  EXPECT_EQ(f.describe(), "hang=coverage/triangle_fan,crash=*");
+  EXPECT_EQ(gl::testing::parseFaults(f.describe()).describe(), f.describe());
+  const Faults none = gl::testing::parseFaults("light_scale=2");
+  EXPECT_FALSE(none.hangs("x"));
+  EXPECT_FALSE(none.crashes("x"));
+}
+
 TEST(GlFaultParse, BadEntriesAreInputErrorsNamingTheVariable) {
   for (const char* bad :
        {"frobnicate", "drop_primitive", "drop_primitive=0", "drop_primitive=x", "depth_bias=1.5",
         "light_scale=nan", "light_scale=", "no_inverse_transpose=1", "shift_x=inf",
         "shader_compile_error=yes", "light_scale=2,bogus=1", "move_vertex=0", "move_vertex",
-        "texel_offset=x", "blend_factor=zero", "blend_factor"}) {
+        "texel_offset=x", "blend_factor=zero", "blend_factor", "hang", "hang=", "crash"}) {
     try {
       gl::testing::parseFaults(bad);
       ADD_FAILURE() << bad << " was accepted";
