@@ -186,6 +186,10 @@ int runCli(int argc, char** argv) {
                            "Children at a time (default: one per core)");
   campaign_cmd->add_option("--batch", campaign.batch, "Scenes per `run` child")
       ->capture_default_str();
+  campaign_cmd->add_option("--expectations", campaign.expectations,
+                           "Known driver differences, as for run: a group every failure of "
+                           "which one covers is reported as known and does not fail the "
+                           "campaign (default: fixtures/expectations.json)");
   campaign_cmd->add_option("--profile", campaign.profile, "Feature mix, as for generate")
       ->capture_default_str();
   campaign_cmd->add_option("--max-size", campaign.max_size, "Largest image, WxH")

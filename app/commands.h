@@ -130,9 +130,12 @@ struct CampaignArgs {
   std::string against = "ref";
   std::filesystem::path out;
   std::vector<std::string> tolerance;
-  double reduce_seconds = 60.0;     // per failure; 0: do not reduce (probe the original)
-  int jobs = 0;                     // 0: one per core
-  int batch = 20;                   // scenes per `run`
+  double reduce_seconds = 60.0;  // per failure; 0: do not reduce (probe the original)
+  int jobs = 0;                  // 0: one per core
+  int batch = 20;                // scenes per `run`
+  // Known driver differences for the `run` children (as run --expectations): a file,
+  // "none", or empty for the default (fixtures/expectations.json).
+  std::string expectations;
   bool mutations = false;           // the mutation study instead of a failure campaign
   std::vector<std::string> faults;  // --mutations: the faults to inject (default: all)
   std::string command_line;         // as typed, for the summary

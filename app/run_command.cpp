@@ -30,8 +30,8 @@
 #include "app/report_support.h"
 #include "app/variants.h"
 #include "app/version.h"
-#include "compare/expectations.h"
 #include "app/worker_pool.h"
+#include "compare/expectations.h"
 #include "compare/report.h"
 #include "compare/shards.h"
 #include "fixtures/catalog.h"
@@ -201,10 +201,10 @@ int runCommand(const RunArgs& args) {
   std::set<std::string> slugs;
   // Every render's estimate within the limits, too (the reference always renders).
   const ResourceLimits limits = ResourceLimits::current();
-  const bool any_gl =
-      against.kind == BackendSpec::Kind::Gl ||
-      std::any_of(backends.begin(), backends.end(),
-                  [](const BackendSpec& b) { return b.kind == BackendSpec::Kind::Gl; });
+  const bool any_gl = against.kind == BackendSpec::Kind::Gl ||
+                      std::any_of(backends.begin(), backends.end(), [](const BackendSpec& b) {
+                        return b.kind == BackendSpec::Kind::Gl;
+                      });
   for (const fs::path& file : findFixtures(inputs)) {
     const Scene scene = loadScene(file);
     checkResources(scene, RendererKind::Reference, limits);

@@ -20,20 +20,6 @@
 namespace rc {
 namespace {
 
-// Our environment with the job's NAME=VALUE entries added or replacing ours.
-std::vector<std::string> childEnvironment(const std::vector<std::string>& extra) {
-  std::vector<std::string> out;
-  for (char** e = environ; *e != nullptr; ++e) {
-    const std::string entry(*e);
-    const std::string name = entry.substr(0, entry.find('='));
-    bool replaced = false;
-    for (const std::string& x : extra) replaced = replaced || x.substr(0, x.find('=')) == name;
-    if (!replaced) out.push_back(entry);
-  }
-  out.insert(out.end(), extra.begin(), extra.end());
-  return out;
-}
-
 pid_t spawn(const Job& job, bool own_process_group) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -80,6 +66,19 @@ void record(Job& job, int status) {
 }
 
 }  // namespace
+
+std::vector<std::string> childEnvironment(const std::vector<std::string>& extra) {
+  std::vector<std::string> out;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry(*e);
+    const std::string name = entry.substr(0, entry.find('='));
+    bool replaced = false;
+    for (const std::string& x : extra) replaced = replaced || x.substr(0, x.find('=')) == name;
+    if (!replaced) out.push_back(entry);
+  }
+  out.insert(out.end(), extra.begin(), extra.end());
+  return out;
+}
 
 void runJobs(std::vector<Job>& jobs, int parallel, const std::function<void(std::size_t)>& on_start,
              const std::function<void(std::size_t)>& on_done, const JobControl& control) {

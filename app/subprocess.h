@@ -11,6 +11,10 @@
 
 namespace rc {
 
+// This process's environment with the NAME=VALUE entries of `extra` added or replacing
+// ours (what a child is started with).
+std::vector<std::string> childEnvironment(const std::vector<std::string>& extra);
+
 struct Job {
   std::vector<std::string> argv;  // argv[0] is the program
   std::filesystem::path log;      // stdout and stderr of the child go here

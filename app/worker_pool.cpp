@@ -16,7 +16,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "app/backends.h"
 #include "app/paths.h"
+#include "app/subprocess.h"
 #include "app/worker.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
@@ -125,7 +127,19 @@ WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
   argv.reserve(args.size() + 1);
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  const int err = posix_spawn(&w->pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+  // A spec naming another Mesa's folder needs LD_LIBRARY_PATH from the worker's start (the
+  // dynamic loader reads it once), as `render` re-executes itself with it.
+  std::vector<std::string> extra;
+  const BackendSpec backend = parseBackendSpec(spec);
+  if (backend.kind == BackendSpec::Kind::Gl)
+    for (const auto& [name, value] : startupEnvironment(backend.gl))
+      extra.push_back(name + "=" + value);
+  std::vector<std::string> env_text = childEnvironment(extra);
+  std::vector<char*> envp;
+  envp.reserve(env_text.size() + 1);
+  for (std::string& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int err = posix_spawn(&w->pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   ::close(request[0]);
   ::close(reply[1]);

@@ -500,8 +500,8 @@ nlohmann::json sectionData(const PairResult& r, const fs::path& report_dir, bool
             v.worst.x,
             v.worst.y};
   x["z"] = {
-      d.compared,  jnum(d.max_steps), jnum(d.mean_steps), jnum(d.p99_steps),  d.over_tolerance,
-      d.over_fail, d.nonfinite,       d.blend_uncertain,  jnum(d.band_px),    d.worst.x,
+      d.compared,  jnum(d.max_steps),   jnum(d.mean_steps),     jnum(d.p99_steps), d.over_tolerance,
+      d.over_fail, d.nonfinite,         d.blend_uncertain,      jnum(d.band_px),   d.worst.x,
       d.worst.y,   jnum(d.worst_steps), jnum(d.worst_allowance)};
   x["s"] = {s.compared,
             jnum(s.max_abs),

@@ -165,6 +165,7 @@ json toJson(const CampaignFailure& f) {
             {"kind", f.kind},
             {"message", f.message},
             {"run", f.run},
+            {"known", f.known},
             {"images", f.images},
             {"reduction", f.reduction},
             {"reduced_file", f.reduced_file},
@@ -193,6 +194,7 @@ CampaignFailure campaignFailureFromJson(const json& j, const std::string& source
   f.message = r.text("message", false);
   f.run = r.text("run", false);
   f.images = r.text("images", false);
+  f.known = r.text("known", false);
   f.reduction = r.text("reduction", false);
   f.reduced_file = r.text("reduced_file", false);
   f.reduce_note = r.text("reduce_note", false);
@@ -248,6 +250,9 @@ std::vector<CampaignFailure> failuresOfReport(
       } else {
         f.message = classMessage(row, cls);
         if (cls == "visibility") f.kind = visibilityKind(row[cls]);
+        if (row.contains("known") && row["known"].is_array())
+          for (const json& k : row["known"])
+            if (k.is_object() && k.value("class", "") == cls) f.known = k.value("id", "");
       }
       out.push_back(std::move(f));
     };

@@ -32,7 +32,10 @@ struct CampaignFailure {
   std::string kind;     // visibility: missing, extra or wrong_primitive (most hard pixels)
   std::string message;  // the report row's one-line description (error: the error)
   std::string run;      // the run folder holding the row, relative to the campaign folder
-  std::string images;   // the pair's image folder, relative to the campaign folder
+  // The expectations entry (fixtures/expectations.json id) that covers this class of the
+  // row, as the run marked it ("known" in report.json); empty when none does.
+  std::string known;
+  std::string images;  // the pair's image folder, relative to the campaign folder
   // Reduction (`rastercheck reduce`): "reduced", "timed_out" (smallest failing scene
   // found in the time), "failed" (reduce could not run or did not reproduce), "skipped"
   // (errors are not reduced), or empty while pending.
@@ -92,10 +95,9 @@ std::string reproduceCommand(const std::filesystem::path& reproducer, const std:
                              const std::vector<std::string>& tolerance_args,
                              const std::filesystem::path& out);
 
-// Whether a known-differences entry covers a group. Hook for the scoped expectations
-// (fixtures/expectations.json read by compare/expectations.h, on their way to main):
-// until the campaign is given a lookup, `checked` stays false and the summary says
-// "not checked".
+// Whether a known-differences entry (fixtures/expectations.json, compare/expectations.h)
+// covers a group: `checked` false only for summaries written before expectations were
+// checked ("not checked").
 struct ExpectationVerdict {
   bool checked = false;
   std::string entry;  // the covering entry, for people; empty when none covers the group

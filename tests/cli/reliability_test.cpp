@@ -285,14 +285,15 @@ TEST(Reliability, AFailingCommandCreatesNothing) {
             2);
   EXPECT_FALSE(fs::exists(dir / "new"));
 
-  // A full disk, as a file size limit: every write past 64 kB fails with EFBIG.
+  // A full disk, as a file size limit: every write past 64 kB fails with EFBIG (the kept
+  // frames are larger).
   const fs::path out = dir / "out";
   ASSERT_EQ(run("run " + fan + " --backends ref:subpixel=8 --out " + out.string()).code, 0);
   const auto before = snapshot(out);
   const Result full =
       rc::test::runShell("sh -c 'trap \"\" XFSZ; ulimit -f 64; exec " RC_EXE " run " +
                          catalog("coverage/jittered_grid.json") +
-                         " --backends ref:subpixel=8 --out " + out.string() + "'");
+                         " --backends ref:subpixel=8 --keep-frames --out " + out.string() + "'");
   EXPECT_EQ(full.code, 2) << full.out;
   EXPECT_EQ(snapshot(out), before);
   EXPECT_EQ(stagingIn(dir), std::vector<std::string>{});
@@ -373,7 +374,9 @@ TEST(Reliability, ReportFoldersAreUniqueWhateverTheNames) {
   for (const std::string name : {"dup/a b", "dup/a_b", "dup/a?b"})
     writeBytes(dir / ("f" + std::to_string(k++) + ".json"), scene(R"(, "name": ")" + name + "\""));
   const fs::path out = dir / "out";
-  const Result r = run("run " + dir.string() + " --backends ref:subpixel=4 --out " + out.string());
+  // --keep-frames: passing pairs get their images (and folders) too.
+  const Result r =
+      run("run " + dir.string() + " --backends ref:subpixel=4 --keep-frames --out " + out.string());
   ASSERT_LE(r.code, 1) << r.out;
   const nlohmann::json j = nlohmann::json::parse(readBytes(out / "report.json"));
   std::set<std::string> folders;
