@@ -156,6 +156,8 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
       known.push_back({{"id", k.id}, {"class", k.cls}, {"reason", k.reason}});
     j["known"] = known;
   }
+  if (!r.fixture_file.empty()) j["fixture_file"] = r.fixture_file;
+  if (!r.tags.empty()) j["tags"] = r.tags;
   if (r.status == Status::Error) {
     // The contract's shape with nothing compared: every class "error", zero counts.
     const char* e = toString(Status::Error);
@@ -277,6 +279,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
             {"exit_code", exitCodeFor(report)}};
   if (!report.command.empty()) j["command"] = report.command;
   if (!report.variants.empty()) j["variants"] = report.variants;
+  if (!report.shard.empty()) j["shard"] = report.shard;
   return j;
 }
 
