@@ -286,7 +286,7 @@ TEST_F(ReportTest, HtmlRendersEveryRowAndLoadsEveryImageInChromium) {
   ASSERT_TRUE(first.ready) << "the page's script did not finish";
   EXPECT_EQ(first.rows, 4);
   EXPECT_EQ(first.pairs, 4);
-  EXPECT_EQ(first.images_ok, 2 * 5);
+  EXPECT_EQ(first.images_ok, 2 * 6);  // five maps and pictures plus the FLIP map
   EXPECT_EQ(first.images_failed, 0);
   const PageState s = renderInChromium(*out_ / "report.html", "#open-all");
   ASSERT_TRUE(s.ready) << "the page's script did not finish";
