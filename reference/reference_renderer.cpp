@@ -113,6 +113,7 @@ struct TexelNote {
 struct Scratch {
   std::vector<std::uint32_t> depth;
   UncertaintyTracker gaps;
+  EdgeDistanceBatch edges;  // the polygons' edge_dist work, applied at the end of the frame
   std::vector<std::vector<TransformedVertex>> vertices;  // per object
   std::vector<std::vector<LitColor>> gouraud;            // per object, Gouraud only
 };
@@ -143,7 +144,8 @@ class Renderer {
         vertices_(t_scratch.vertices),
         gouraud_(t_scratch.gouraud),
         depth_(t_scratch.depth),
-        gaps_(t_scratch.gaps) {
+        gaps_(t_scratch.gaps),
+        edges_(t_scratch.edges) {
     shading_.reserve(scene.materials.size());
     for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
   }
@@ -201,6 +203,7 @@ class Renderer {
   Frame frame_;                        // colour, id, edge_dist over the clip rectangle
   std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
   UncertaintyTracker& gaps_;           // scratch
+  EdgeDistanceBatch& edges_;           // scratch
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
 };
@@ -234,11 +237,15 @@ Frame Renderer::run() {
                   static_cast<float>(storedDepth(clear_key, depth_format_)), uncertainty_);
   depth_.assign(frame_.pixelCount(), clear_key);
   if (uncertainty_) gaps_.reset(frame_, depth_format_, clampDepth(scene_.clear_depth));
+  edges_.clear();
 
   transformVertices();
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter))
     for (const PrimitiveRef& prim : pass.primitives) drawTriangle(prim, pass);
-  if (uncertainty_) gaps_.finish(frame_);
+  if (uncertainty_) {
+    edges_.apply(clip_, fb_width_, fb_height_, frame_.edge_dist.data());
+    gaps_.finish(frame_);
+  }
 
   // Stored depth back to [0, 1] (one simple loop per format, so that it vectorizes).
   const std::size_t n = frame_.pixelCount();
@@ -250,6 +257,7 @@ Frame Renderer::run() {
   }
   if (depth_.capacity() > kMaxKeptScratchPixels) depth_ = {};
   if (gaps_.capacity() > kMaxKeptScratchPixels) gaps_.release();
+  if (edges_.capacity() > kMaxKeptScratchPixels) edges_.release();
   std::size_t kept_vertices = 0;
   for (const auto& v : vertices_) kept_vertices += v.capacity();
   if (kept_vertices > kMaxKeptScratchVertices) {
@@ -355,7 +363,7 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
     if (rasterized || cullCouldFlip(wv, count, max_reach))
-      addEdgeDistances(wv, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(), reach);
+      edges_.add(wv, count, reach);  // addEdgeDistances(), deferred (EdgeDistanceBatch)
   }
 
   TriangleContext t;

@@ -68,8 +68,14 @@ inline double ceilFast(double x) { return -floorFast(-x); }
 // so fl(qx^2 + qy^2) >= cur^2 (1 + 2^-40) means hypot(q) > cur and no change (cur is a
 // float, so cur^2 is exact in double). Pixels are visited in any superset of the band
 // within one pixel of the segment: a pixel farther than 1 keeps its value (<= 1).
-void lowerRow(float* row, int first, int last, double cy, const WindowVertex& a,
-              const WindowVertex& b, double reach) {
+// A segment's end point (the x, y of a WindowVertex).
+struct Point {
+  double x;
+  double y;
+};
+
+void lowerRow(float* row, int first, int last, double cy, const Point& a, const Point& b,
+              double reach) {
   const double dx = b.x - a.x;
   const double dy = b.y - a.y;
   const double len2 = dx * dx + dy * dy;
@@ -88,8 +94,8 @@ void lowerRow(float* row, int first, int last, double cy, const WindowVertex& a,
   }
 }
 
-void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& clip, int width,
-                int height, float* edge_dist, double reach) {
+void addSegment(const Point& a, const Point& b, const PixelRect& clip, int width, int height,
+                float* edge_dist, double reach) {
   // Centres farther than 1 + reach from the segment keep their value (<= 1).
   const double band = 1.0 + reach;
   int row_first = 0;
@@ -130,8 +136,44 @@ void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& c
   for (int i = 0; i < count; ++i) {
     const int j = (i + 1) % count;
     const double reach = reach_px ? std::max(reach_px[i], reach_px[j]) : 0.0;
-    addSegment(polygon[i], polygon[j], clip, width, height, edge_dist, reach);
+    addSegment(Point{polygon[i].x, polygon[i].y}, Point{polygon[j].x, polygon[j].y}, clip, width,
+               height, edge_dist, reach);
   }
+}
+
+void EdgeDistanceBatch::add(const WindowVertex* polygon, int count, const double* reach_px) {
+  double min_y = polygon[0].y;
+  for (int i = 0; i < count; ++i) {
+    xy_.push_back(polygon[i].x);
+    xy_.push_back(polygon[i].y);
+    reach_.push_back(reach_px[i]);
+    min_y = std::min(min_y, polygon[i].y);
+  }
+  // Any key gives the same result; the lowest row (clamped, NaN to 0) gives locality.
+  const double row = min_y > 0.0 ? std::min(min_y, 65536.0) : 0.0;
+  polygons_.push_back(Polygon{static_cast<std::uint32_t>(reach_.size() - count), count,
+                              static_cast<std::int32_t>(row)});
+}
+
+void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, float* edge_dist) {
+  // Counting sort by key (stable; keys in [0, 65536]).
+  int max_key = 0;
+  for (const Polygon& p : polygons_) max_key = std::max(max_key, p.key);
+  starts_.assign(static_cast<std::size_t>(max_key) + 2, 0);
+  for (const Polygon& p : polygons_) ++starts_[static_cast<std::size_t>(p.key) + 1];
+  for (std::size_t k = 1; k < starts_.size(); ++k) starts_[k] += starts_[k - 1];
+  sorted_.resize(polygons_.size());
+  for (const Polygon& p : polygons_) sorted_[starts_[static_cast<std::size_t>(p.key)]++] = p;
+  for (const Polygon& p : sorted_) {
+    const double* xy = &xy_[2 * static_cast<std::size_t>(p.first)];
+    const double* reach_px = &reach_[p.first];
+    for (int i = 0; i < p.count; ++i) {
+      const int j = (i + 1) % p.count;
+      addSegment(Point{xy[2 * i], xy[2 * i + 1]}, Point{xy[2 * j], xy[2 * j + 1]}, clip, width,
+                 height, edge_dist, std::max(reach_px[i], reach_px[j]));
+    }
+  }
+  clear();
 }
 
 }  // namespace rc::ref
