@@ -60,6 +60,12 @@ inline double ceilFast(double x) { return -floorFast(-x); }
   return first < last_excl;
 }
 
+// A segment's end point (the x, y of a WindowVertex).
+struct Point {
+  double x;
+  double y;
+};
+
 // Lowers row[px] to the distance from each listed pixel centre to the segment a-b (in
 // [first, last) of the row at window y = cy), when that is smaller:
 //   t = clamp(((p - a) . d) / |d|^2, 0, 1), distance = hypot(p - (a + t d)).
@@ -68,22 +74,32 @@ inline double ceilFast(double x) { return -floorFast(-x); }
 // so fl(qx^2 + qy^2) >= cur^2 (1 + 2^-40) means hypot(q) > cur and no change (cur is a
 // float, so cur^2 is exact in double). Pixels are visited in any superset of the band
 // within one pixel of the segment: a pixel farther than 1 keeps its value (<= 1).
-// A segment's end point (the x, y of a WindowVertex).
-struct Point {
-  double x;
-  double y;
-};
-
 void lowerRow(float* row, int first, int last, double cy, const Point& a, const Point& b,
               double reach) {
   const double dx = b.x - a.x;
   const double dy = b.y - a.y;
   const double len2 = dx * dx + dy * dy;
+  const bool finite_len2 = std::isfinite(len2);
   const double py = cy;
   for (int px = first; px < last; ++px) {
     const double cx = px + 0.5;
     double t = 0.0;
-    if (len2 > 0.0) t = std::clamp(((cx - a.x) * dx + (py - a.y) * dy) / len2, 0.0, 1.0);
+    if (len2 > 0.0) {
+      // t = clamp(num / len2, 0, 1) without the division where the clamp decides: for a
+      // finite len2 > 0, num >= len2 gives a quotient >= 1 (rounding is monotone) and
+      // num <= 0 one <= 0 (t = -0 for num = -0, which moves no end point: a.x + -0 * dx
+      // and a.x + 0 * dx differ at most in the sign of a zero, and cx, py are never 0).
+      const double num = (cx - a.x) * dx + (py - a.y) * dy;
+      if (!finite_len2) {
+        t = std::clamp(num / len2, 0.0, 1.0);
+      } else if (num >= len2) {
+        t = 1.0;
+      } else if (num > 0.0) {
+        t = num / len2;  // in (0, 1]: the clamp keeps it
+      } else if (!(num <= 0.0)) {
+        t = num / len2;  // NaN, as the clamp returns it
+      }
+    }
     const double qx = cx - (a.x + t * dx);
     const double qy = py - (a.y + t * dy);
     const double cur = row[px];
@@ -142,37 +158,29 @@ void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& c
 }
 
 void EdgeDistanceBatch::add(const WindowVertex* polygon, int count, const double* reach_px) {
-  double min_y = polygon[0].y;
   for (int i = 0; i < count; ++i) {
-    xy_.push_back(polygon[i].x);
-    xy_.push_back(polygon[i].y);
-    reach_.push_back(reach_px[i]);
-    min_y = std::min(min_y, polygon[i].y);
+    const int j = (i + 1) % count;
+    const WindowVertex& a = polygon[i];
+    const WindowVertex& b = polygon[j];
+    // Any key gives the same result; the lower row (clamped, NaN to 0) gives locality.
+    const double low = std::min(a.y, b.y);
+    const double row = low > 0.0 ? std::min(low, 65536.0) : 0.0;
+    segments_.push_back(Segment{a.x, a.y, b.x, b.y, std::max(reach_px[i], reach_px[j]),
+                                static_cast<std::int32_t>(row)});
   }
-  // Any key gives the same result; the lowest row (clamped, NaN to 0) gives locality.
-  const double row = min_y > 0.0 ? std::min(min_y, 65536.0) : 0.0;
-  polygons_.push_back(Polygon{static_cast<std::uint32_t>(reach_.size() - count), count,
-                              static_cast<std::int32_t>(row)});
 }
 
 void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, float* edge_dist) {
-  // Counting sort by key (stable; keys in [0, 65536]).
+  // Counting sort by key (keys in [0, 65536]).
   int max_key = 0;
-  for (const Polygon& p : polygons_) max_key = std::max(max_key, p.key);
+  for (const Segment& s : segments_) max_key = std::max(max_key, s.key);
   starts_.assign(static_cast<std::size_t>(max_key) + 2, 0);
-  for (const Polygon& p : polygons_) ++starts_[static_cast<std::size_t>(p.key) + 1];
+  for (const Segment& s : segments_) ++starts_[static_cast<std::size_t>(s.key) + 1];
   for (std::size_t k = 1; k < starts_.size(); ++k) starts_[k] += starts_[k - 1];
-  sorted_.resize(polygons_.size());
-  for (const Polygon& p : polygons_) sorted_[starts_[static_cast<std::size_t>(p.key)]++] = p;
-  for (const Polygon& p : sorted_) {
-    const double* xy = &xy_[2 * static_cast<std::size_t>(p.first)];
-    const double* reach_px = &reach_[p.first];
-    for (int i = 0; i < p.count; ++i) {
-      const int j = (i + 1) % p.count;
-      addSegment(Point{xy[2 * i], xy[2 * i + 1]}, Point{xy[2 * j], xy[2 * j + 1]}, clip, width,
-                 height, edge_dist, std::max(reach_px[i], reach_px[j]));
-    }
-  }
+  sorted_.resize(segments_.size());
+  for (const Segment& s : segments_) sorted_[starts_[static_cast<std::size_t>(s.key)]++] = s;
+  for (const Segment& s : sorted_)
+    addSegment(Point{s.ax, s.ay}, Point{s.bx, s.by}, clip, width, height, edge_dist, s.reach);
   clear();
 }
 

@@ -256,28 +256,27 @@ void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& c
 // in random places otherwise miss it on nearly every row).
 class EdgeDistanceBatch {
  public:
-  void clear() {
-    xy_.clear();
-    reach_.clear();
-    polygons_.clear();
-  }
+  void clear() { segments_.clear(); }
   // The polygon's vertex positions and per-vertex reach, as addEdgeDistances() takes them.
   void add(const WindowVertex* polygon, int count, const double* reach_px);
   // addEdgeDistances() of every added polygon into edge_dist, then clear().
   void apply(const PixelRect& clip, int width, int height, float* edge_dist);
-  std::size_t capacity() const { return xy_.capacity(); }
+  std::size_t capacity() const { return segments_.capacity(); }
   void release() { *this = {}; }
 
  private:
-  struct Polygon {
-    std::uint32_t first;  // index of its first vertex in xy_ / 2 and reach_
-    std::int32_t count;
-    std::int32_t key;  // lowest row, clamped to the frame (the sort key)
+  // One boundary segment with its reach (the larger of its end points'), kept whole so
+  // that the sorted pass reads them in sequence.
+  struct Segment {
+    double ax;
+    double ay;
+    double bx;
+    double by;
+    double reach;
+    std::int32_t key;  // its lower row, clamped to [0, 65536] (the sort key)
   };
-  std::vector<double> xy_;  // x, y per vertex
-  std::vector<double> reach_;
-  std::vector<Polygon> polygons_;
-  std::vector<Polygon> sorted_;
+  std::vector<Segment> segments_;
+  std::vector<Segment> sorted_;
   std::vector<std::uint32_t> starts_;
 };
 
