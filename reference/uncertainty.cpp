@@ -94,10 +94,8 @@ void lowerRow(float* row, int first, int last, double cy, const Point& a, const 
         t = std::clamp(num / len2, 0.0, 1.0);
       } else if (num >= len2) {
         t = 1.0;
-      } else if (num > 0.0) {
-        t = num / len2;  // in (0, 1]: the clamp keeps it
       } else if (!(num <= 0.0)) {
-        t = num / len2;  // NaN, as the clamp returns it
+        t = num / len2;  // in (0, 1] (the clamp keeps it) or NaN (the clamp returns it)
       }
     }
     const double qx = cx - (a.x + t * dx);
