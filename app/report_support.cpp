@@ -13,6 +13,7 @@
 #include "compare/pair_images.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
+#include "fixtures/multisample.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -167,12 +168,35 @@ void ReportFolder::commit(const Report& report) {
   committed_ = true;
 }
 
+PairResult failedRenderResult(std::string fixture, std::string expected, std::string actual,
+                              const std::string& message) {
+  if (const std::optional<std::string> reason = notSupportedReason(message))
+    return notSupportedResult(std::move(fixture), std::move(expected), std::move(actual), *reason);
+  return errorResult(std::move(fixture), std::move(expected), std::move(actual), message);
+}
+
+void resampleReference(Frame& ref, const Frame& gl, const fs::path& scene_file,
+                       ReferenceOptions options) {
+  if (!ref.multisampled() || !gl.multisampled()) return;
+  const std::vector<glm::dvec2> want = samplePositionsFromMeta(gl.meta);
+  if (want.empty() || want == samplePositionsFromMeta(ref.meta)) return;
+  options.sample_positions = want;
+  Frame again = renderReference(loadScene(scene_file), options);
+  nlohmann::json meta = ref.meta;
+  for (const char* key : {"multisample", "fragments", "triangles_rasterized", "timing_ms"})
+    meta[key] = again.meta[key];
+  meta["multisample"]["positions_from"] = gl.meta.value("backend", std::string("the driver"));
+  again.meta = std::move(meta);
+  ref = std::move(again);
+}
+
 // ---- Summary ----
 
 namespace {
 
 std::string cellText(const PairResult& r) {
   if (r.status == Status::Error) return "ERROR";
+  if (r.status == Status::NotSupported) return "not supported";
   std::string status = toString(r.status);
   if (r.status != Status::Pass)
     std::transform(status.begin(), status.end(), status.begin(),
@@ -241,7 +265,8 @@ std::string summaryTable(const Report& report, std::size_t max_rows) {
         if (const auto it = cells.find({f, backends[k]}); it != cells.end())
           ++n[it->second->status];
       std::string text;
-      for (const Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error})
+      for (const Status st :
+           {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported})
         if (n[st] > 0)
           text += fmt::format("{}{} {}", text.empty() ? "" : ", ", n[st], toString(st));
       line += fmt::format("  {:<{}}", text, widths[k]);
@@ -268,9 +293,10 @@ void printSummary(const Report& report, const fs::path& out_dir, std::ostream& o
       if (f.is_string()) os << "finding: " << spec << ": " << f.get<std::string>() << '\n';
   }
   const ReportSummary s = report.summary();
-  os << fmt::format("{} pairs: {} pass, {} warn, {} fail{}, {} error\n", s.total(), s.pass, s.warn,
-                    s.fail, s.known_fail ? fmt::format(" ({} known)", s.known_fail) : std::string(),
-                    s.error);
+  os << fmt::format(
+      "{} pairs: {} pass, {} warn, {} fail{}, {} error{}\n", s.total(), s.pass, s.warn, s.fail,
+      s.known_fail ? fmt::format(" ({} known)", s.known_fail) : std::string(), s.error,
+      s.not_supported ? fmt::format(", {} not supported", s.not_supported) : std::string());
   os << "report: " << (fs::absolute(out_dir) / "report.html").lexically_normal().string() << '\n';
   os << (s.error                 ? "ERROR"
          : s.fail > s.known_fail ? "FAILURE"

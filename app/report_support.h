@@ -13,6 +13,7 @@
 #include "compare/tolerances.h"
 #include "fixtures/frame.h"
 #include "fixtures/scene.h"
+#include "reference/reference_renderer.h"
 
 namespace rc {
 
@@ -30,6 +31,18 @@ Tolerances pairTolerances(const Frame& expected, const Frame& actual,
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, const std::filesystem::path& out_dir,
                        const PairPictures& pictures = {});
+
+// A report row for a pair whose render failed with `message`: status not_supported when
+// the message says the backend does not support the fixture, else error.
+PairResult failedRenderResult(std::string fixture, std::string expected, std::string actual,
+                              const std::string& message);
+
+// A multisampled reference frame samples where the driver it is compared with does: when
+// `gl`'s frame.json "multisample" positions differ from `ref`'s, `ref` is rendered again
+// (with `options` and those positions) from the fixture file, keeping its frame.json keys.
+// Nothing happens for single-sample frames or frames without positions.
+void resampleReference(Frame& ref, const Frame& gl, const std::filesystem::path& scene_file,
+                       ReferenceOptions options);
 
 // A frame folder's color.png when it shows `frame` (frame.json's "color_digest", written
 // by `render`, matches the frame that was read), else empty: then the comparator encodes

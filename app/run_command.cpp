@@ -179,20 +179,23 @@ int runCommand(const RunArgs& args) {
       if (b.text == against.text) continue;
       const Job& job = jobs[job_of[{f, b.text}]];
       if (against_job.exit_code != 0) {
-        report.results.push_back(
-            errorResult(fx.name, against.text, b.text,
-                        against.text + ": " +
-                            childFailure(against_job, {fx.name + ": ", against.text + ": "})));
+        report.results.push_back(failedRenderResult(
+            fx.name, against.text, b.text,
+            against.text + ": " +
+                childFailure(against_job, {fx.name + ": ", against.text + ": "})));
         continue;
       }
       if (job.exit_code != 0) {
-        report.results.push_back(errorResult(fx.name, against.text, b.text,
-                                             childFailure(job, {fx.name + ": ", b.text + ": "})));
+        report.results.push_back(failedRenderResult(
+            fx.name, against.text, b.text, childFailure(job, {fx.name + ": ", b.text + ": "})));
         continue;
       }
       try {
-        const Frame expected = readRendered(f, against.text);
+        Frame expected = readRendered(f, against.text);
         const Frame actual = readRendered(f, b.text);
+        // A multisampled reference samples where the driver does (its frame.json positions).
+        if (expected.hasUncertainty() && against.kind == BackendSpec::Kind::Reference)
+          resampleReference(expected, actual, fx.file, against.reference);
         if (expected.width != actual.width || expected.height != actual.height)
           throw BackendError(fmt::format("{} drew {}x{}, {} drew {}x{}", against.text,
                                          expected.width, expected.height, b.text, actual.width,
@@ -201,6 +204,7 @@ int runCommand(const RunArgs& args) {
         const Frame* uncertainty = &expected;
         if (!expected.hasUncertainty() && ref_job.exit_code == 0) {
           ref = readRendered(f, "ref");
+          resampleReference(ref, actual, fx.file, ReferenceOptions{});
           if (ref.width != expected.width || ref.height != expected.height)
             throw BackendError(fmt::format("ref drew {}x{}, {} drew {}x{}", ref.width, ref.height,
                                            against.text, expected.width, expected.height));

@@ -97,7 +97,7 @@ h3{font-size:15px;margin:0 0 6px}
 .summary b{display:block;font-size:20px}
 .badge{display:inline-block;padding:0 6px;border-radius:4px;font-size:12px;font-weight:600;
   text-transform:uppercase;color:#fff}
-.pass{background:#2e7d32}.warn{background:#e6a100}.fail{background:#c62828}.error{background:#6a1b9a}
+.pass{background:#2e7d32}.warn{background:#e6a100}.fail{background:#c62828}.error{background:#6a1b9a}.not_supported{background:#607d8b}
 table{border-collapse:collapse;background:#fff}
 th,td{border:1px solid #ddd;padding:3px 7px;text-align:left;white-space:nowrap}
 td.n{text-align:right;font-variant-numeric:tabular-nums}
@@ -266,7 +266,7 @@ std::string pairSection(const PairResult& r, std::size_t k, const fs::path& repo
       k, toString(r.status), r.status == Status::Pass ? "" : " open", esc(r.fixture),
       esc(r.expected), esc(r.actual), badge(r.status));
   out += fmt::format("<div class=\"describe\">{}</div>", esc(describe(r)));
-  if (r.status == Status::Error) return out + "</details>";
+  if (r.status == Status::Error || r.status == Status::NotSupported) return out + "</details>";
 
   out += "<div class=\"images\">";
   out += figure(r, "expected", ("expected: " + r.expected).c_str(), report_dir, "");
@@ -474,8 +474,8 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
   out += fmt::format(
       "<div class=\"summary\" id=\"summary\"><div>pairs<b>{}</b></div><div>pass<b>{}</b></div>"
       "<div>warn<b>{}</b></div><div>fail<b>{}</b></div><div>error<b>{}</b></div>"
-      "<div>exit code<b>{}</b></div></div>",
-      sum.total(), sum.pass, sum.warn, sum.fail, sum.error, exitCodeFor(report));
+      "<div>not supported<b>{}</b></div><div>exit code<b>{}</b></div></div>",
+      sum.total(), sum.pass, sum.warn, sum.fail, sum.error, sum.not_supported, exitCodeFor(report));
   out += matrix(report);
   out += variantsTable(report);
 
@@ -484,7 +484,8 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       "placeholder=\"filter: fixture, backend, status...\"><select id=\"status-filter\">"
       "<option value=\"\">all statuses</option><option value=\"not-pass\">not pass</option>"
       "<option value=\"pass\">pass</option><option value=\"warn\">warn</option>"
-      "<option value=\"fail\">fail</option><option value=\"error\">error</option></select>"
+      "<option value=\"fail\">fail</option><option value=\"error\">error</option>"
+      "<option value=\"not_supported\">not supported</option></select>"
       "<span id=\"shown\"></span></div>";
   out += "<table id=\"results\"><thead><tr>";
   const std::pair<const char*, bool> heads[] = {
@@ -506,7 +507,7 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
     out += cell(esc(r.expected), r.expected, false);
     out += cell(esc(r.actual), r.actual, false);
     out += cell(badge(r.status), fmt::format("{}", static_cast<int>(r.status)), true);
-    if (r.status == Status::Error) {
+    if (r.status == Status::Error || r.status == Status::NotSupported) {
       for (int c = 0; c < 12; ++c) out += emptyCell();
     } else {
       out += countCell(r.visibility.hard);

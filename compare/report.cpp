@@ -131,6 +131,9 @@ ReportSummary Report::summary() const {
       case Status::Error:
         ++s.error;
         break;
+      case Status::NotSupported:
+        ++s.not_supported;
+        break;
     }
   }
   return s;
@@ -156,10 +159,11 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
       known.push_back({{"id", k.id}, {"class", k.cls}, {"reason", k.reason}});
     j["known"] = known;
   }
-  if (r.status == Status::Error) {
-    // The contract's shape with nothing compared: every class "error", zero counts.
-    const char* e = toString(Status::Error);
-    j["error"] = r.error;
+  if (r.status == Status::Error || r.status == Status::NotSupported) {
+    // The contract's shape with nothing compared: every class "error" (or
+    // "not_supported"), zero counts.
+    const char* e = toString(r.status);
+    j[r.status == Status::Error ? "error" : "not_supported"] = r.error;
     j["visibility"] = {{"status", e},  {"mismatched", 0}, {"ambiguous", 0},      {"hard", 0},
                        {"missing", 0}, {"extra", 0},      {"wrong_primitive", 0}};
     j["depth"] = {{"status", e},    {"compared", 0},       {"max_steps", 0},  {"mean_steps", 0},
@@ -209,6 +213,10 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                      {"worst", pixel(v.worst)},
                      {"worst_window", windowPixel(v.worst, r.height)},
                      {"worst_edge_dist", v.worst.valid() ? num(v.worst_edge_dist) : json(nullptr)}};
+  if (v.samples > 1) {  // multisampled: pixels count as mismatched when any sample differs
+    j["visibility"]["samples"] = v.samples;
+    j["visibility"]["mismatched_samples"] = v.mismatched_samples;
+  }
   j["depth"] = {{"status", toString(d.status)},
                 {"compared", d.compared},
                 {"max_steps", num(d.max_steps)},
@@ -269,6 +277,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
               {"warn", s.warn},
               {"fail", s.fail},
               {"error", s.error},
+              {"not_supported", s.not_supported},
               {"known_fail", s.known_fail},
               {"total", s.total()}}},
             {"exit_code", exitCodeFor(report)}};
@@ -283,6 +292,7 @@ std::string describe(const PairResult& r) {
   if (!r.known.empty()) status = "KNOWN FAIL";
   std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
   if (r.status == Status::Error) return head + ": " + r.error;
+  if (r.status == Status::NotSupported) return head + ": " + r.error;
   if (!r.known.empty()) {
     std::vector<std::string> ids;
     for (const KnownFailure& k : r.known) ids.push_back(k.id);
