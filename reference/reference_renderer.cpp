@@ -170,6 +170,8 @@ class Renderer {
   void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
                    int count);
   void prepareTriangle(TriangleContext& t) const;
+  __attribute__((noinline)) void addSampleEdgeDistances(const WindowVertex* wv, int count,
+                                                        const double* reach);
   void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
                 const FragmentInterpolator& interp);
   template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
@@ -374,15 +376,8 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
     if (rasterized || cullCouldFlip(wv, count, max_reach)) {
-      if (shift_.active) {  // distances from the sample position
-        WindowVertex moved[kMaxClipVertices];
-        for (int i = 0; i < count; ++i) {
-          moved[i] = wv[i];
-          moved[i].x -= shift_.offset.x;
-          moved[i].y -= shift_.offset.y;
-        }
-        addEdgeDistances(moved, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(),
-                         reach);
+      if (shift_.active) {
+        addSampleEdgeDistances(wv, count, reach);
       } else {
         addEdgeDistances(wv, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(), reach);
       }
@@ -436,6 +431,18 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     }
     shadeFan(t, coverage, interp);
   }
+}
+
+// Multisampling: edge_dist from the sample position (out of line, so that the
+// single-sample drawPolygon() compiles as it did before multisampling).
+void Renderer::addSampleEdgeDistances(const WindowVertex* wv, int count, const double* reach) {
+  WindowVertex moved[kMaxClipVertices];
+  for (int i = 0; i < count; ++i) {
+    moved[i] = wv[i];
+    moved[i].x -= shift_.offset.x;
+    moved[i].y -= shift_.offset.y;
+  }
+  addEdgeDistances(moved, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(), reach);
 }
 
 template <Shading kShading>
