@@ -581,6 +581,7 @@ class Comparator {
       bool any_primitive = false;
       double dz_max = 0.0;
       bool first_gap = false;
+      bool any_gap = false;  // a differing sample excused by a depth tie, not by an edge
       double first_edge = kInf;
       for (int s = 0; s < samples; ++s) {
         const std::size_t k = e_.sampleIndex(s, i);
@@ -591,6 +592,7 @@ class Comparator {
           bool by_gap = false;
           double edge = kInf;
           const bool ambiguous = sampleAmbiguous(i, s, a, b, by_gap, edge);
+          any_gap = any_gap || by_gap;
           if (first_diff < 0) {
             first_diff = s;
             first_gap = by_gap;
@@ -653,6 +655,14 @@ class Comparator {
         if (dz_max > tol_.depth.warn) depthOverBase(x, y, i, dz_max);
         if (maps_) maps_->depth_steps[i] = static_cast<float>(dz_max);
       }
+      // A sample that may legally show another primitive by a depth tie may carry the colour
+      // of a fragment that lost its depth test in the reference: no sample colour the
+      // reference keeps bounds it, so the resolved colour is not compared (as the colour of
+      // a single-sample pixel whose primitive differs is not).
+      if (any_gap) {
+        ++shade_skipped_;
+        continue;
+      }
       if (!color_finite) {
         shadingNonFinite(i);
         if (maps_) maps_->shading_abs[i] = std::numeric_limits<float>::quiet_NaN();
@@ -661,6 +671,7 @@ class Comparator {
       float d[4];
       for (int c = 0; c < 4; ++c) d[c] = colorError(pa[c], pb[c]);
       const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
+      ++shade_compared_;
       shade_sum_ += (d[0] + d[1]) + (d[2] + d[3]);
       shade_sq_ += (d[0] * d[0] + d[1] * d[1]) + (d[2] * d[2] + d[3] * d[3]);
       for (int c = 0; c < 4; ++c) shade_max_rgba_[c] = std::max(shade_max_rgba_[c], d[c]);
@@ -895,7 +906,8 @@ class Comparator {
     d.status = d.over_fail ? Status::Fail : d.over_tolerance ? Status::Warn : Status::Pass;
 
     ShadingStats& s = r_.shading;
-    s.compared = vis_match_;
+    s.compared = e_.multisampled() ? shade_compared_ + s.nonfinite : vis_match_;
+    s.depth_tied = shade_skipped_;
     const std::uint64_t shade_finite = s.compared - s.nonfinite;
     s.max_abs = shade_max_;
     for (int c = 0; c < 4; ++c) s.max_abs_rgba[c] = shade_max_rgba_[c];
@@ -941,7 +953,9 @@ class Comparator {
   // Multisampled frames: per-sample edge distances and sample_alt are available.
   bool have_sample_uncertainty_ = false;
   std::uint64_t sample_mismatches_ = 0;
-  double coverage_allowance_ = 0.0;  // units, of the pixel being compared (multisampled)
+  std::uint64_t shade_skipped_ = 0;   // multisampled: depth-tied pixels (not shading-compared)
+  std::uint64_t shade_compared_ = 0;  // multisampled: pixels shading-compared
+  double coverage_allowance_ = 0.0;   // units, of the pixel being compared (multisampled)
 
   std::uint64_t class_counts_[kPixelClassCount] = {};
   std::uint64_t vis_match_ = 0;

@@ -106,6 +106,9 @@ struct ShadingStats {
   // Pixels over their tolerance not counted because the fragments blended under the top
   // one may legally differ (see DepthStats::blend_uncertain).
   std::uint64_t blend_uncertain = 0;
+  // Multisampled pairs: pixels not compared because a sample there may legally show
+  // another primitive by a depth tie (docs/tolerances.md "5. Multisampling").
+  std::uint64_t depth_tied = 0;
   std::array<double, 4> max_abs_rgba{};
   // The pixel furthest over its tolerance when any is over (a non-finite one first), else
   // the largest per-pixel error (first in row order on ties); none when all are equal.

@@ -213,10 +213,6 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                      {"worst", pixel(v.worst)},
                      {"worst_window", windowPixel(v.worst, r.height)},
                      {"worst_edge_dist", v.worst.valid() ? num(v.worst_edge_dist) : json(nullptr)}};
-  if (v.samples > 1) {  // multisampled: pixels count as mismatched when any sample differs
-    j["visibility"]["samples"] = v.samples;
-    j["visibility"]["mismatched_samples"] = v.mismatched_samples;
-  }
   j["depth"] = {{"status", toString(d.status)},
                 {"compared", d.compared},
                 {"max_steps", num(d.max_steps)},
@@ -254,6 +250,11 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                   {"worst_abs", s.worst.valid() ? num(s.worst_abs) : json(nullptr)},
                   {"worst_allowance", s.worst.valid() ? num(s.worst_allowance) : json(nullptr)},
                   {"histogram", histogram(s.histogram, s.max_abs, "8-bit units")}};
+  if (v.samples > 1) {  // multisampled: pixels count as mismatched when any sample differs
+    j["visibility"]["samples"] = v.samples;
+    j["visibility"]["mismatched_samples"] = v.mismatched_samples;
+    j["shading"]["depth_tied"] = s.depth_tied;
+  }
   j["nonfinite"] = {{"expected", nonfinite(r.nonfinite_expected)},
                     {"actual", nonfinite(r.nonfinite_actual)}};
   json images = json::object();
