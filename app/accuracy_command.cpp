@@ -7,8 +7,8 @@
 #include "app/commands.h"
 #include "app/paths.h"
 #include "compare/accuracy.h"
-#include "compare/atomic_file.h"
 #include "fixtures/errors.h"
+#include "fixtures/output_folder.h"
 
 namespace rc {
 
@@ -22,9 +22,9 @@ int accuracyCommand(const AccuracyArgs& args) {
   if (args.out.empty()) {
     std::cout << md;
   } else {
-    AtomicFileSet files;
-    files.stageText(args.out, md);
-    files.commit();
+    OutputFile file(args.out);
+    file.writeText(md);
+    file.commit();
     std::cout << fmt::format("{} comparisons -> {}\n", data.pairs.size(), args.out.string());
   }
   return kExitPass;

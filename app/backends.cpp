@@ -79,6 +79,7 @@ Frame renderWith(const BackendSpec& backend, const Scene& scene) {
   m["backend"] = backend.text;
   m["fixture"] = scene.name;
   if (!scene.source.empty()) m["fixture_file"] = scene.source.string();
+  if (!scene.tags.empty()) m["tags"] = scene.tags;
   m["width"] = scene.width;
   m["height"] = scene.height;
   m["depth_format"] = toString(scene.state.depth_format);

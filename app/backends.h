@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "fixtures/frame.h"
+#include "fixtures/resource_estimate.h"
 #include "fixtures/scene.h"
 #include "gl_backend/gl_backend.h"
 #include "reference/reference_renderer.h"
@@ -23,6 +24,11 @@ struct BackendSpec {
 
 // Throws InputError (exit 2) for an unknown SPEC, listing the valid forms.
 BackendSpec parseBackendSpec(std::string_view spec);
+
+// Which resource estimate (fixtures/resource_estimate.h) a backend's renders follow.
+inline RendererKind rendererKind(const BackendSpec& backend) {
+  return backend.kind == BackendSpec::Kind::Reference ? RendererKind::Reference : RendererKind::Gl;
+}
 
 // Renders and fills the frame.json keys every backend shares (backend, fixture, sizes,
 // formats, tool version, total time). Throws BackendError (exit 3) when the backend fails.

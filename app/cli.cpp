@@ -2,16 +2,19 @@
 // ends as one line on stderr and an exit code from fixtures/errors.h.
 #include "app/cli.h"
 
+#include <cstdlib>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
 #include "app/version.h"
+#include "debug/campaign.h"
 #include "fixtures/errors.h"
+#include "fixtures/message_text.h"
+#include "fixtures/resource_estimate.h"
 
 namespace rc {
-
 int runCli(int argc, char** argv) {
   CLI::App app{
       "rastercheck: renders fixtures with a scalar CPU reference and with OpenGL drivers, and "
@@ -22,8 +25,19 @@ int runCli(int argc, char** argv) {
   app.require_subcommand(1);
   // Usage errors in one line, as every other error (CLI11 adds a second by default).
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    return std::string("rastercheck: error: ") + e.what() + " (see --help)\n";
+    return "rastercheck: error: " + oneLineMessage(e.what()) + " (see --help)\n";
   });
+  // Resource limits (fixtures/resource_estimate.h), accepted before or after the command
+  // name; passed on through the environment, so that the renders `run` starts obey them.
+  app.fallthrough();
+  std::string max_memory;
+  std::string max_work;
+  app.add_option("--max-memory", max_memory,
+                 "Refuse a render estimated to need more memory (e.g. 4G; default: the memory "
+                 "available when it starts)");
+  app.add_option("--max-work", max_work,
+                 "Refuse a render estimated to need more operations (default 1e10, a few "
+                 "minutes of the reference)");
 
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "Render one fixture with one backend");
@@ -78,6 +92,8 @@ int runCli(int argc, char** argv) {
   compare_cmd->add_option("--tolerance,-t", compare.tolerance,
                           "Override a threshold: CLASS.KEY=VALUE (visibility|depth|shading . "
                           "warn|fail, depth.slope_factor); repeatable");
+  compare_cmd->add_flag("--diff-exr", compare.diff_exr,
+                        "Write diff.exr also when the pair passes (by default only when not)");
 
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand(
@@ -94,6 +110,18 @@ int runCli(int argc, char** argv) {
   run_cmd->add_option("--expectations", run.expectations,
                       "Known driver differences to mark as known failures: a file, or 'none' "
                       "(default: fixtures/expectations.json)");
+  run_cmd
+      ->add_option("--timeout", run.timeout_seconds,
+                   "Seconds one render may take before its worker is killed and the pair is an "
+                   "error row (0: no watchdog)")
+      ->capture_default_str();
+  run_cmd->add_flag("--keep-frames", run.keep_frames,
+                    "Write frames and pair images of passing pairs too (by default only of "
+                    "pairs that warn, fail or error)");
+  run_cmd->add_option("--shard", run.shard,
+                      "Run part K of N (K/N, 1-based) of the whole run, or `env`: from "
+                      "RASTERCHECK_SHARD, CI_NODE_INDEX/CI_NODE_TOTAL or "
+                      "JOB_COMPLETION_INDEX/JOB_COMPLETIONS; join the parts with `merge`");
   run_cmd->add_flag("!--no-variants", run.variants,
                     "Skip the variant probes (subpixel precision, tie-break, depth rounding) "
                     "of each GL backend");
@@ -132,6 +160,51 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   reduce_cmd->add_option("--tolerance,-t", reduce.tolerance, "As for compare; repeatable");
 
+  CampaignArgs campaign;
+  CLI::App* campaign_cmd = app.add_subcommand(
+      "campaign",
+      "Generate random scenes, run them on backends, reduce and group every failure "
+      "(docs/campaigns.md); --mutations: measure how often injected GL faults are caught");
+  campaign_cmd->add_option("--seed,-s", campaign.seed, "Seed of the random scenes (0 to 2^64 - 1)")
+      ->required()
+      ->type_name("UINT");
+  campaign_cmd->add_option("--count,-n", campaign.count, "Number of scenes")->capture_default_str();
+  campaign_cmd->add_option("--backends,-b", campaign.backends, "Backend SPECs, comma separated")
+      ->required()
+      ->delimiter(',');
+  campaign_cmd->add_option("--against,-a", campaign.against, "SPEC every backend is compared with")
+      ->capture_default_str();
+  campaign_cmd
+      ->add_option("--out,-o", campaign.out,
+                   "Campaign folder (the same command on the same folder continues it)")
+      ->required();
+  campaign_cmd
+      ->add_option("--reduce-seconds", campaign.reduce_seconds,
+                   "Time limit of each failure's reduction (0: do not reduce)")
+      ->capture_default_str();
+  campaign_cmd->add_option("--jobs,-j", campaign.jobs,
+                           "Children at a time (default: one per core)");
+  campaign_cmd->add_option("--batch", campaign.batch, "Scenes per `run` child")
+      ->capture_default_str();
+  campaign_cmd->add_option("--expectations", campaign.expectations,
+                           "Known driver differences, as for run: a group every failure of "
+                           "which one covers is reported as known and does not fail the "
+                           "campaign (default: fixtures/expectations.json)");
+  campaign_cmd->add_option("--profile", campaign.profile, "Feature mix, as for generate")
+      ->capture_default_str();
+  campaign_cmd->add_option("--max-size", campaign.max_size, "Largest image, WxH")
+      ->capture_default_str();
+  campaign_cmd->add_option("--meshes", campaign.meshes, "Folder of assimp-testmodels' models");
+  campaign_cmd->add_option("--tolerance,-t", campaign.tolerance, "As for compare; repeatable");
+  campaign_cmd->add_flag("--mutations", campaign.mutations,
+                         "The mutation study: inject each GL fault into every scene and report "
+                         "how often it is caught in its class");
+  campaign_cmd
+      ->add_option("--faults", campaign.faults,
+                   "--mutations: faults to inject, comma separated (default: light_scale, "
+                   "depth_bias, drop_primitive, move_vertex, texel_offset, blend_factor)")
+      ->delimiter(',');
+
   AccuracyArgs accuracy;
   CLI::App* accuracy_cmd = app.add_subcommand(
       "accuracy", "Write the accuracy report (Markdown) from the report.json of run folders");
@@ -144,14 +217,43 @@ int runCli(int argc, char** argv) {
   accuracy_cmd->add_option("--command", accuracy.command,
                            "How the document says it was made (Markdown)");
 
+  MergeArgs merge;
+  CLI::App* merge_cmd =
+      app.add_subcommand("merge", "Join the folders of `run --shard K/N` into one run's report");
+  merge_cmd->add_option("runs", merge.runs, "Folders written by `run --shard`")->required();
+  merge_cmd->add_option("--out,-o", merge.out, "Report folder")->required();
+
+  DiffRunsArgs diff_runs;
+  CLI::App* diff_runs_cmd = app.add_subcommand(
+      "diff-runs", "Regressions, fixes, new and vanished pairs between two run folders");
+  diff_runs_cmd->add_option("old", diff_runs.old_run, "The earlier run folder")->required();
+  diff_runs_cmd->add_option("new", diff_runs.new_run, "The later run folder")->required();
+  diff_runs_cmd->add_flag("--json", diff_runs.json, "Print JSON instead of text");
+  diff_runs_cmd->add_option("--out,-o", diff_runs.out,
+                            "Also write diff.txt, diff.json and diff.html into this folder");
+
+  // `run`'s workers (app/worker.h); not for people, so not in --help.
+  std::string worker_spec;
+  CLI::App* worker_cmd = app.add_subcommand("worker", "");
+  worker_cmd->group("");
+  worker_cmd->add_option("--backend", worker_spec)->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints help/version or the parse error
+    const int code = app.exit(e);  // prints help/version or the one-line parse error
     return code == 0 ? kExitPass : kExitInput;
   }
 
   try {
+    if (!max_memory.empty()) {
+      parseByteSize(max_memory, "--max-memory");
+      ::setenv("RASTERCHECK_MAX_MEMORY", max_memory.c_str(), 1);
+    }
+    if (!max_work.empty()) {
+      parseWork(max_work, "--max-work");
+      ::setenv("RASTERCHECK_MAX_WORK", max_work.c_str(), 1);
+    }
     if (*render_cmd) return renderCommand(render);
     if (*list_cmd) return listCommand(list);
     if (*generate_cmd) return generateCommand(generate);
@@ -160,17 +262,25 @@ int runCli(int argc, char** argv) {
     if (*accuracy_cmd) return accuracyCommand(accuracy);
     if (*explain_cmd) return explainCommand(explain);
     if (*reduce_cmd) return reduceCommand(reduce);
+    if (*campaign_cmd) {
+      campaign.command_line = "rastercheck";
+      for (int i = 1; i < argc; ++i) campaign.command_line += " " + shellQuote(argv[i]);
+      return campaignCommand(campaign);
+    }
+    if (*merge_cmd) return mergeCommand(merge);
+    if (*diff_runs_cmd) return diffRunsCommand(diff_runs);
+    if (*worker_cmd) return workerCommand(worker_spec);
   } catch (const InputError& e) {
-    std::cerr << "rastercheck: error: " << e.what() << '\n';
+    std::cerr << "rastercheck: error: " << oneLineMessage(e.what()) << '\n';
     return kExitInput;
   } catch (const NotSupportedError& e) {
     std::cerr << "rastercheck: " << e.what() << '\n';  // "not supported: ..."
     return kExitBackend;
   } catch (const BackendError& e) {
-    std::cerr << "rastercheck: backend error: " << e.what() << '\n';
+    std::cerr << "rastercheck: backend error: " << oneLineMessage(e.what()) << '\n';
     return kExitBackend;
   } catch (const std::exception& e) {
-    std::cerr << "rastercheck: internal error: " << e.what() << '\n';
+    std::cerr << "rastercheck: internal error: " << oneLineMessage(e.what()) << '\n';
     return kExitBackend;
   }
   return kExitInput;

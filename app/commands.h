@@ -26,6 +26,9 @@ struct GenerateArgs {
   std::filesystem::path meshes;  // empty: /usr/share/assimp/models
 };
 int generateCommand(const GenerateArgs& args);
+struct RandomSceneOptions;
+// The generator's options from the arguments, checked (InputError names the option).
+RandomSceneOptions generateOptions(const GenerateArgs& args);
 
 struct ListArgs {
   std::vector<std::filesystem::path> paths;
@@ -49,6 +52,7 @@ struct CompareArgs {
   std::filesystem::path uncertainty;  // empty: the expected (or actual) frame's channels
   std::filesystem::path out;
   std::vector<std::string> tolerance;
+  bool diff_exr = false;  // write diff.exr also when the pair passes
 };
 int compareCommand(const CompareArgs& args);
 
@@ -58,13 +62,33 @@ struct RunArgs {
   std::string against = "ref";
   std::filesystem::path out;
   std::vector<std::string> tolerance;
-  int jobs = 0;          // 0: one per core
-  bool variants = true;  // probe each GL backend's variants (app/variants.h)
+  int jobs = 0;                    // 0: one per core
+  bool variants = true;            // probe each GL backend's variants (app/variants.h)
+  double timeout_seconds = 120.0;  // per render: a worker past it is killed (0: no watchdog)
+  bool keep_frames = false;        // frames and pair images of passing pairs too
+  std::string shard;               // "K/N" or "env"; empty: the whole run
   // Known driver differences to mark (compare/expectations.h): a file, "none", or empty
   // for the default (defaultExpectationsFile()).
   std::string expectations;
 };
 int runCommand(const RunArgs& args);
+
+// `rastercheck worker --backend SPEC`: hidden; `run` starts it (app/worker.h).
+int workerCommand(const std::string& spec);
+
+struct MergeArgs {
+  std::vector<std::filesystem::path> runs;  // folders written by `run --shard K/N`
+  std::filesystem::path out;
+};
+int mergeCommand(const MergeArgs& args);
+
+struct DiffRunsArgs {
+  std::filesystem::path old_run;
+  std::filesystem::path new_run;
+  bool json = false;          // print JSON instead of text
+  std::filesystem::path out;  // also write diff.json, diff.txt and diff.html there
+};
+int diffRunsCommand(const DiffRunsArgs& args);
 
 struct AccuracyArgs {
   std::vector<std::filesystem::path> runs;      // folders written by `run`
@@ -95,5 +119,28 @@ struct ReduceArgs {
   std::vector<std::string> tolerance;
 };
 int reduceCommand(const ReduceArgs& args);
+
+struct CampaignArgs {
+  std::string seed;  // as for generate
+  std::int64_t count = 100;
+  std::string profile = "all";
+  std::string max_size = "200x150";
+  std::filesystem::path meshes;
+  std::vector<std::string> backends;
+  std::string against = "ref";
+  std::filesystem::path out;
+  std::vector<std::string> tolerance;
+  double reduce_seconds = 60.0;  // per failure; 0: do not reduce (probe the original)
+  int jobs = 0;                  // 0: one per core
+  int batch = 20;                // scenes per `run`
+  // Known driver differences for the `run` children (as run --expectations): a file,
+  // "none", or empty for the default (fixtures/expectations.json).
+  std::string expectations;
+  bool mutations = false;           // the mutation study instead of a failure campaign
+  std::vector<std::string> faults;  // --mutations: the faults to inject (default: all)
+  std::string command_line;         // as typed, for the summary
+};
+int campaignCommand(const CampaignArgs& args);
+int mutationCampaign(const CampaignArgs& args);
 
 }  // namespace rc

@@ -13,6 +13,7 @@
 #include "compare/report.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
+#include "fixtures/resource_estimate.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -20,6 +21,11 @@ namespace fs = std::filesystem;
 int compareCommand(const CompareArgs& args) {
   CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
+  // The frames' memory within the limit before either is read (fixtures/resource_estimate.h).
+  for (const fs::path& dir : {args.expected, args.actual}) {
+    const auto [width, height] = readFrameSize(dir);
+    checkComparison(dir.string(), width, height, ResourceLimits::current());
+  }
   // The frames are independent files: read them concurrently (decompression dominates),
   // each with the check that its color.png can be reused (a digest of the whole frame).
   struct Read {
@@ -59,8 +65,8 @@ int compareCommand(const CompareArgs& args) {
   report.tool_version = kVersion;
   report.command = "compare";
   const PairPictures pictures{expected_read.picture, actual_read.picture};
-  report.results.push_back(
-      comparePair(expected, actual, *uncertainty, tolerances, folder.staging(), pictures));
+  report.results.push_back(comparePair(expected, actual, *uncertainty, tolerances, folder,
+                                       pictures, args.diff_exr));
   folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);

@@ -3,31 +3,23 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "app/paths.h"
+#include "app/worker_pool.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 
 namespace rc {
 namespace fs = std::filesystem;
 
-ScratchDir::ScratchDir(std::string_view prefix) {
-  std::string pattern =
-      (fs::temp_directory_path() / fmt::format("rastercheck-{}-XXXXXX", prefix)).string();
-  std::vector<char> buf(pattern.begin(), pattern.end());
-  buf.push_back('\0');
-  if (::mkdtemp(buf.data()) == nullptr)
-    throw InputError(fmt::format("cannot create a scratch folder {}", pattern));
-  path_ = buf.data();
-}
+ScratchDir::ScratchDir(std::string_view prefix) : folder_(prefix), path_(folder_.path()) {}
 
 ScratchDir::~ScratchDir() {
-  if (const char* keep = std::getenv("RASTERCHECK_KEEP_SCRATCH"); keep && *keep) return;
-  std::error_code ec;
-  fs::remove_all(path_, ec);
+  if (const char* keep = std::getenv("RASTERCHECK_KEEP_SCRATCH"); keep && *keep) folder_.keep();
 }
 
 Job renderJob(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {
@@ -40,15 +32,8 @@ Job renderJob(const fs::path& scene_file, const std::string& spec, const fs::pat
 
 std::string childFailure(const Job& job, const std::vector<std::string>& also_strip) {
   std::ifstream in(job.log);
-  std::string line;
-  std::string last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  for (const char* prefix :
-       {"rastercheck: backend error: ", "rastercheck: error: ", "rastercheck: internal error: "}) {
-    if (last.rfind(prefix, 0) == 0) last = last.substr(std::string(prefix).size());
-  }
+  std::string last = lastErrorLine(
+      std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
   for (const std::string& prefix : also_strip) {
     if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
   }

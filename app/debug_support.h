@@ -12,12 +12,15 @@
 #include "app/backends.h"
 #include "app/subprocess.h"
 #include "fixtures/frame.h"
+#include "fixtures/output_folder.h"
 #include "fixtures/scene.h"
 
 namespace rc {
 
 // A fresh folder under the system temporary directory, removed with its contents when
-// the object goes (unless RASTERCHECK_KEEP_SCRATCH is set, for debugging the tool).
+// the object goes (unless RASTERCHECK_KEEP_SCRATCH is set, for debugging the tool: then it
+// is kept as rastercheck-PREFIX-PID). A killed process's is removed by the next command
+// (fixtures/output_folder.h ScratchFolder).
 class ScratchDir {
  public:
   explicit ScratchDir(std::string_view prefix);
@@ -27,6 +30,7 @@ class ScratchDir {
   const std::filesystem::path& path() const { return path_; }
 
  private:
+  ScratchFolder folder_;
   std::filesystem::path path_;
 };
 

@@ -21,6 +21,7 @@
 #include "compare/compare.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
+#include "fixtures/resource_estimate.h"
 #include "fixtures/scene_logic.h"
 #include "reference/fragment_ops.h"
 #include "reference/shading.h"
@@ -479,6 +480,10 @@ int explainCommand(const ExplainArgs& args) {
   parseToleranceArgs(args.tolerance, cli);
   const glm::ivec2 pixel = parsePixel(args.pixel);
   const Scene scene = loadScene(args.scene);
+  checkResources(scene, RendererKind::Reference, ResourceLimits::current());
+  for (const std::string& spec : args.backends)
+    if (parseBackendSpec(spec).kind == BackendSpec::Kind::Gl)
+      checkResources(scene, RendererKind::Gl, ResourceLimits::current());
   if (pixel.x < 0 || pixel.y < 0 || pixel.x >= scene.width || pixel.y >= scene.height)
     throw InputError(fmt::format("{}: pixel {},{} is outside the {}x{} image", args.scene.string(),
                                  pixel.x, pixel.y, scene.width, scene.height));

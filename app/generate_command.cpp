@@ -1,7 +1,5 @@
 // `rastercheck generate --seed S --count N --out DIR`: reproducible random fixtures
-// (fixtures/random_scene.h), written all-or-nothing through a staging folder beside DIR.
-#include <unistd.h>
-
+// (fixtures/random_scene.h), the folder replaced all-or-nothing (fixtures/output_folder.h).
 #include <charconv>
 #include <iostream>
 #include <limits>
@@ -11,73 +9,12 @@
 
 #include "app/commands.h"
 #include "fixtures/errors.h"
+#include "fixtures/output_folder.h"
 #include "fixtures/random_scene.h"
 
 namespace rc {
 namespace fs = std::filesystem;
 namespace {
-
-// A folder written all-or-nothing: everything goes into `.<name>.staging-<pid>` beside
-// `out`; commit() swaps it into place (an earlier generated folder is replaced whole);
-// destroyed without commit(), it removes the staging folder and `out` stays as it was.
-// Kept small so that a shared atomic-folder mechanism can take its place.
-class StagedFolder {
- public:
-  explicit StagedFolder(fs::path out) : out_(std::move(out)) {
-    std::error_code ec;
-    if (fs::exists(out_, ec) && !fs::is_directory(out_, ec))
-      throw InputError(fmt::format("{}: --out names a file; it must be a folder", out_.string()));
-    if (fs::is_directory(out_, ec) && !fs::is_empty(out_, ec) &&
-        !fs::exists(out_ / kRandomManifest, ec))
-      throw InputError(fmt::format(
-          "{}: --out is a folder that `generate` did not write (no {}); name a new or empty "
-          "folder",
-          out_.string(), kRandomManifest));
-    fs::create_directories(out_.parent_path(), ec);
-    staging_ = sibling("staging");
-    fs::remove_all(staging_, ec);
-    if (!fs::create_directory(staging_, ec) || ec)
-      throw InputError(
-          fmt::format("{}: cannot create the output folder: {}", staging_.string(), ec.message()));
-  }
-  StagedFolder(const StagedFolder&) = delete;
-  StagedFolder& operator=(const StagedFolder&) = delete;
-  ~StagedFolder() {
-    std::error_code ec;
-    if (!committed_) fs::remove_all(staging_, ec);
-  }
-
-  const fs::path& path() const { return staging_; }
-
-  void commit() {
-    std::error_code ec;
-    const fs::path old = sibling("old");
-    const bool replacing = fs::exists(out_, ec);
-    if (replacing) {
-      fs::remove_all(old, ec);
-      fs::rename(out_, old, ec);
-      if (ec) throw InputError(fmt::format("{}: cannot replace: {}", out_.string(), ec.message()));
-    }
-    fs::rename(staging_, out_, ec);
-    if (ec) {
-      std::error_code undo;
-      if (replacing) fs::rename(old, out_, undo);
-      throw InputError(fmt::format("{}: cannot move into place: {}", out_.string(), ec.message()));
-    }
-    committed_ = true;
-    if (replacing) fs::remove_all(old, ec);
-  }
-
- private:
-  fs::path sibling(const char* what) const {
-    return out_.parent_path() /
-           fmt::format(".{}.{}-{}", out_.filename().string(), what, ::getpid());
-  }
-
-  fs::path out_;
-  fs::path staging_;
-  bool committed_ = false;
-};
 
 // A decimal in [0, 2^64 - 1], digits only.
 std::uint64_t parseUnsigned(const std::string& text, const char* option) {
@@ -92,7 +29,7 @@ std::uint64_t parseUnsigned(const std::string& text, const char* option) {
 
 }  // namespace
 
-int generateCommand(const GenerateArgs& args) {
+RandomSceneOptions generateOptions(const GenerateArgs& args) {
   RandomSceneOptions options;
   options.seed = parseUnsigned(args.seed, "--seed");
   options.first = parseUnsigned(args.first, "--first");
@@ -114,13 +51,26 @@ int generateCommand(const GenerateArgs& args) {
   options.profile = parseRandomProfile(args.profile);
   if (!args.meshes.empty()) options.mesh_root = fs::absolute(args.meshes).lexically_normal();
   checkRandomMeshFiles(options);
+  return options;
+}
+
+int generateCommand(const GenerateArgs& args) {
+  const RandomSceneOptions options = generateOptions(args);
 
   // "DIR/" and "DIR/." name DIR itself.
   fs::path out = fs::absolute(args.out).lexically_normal();
   if (!out.has_filename()) out = out.parent_path();
   if (out == out.root_path()) throw InputError("--out: cannot be the root folder");
-  StagedFolder folder(out);
-  writeRandomFixtures(options, folder.path());
+  // The folder is replaced whole (fixtures/output_folder.h), so it must be one that
+  // `generate` wrote, or new, or empty.
+  std::error_code ec;
+  if (fs::is_directory(out, ec) && !fs::is_empty(out, ec) && !fs::exists(out / kRandomManifest, ec))
+    throw InputError(fmt::format(
+        "{}: --out is a folder that `generate` did not write (no {}); name a new or empty "
+        "folder",
+        out.string(), kRandomManifest));
+  OutputFolder folder(out, {"*"});
+  writeRandomFixtures(options, folder.staging());
   folder.commit();
   std::cout << fmt::format("wrote {} fixtures (seed {}, profile {}) to {}\n", options.count,
                            options.seed, toString(options.profile), out.string());

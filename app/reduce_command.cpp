@@ -361,7 +361,6 @@ class Reducer {
         timed_out_ ? " (time ran out: not minimal)" : "");
     if (std::find(reduced.tags.begin(), reduced.tags.end(), "reduced") == reduced.tags.end())
       reduced.tags.emplace_back("reduced");
-    if (args_.out.has_parent_path()) fs::create_directories(args_.out.parent_path());
     writeSceneFile(reduced, args_.out);
 
     std::cout << fmt::format(
@@ -434,7 +433,10 @@ int reduceCommand(const ReduceArgs& args) {
   if (args.out.extension() != ".json")
     throw InputError(
         fmt::format("--out {}: the minimal fixture is a .json file", args.out.string()));
-  Reducer reducer(args, loadScene(args.scene));
+  Scene scene = loadScene(args.scene);
+  checkResources(scene, rendererKind(parseBackendSpec(args.expected)), ResourceLimits::current());
+  checkResources(scene, rendererKind(parseBackendSpec(args.actual)), ResourceLimits::current());
+  Reducer reducer(args, std::move(scene));
   return reducer.run();
 }
 

@@ -17,6 +17,7 @@
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
+#include "fixtures/resource_estimate.h"
 
 namespace rc {
 
@@ -56,6 +57,7 @@ int renderCommand(const RenderArgs& args) {
   const BackendSpec backend = parseBackendSpec(args.backend);
   restartWithStartupEnvironment(args, backend);
   const Scene scene = loadScene(args.scene);
+  checkResources(scene, rendererKind(backend), ResourceLimits::current());
   const Frame frame = renderWith(backend, scene);
   writeFrameDir(frame, args.out);
   std::cout << fmt::format("{}: {} -> {}\n", scene.name, backend.text, args.out.string());

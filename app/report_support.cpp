@@ -1,8 +1,6 @@
 // See report_support.h.
 #include "app/report_support.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <fstream>
 #include <map>
@@ -69,103 +67,49 @@ nlohmann::json driverStack(const Frame& frame) {
 
 }  // namespace
 
-PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
-                       const Tolerances& tolerances, const fs::path& out_dir,
-                       const PairPictures& pictures) {
-  ClassMaps maps;
-  PairResult result = compareFrames(expected, actual, uncertainty, tolerances, &maps);
-  auto name = [](const Frame& f, const char* fallback) {
-    return f.meta.contains("backend") && f.meta["backend"].is_string()
-               ? f.meta["backend"].get<std::string>()
-               : std::string(fallback);
+PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                        const Tolerances& tolerances, ClassMaps* maps) {
+  PairResult result = compareFrames(expected, actual, uncertainty, tolerances, maps);
+  auto text = [](const Frame& f, const char* key, const char* fallback) {
+    return f.meta.contains(key) && f.meta[key].is_string() ? f.meta[key].get<std::string>()
+                                                           : std::string(fallback);
   };
-  result.expected = name(expected, "expected");
-  result.actual = name(actual, "actual");
+  result.expected = text(expected, "backend", "expected");
+  result.actual = text(actual, "backend", "actual");
   result.expected_stack = driverStack(expected);
   result.actual_stack = driverStack(actual);
-  if (expected.meta.contains("fixture") && expected.meta["fixture"].is_string())
-    result.fixture = expected.meta["fixture"].get<std::string>();
-  writePairImages(expected, actual, maps, pairDirectory(out_dir, result), result, pictures);
+  result.fixture = text(expected, "fixture", "");
+  result.fixture_file = text(expected, "fixture_file", "");
+  if (expected.meta.contains("tags") && expected.meta["tags"].is_array())
+    for (const nlohmann::json& t : expected.meta["tags"])
+      if (t.is_string()) result.tags.push_back(t.get<std::string>());
+  setHeatScales(result);
+  return result;
+}
+
+PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                       const Tolerances& tolerances, ReportFolder& folder,
+                       const PairPictures& pictures, bool diff_exr_when_passing) {
+  ClassMaps maps;
+  PairResult result = compareNamed(expected, actual, uncertainty, tolerances, &maps);
+  writePairImages(expected, actual, maps, folder.pairDirectory(result), result, pictures,
+                  diff_exr_when_passing || result.status != Status::Pass);
   return result;
 }
 
 // ---- ReportFolder ----
 
-namespace {
-
-constexpr const char* kOwnedEntries[] = {"frames", "pairs", "report.json", "junit.xml",
-                                         "report.html"};
-
-// Removes the image files an earlier report.json names (relative paths inside `out`
-// only) and the folders they leave empty.
-void removeReportedFiles(const fs::path& out) {
-  std::ifstream in(out / "report.json");
-  if (!in) return;
-  const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
-  if (old.is_discarded() || !old.contains("results") || !old["results"].is_array()) return;
-  std::error_code ec;
-  for (const nlohmann::json& row : old["results"]) {
-    if (!row.is_object() || !row.contains("images") || !row["images"].is_object()) continue;
-    for (const auto& [kind, value] : row["images"].items()) {
-      if (!value.is_string()) continue;
-      const fs::path rel = fs::path(value.get<std::string>()).lexically_normal();
-      if (rel.empty() || rel.is_absolute() || *rel.begin() == "..") continue;
-      fs::path file = out / rel;
-      fs::remove(file, ec);
-      for (fs::path dir = file.parent_path();
-           dir != out && dir.string().size() > out.string().size(); dir = dir.parent_path()) {
-        if (!fs::is_empty(dir, ec) || ec) break;
-        fs::remove(dir, ec);
-      }
-    }
-  }
+const std::vector<std::string>& ReportFolder::ownedNames() {
+  static const std::vector<std::string> names = {"frames",      "pairs",     "variants",
+                                                 "report.json", "junit.xml", "report.html"};
+  return names;
 }
 
-}  // namespace
-
-ReportFolder::ReportFolder(fs::path out) : out_(std::move(out)) {
-  std::error_code ec;
-  if (out_.empty()) throw InputError("--out: needs a folder");
-  if (fs::exists(out_, ec) && !fs::is_directory(out_, ec))
-    throw InputError(fmt::format("{}: --out names a file; it must be a folder", out_.string()));
-  if (!fs::exists(out_, ec)) {
-    fs::create_directories(out_, ec);
-    if (ec)
-      throw InputError(
-          fmt::format("{}: cannot create the report folder: {}", out_.string(), ec.message()));
-    created_out_ = true;
-  }
-  staging_ = out_ / fmt::format(".rastercheck-staging-{}", ::getpid());
-  fs::remove_all(staging_, ec);
-  fs::create_directory(staging_, ec);
-  if (ec) {
-    if (created_out_) fs::remove(out_, ec);
-    throw InputError(
-        fmt::format("{}: cannot write into the report folder: {}", out_.string(), ec.message()));
-  }
-}
-
-ReportFolder::~ReportFolder() {
-  if (committed_) return;
-  std::error_code ec;
-  fs::remove_all(staging_, ec);
-  if (created_out_) fs::remove(out_, ec);  // only when still empty
-}
+ReportFolder::ReportFolder(fs::path out) : folder_(std::move(out), ownedNames()) {}
 
 void ReportFolder::commit(const Report& report) {
-  writeReport(report, staging_);
-  std::error_code ec;
-  removeReportedFiles(out_);
-  for (const char* name : kOwnedEntries) fs::remove_all(out_ / name, ec);
-  for (const char* name : kOwnedEntries) {
-    if (!fs::exists(staging_ / name, ec)) continue;
-    fs::rename(staging_ / name, out_ / name, ec);
-    if (ec)
-      throw InputError(
-          fmt::format("{}: cannot move into place: {}", (out_ / name).string(), ec.message()));
-  }
-  fs::remove_all(staging_, ec);
-  committed_ = true;
+  writeReport(report, staging());
+  folder_.commit();
 }
 
 PairResult failedRenderResult(std::string fixture, std::string expected, std::string actual,
@@ -175,11 +119,16 @@ PairResult failedRenderResult(std::string fixture, std::string expected, std::st
   return errorResult(std::move(fixture), std::move(expected), std::move(actual), message);
 }
 
+bool needsResample(const Frame& ref, const Frame& gl) {
+  if (!ref.multisampled() || !gl.multisampled()) return false;
+  const std::vector<glm::dvec2> want = samplePositionsFromMeta(gl.meta);
+  return !want.empty() && want != samplePositionsFromMeta(ref.meta);
+}
+
 void resampleReference(Frame& ref, const Frame& gl, const fs::path& scene_file,
                        ReferenceOptions options) {
-  if (!ref.multisampled() || !gl.multisampled()) return;
+  if (!needsResample(ref, gl)) return;
   const std::vector<glm::dvec2> want = samplePositionsFromMeta(gl.meta);
-  if (want.empty() || want == samplePositionsFromMeta(ref.meta)) return;
   options.sample_positions = want;
   Frame again = renderReference(loadScene(scene_file), options);
   nlohmann::json meta = ref.meta;

@@ -4,14 +4,18 @@
 #pragma once
 
 #include <filesystem>
+#include <mutex>
 #include <optional>
 #include <ostream>
+#include <string>
+#include <vector>
 
 #include "compare/compare.h"
 #include "compare/pair_images.h"
 #include "compare/report.h"
 #include "compare/tolerances.h"
 #include "fixtures/frame.h"
+#include "fixtures/output_folder.h"
 #include "fixtures/scene.h"
 #include "reference/reference_renderer.h"
 
@@ -27,10 +31,20 @@ ToleranceOverrides fixtureTolerance(const Frame& expected, const Frame& actual);
 Tolerances pairTolerances(const Frame& expected, const Frame& actual,
                           const ToleranceOverrides& fixture, const CommandLineTolerances& cli);
 
-// Compares and writes the pair's images under out_dir (pairDirectory).
+class ReportFolder;
+
+// Compares without writing anything: the result named from the frames' frame.json
+// (fixture, backends, fixture file, tags, driver stacks), with its heat scales; `maps` as
+// compareFrames.
+PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame& uncertainty,
+                        const Tolerances& tolerances, ClassMaps* maps);
+
+// Compares and writes the pair's images into the report folder (a folder of its own for
+// every pair: ReportFolder::pairDirectory); diff.exr only when the pair does not pass,
+// unless diff_exr_when_passing.
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
-                       const Tolerances& tolerances, const std::filesystem::path& out_dir,
-                       const PairPictures& pictures = {});
+                       const Tolerances& tolerances, ReportFolder& folder,
+                       const PairPictures& pictures = {}, bool diff_exr_when_passing = true);
 
 // A report row for a pair whose render failed with `message`: status not_supported when
 // the message says the backend does not support the fixture, else error.
@@ -43,35 +57,41 @@ PairResult failedRenderResult(std::string fixture, std::string expected, std::st
 // Nothing happens for single-sample frames or frames without positions.
 void resampleReference(Frame& ref, const Frame& gl, const std::filesystem::path& scene_file,
                        ReferenceOptions options);
+// Whether resampleReference(ref, gl, ...) would render again (cheap: frame.json only).
+bool needsResample(const Frame& ref, const Frame& gl);
 
 // A frame folder's color.png when it shows `frame` (frame.json's "color_digest", written
 // by `render`, matches the frame that was read), else empty: then the comparator encodes
 // the picture itself.
 std::filesystem::path readyPicture(const std::filesystem::path& frame_dir, const Frame& frame);
 
-// A report folder written all-or-nothing. Everything goes to a staging folder inside it;
-// commit() writes the report there, then removes what an earlier run left (the files its
-// report.json names, and the pairs/ and frames/ folders and report files this tool
-// writes) and moves the new outputs in. Destroyed without commit(), it removes the
-// staging folder (and `out` itself when it created it), leaving earlier outputs as they
-// were.
+// A report folder replaced whole (fixtures/output_folder.h): everything is written under
+// staging(); commit() writes the report files there and puts the folder in place in one
+// step. Files of the user's in an earlier report folder are kept; what an earlier run
+// wrote (frames/, pairs/, variants/, the report files) goes. Destroyed without commit(),
+// nothing of it remains and the earlier outputs are as they were.
 class ReportFolder {
  public:
-  // Throws InputError when `out` exists and is not a folder, or cannot be created.
-  explicit ReportFolder(std::filesystem::path out);
-  ReportFolder(const ReportFolder&) = delete;
-  ReportFolder& operator=(const ReportFolder&) = delete;
-  ~ReportFolder();
+  // The top-level names a report folder's writers use.
+  static const std::vector<std::string>& ownedNames();
 
-  const std::filesystem::path& path() const { return out_; }
-  const std::filesystem::path& staging() const { return staging_; }
+  // Throws InputError when `out` exists and is not a folder, or cannot be staged.
+  explicit ReportFolder(std::filesystem::path out);
+
+  const std::filesystem::path& path() const { return folder_.target(); }
+  const std::filesystem::path& staging() const { return folder_.staging(); }
+  // A fresh folder under staging() for one pair's images, unique whatever the names.
+  // Thread-safe: `run` compares fixtures on several threads.
+  std::filesystem::path pairDirectory(const PairResult& result) {
+    const std::lock_guard lock(pairs_mutex_);
+    return pairs_.take(staging(), result);
+  }
   void commit(const Report& report);
 
  private:
-  std::filesystem::path out_;
-  std::filesystem::path staging_;
-  bool created_out_ = false;
-  bool committed_ = false;
+  OutputFolder folder_;
+  std::mutex pairs_mutex_;
+  PairFolders pairs_;
 };
 
 // Closing lines (idiff style): one line per non-passing pair, a fixture x backend table

@@ -1,16 +1,24 @@
 // `rastercheck run [FIXTURES|DIRS...] --backends SPEC,... [--against SPEC] --out DIR`:
-// renders every fixture with every backend, each render in its own child process
-// (`rastercheck render`, so a driver crash costs one row and each process picks its own
-// GL driver), then compares every backend with --against, classifying with the
-// reference's uncertainty channels, and writes one report. Everything the user gave is
-// checked before the first render (exit 2, nothing written); the outputs replace an
-// earlier run's only once all of them are written.
+// renders every fixture with every backend on long-lived workers (app/worker_pool.h: one
+// process per backend and busy slot, its driver loaded once, so a driver crash or hang
+// costs one row), compares every backend with --against as each fixture's frames arrive,
+// classifying with the reference's uncertainty channels, and writes one report. Frames
+// and pair images are written for pairs that do not pass (all with --keep-frames).
+// Everything the user gave is checked before the first render (exit 2, nothing written);
+// the outputs replace an earlier run's only once all of them are written. With
+// --shard K/N it runs one deterministic part of the whole run (compare/shards.h).
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <exception>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -18,14 +26,14 @@
 
 #include "app/backends.h"
 #include "app/commands.h"
-#include "app/debug_support.h"
 #include "app/paths.h"
 #include "app/report_support.h"
-#include "app/subprocess.h"
 #include "app/variants.h"
 #include "app/version.h"
+#include "app/worker_pool.h"
 #include "compare/expectations.h"
 #include "compare/report.h"
+#include "compare/shards.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
@@ -40,6 +48,14 @@ struct FixtureEntry {
   std::string name;
   std::string slug;  // unique folder name
   ToleranceOverrides tolerance;
+  double raster = 0.0;  // rasterCost (compare/shards.h)
+};
+
+// One compared pair of the whole run: fixture, actual backend, place in the report.
+struct PairPlan {
+  std::size_t fixture = 0;
+  std::size_t backend = 0;  // index into the backends
+  std::size_t index = 0;    // row in the whole (unsharded) run's report
 };
 
 // One status line on a terminal, redrawn in place; nothing when stderr is not a tty.
@@ -64,6 +80,96 @@ class Progress {
   std::size_t width_ = 0;
 };
 
+// Comparison threads: a fixture is compared as soon as all its frames are in, beside the
+// rendering, so that the workers never wait for the comparator.
+class CompareQueue {
+ public:
+  CompareQueue(int threads, std::function<void(std::size_t)> work) : work_(std::move(work)) {
+    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { loop(); });
+  }
+  // Only reached without finish() when the run is already failing: that failure wins.
+  ~CompareQueue() {
+    try {
+      finish();
+    } catch (...) {  // NOLINT(bugprone-empty-catch)
+    }
+  }
+  void push(std::size_t fixture) {
+    {
+      const std::lock_guard lock(mutex_);
+      queue_.push_back(fixture);
+    }
+    ready_.notify_one();
+  }
+  // Fixtures queued or being compared.
+  std::size_t backlog() {
+    const std::lock_guard lock(mutex_);
+    return queue_.size() + active_;
+  }
+  // Waits for the queue to drain and the threads to end; rethrows the first failure.
+  void finish() {
+    {
+      const std::lock_guard lock(mutex_);
+      closing_ = true;
+    }
+    ready_.notify_all();
+    for (std::thread& t : threads_)
+      if (t.joinable()) t.join();
+    if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
+  }
+  bool failed() {
+    const std::lock_guard lock(mutex_);
+    return failure_ != nullptr;
+  }
+
+ private:
+  void loop() {
+    for (;;) {
+      std::size_t fixture = 0;
+      {
+        std::unique_lock lock(mutex_);
+        ready_.wait(lock, [&] { return closing_ || !queue_.empty(); });
+        if (queue_.empty() || failure_) return;
+        fixture = queue_.front();
+        queue_.pop_front();
+        ++active_;
+      }
+      try {
+        work_(fixture);
+      } catch (...) {
+        const std::lock_guard lock(mutex_);
+        if (!failure_) failure_ = std::current_exception();
+      }
+      const std::lock_guard lock(mutex_);
+      --active_;
+    }
+  }
+
+  std::function<void(std::size_t)> work_;
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<std::size_t> queue_;
+  std::size_t active_ = 0;
+  bool closing_ = false;
+  std::exception_ptr failure_;
+  std::vector<std::thread> threads_;
+};
+
+// "<fixture>: <spec>: why" as the backend says it, without what the row already names.
+std::string stripNames(std::string message, const std::vector<std::string>& prefixes) {
+  for (const std::string& p : prefixes)
+    if (message.rfind(p, 0) == 0) message = message.substr(p.size());
+  return message;
+}
+
+void writeText(const fs::path& file, const std::string& text) {
+  std::error_code ec;
+  fs::create_directories(file.parent_path(), ec);
+  std::ofstream out(file);
+  out << text;
+  if (!out) throw InputError(fmt::format("{}: cannot write", file.string()));
+}
+
 }  // namespace
 
 int runCommand(const RunArgs& args) {
@@ -79,148 +185,258 @@ int runCommand(const RunArgs& args) {
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));
   const BackendSpec against = parseBackendSpec(args.against);
+  if (!(args.timeout_seconds >= 0.0))
+    throw InputError(fmt::format("--timeout {}: must be a number of seconds >= 0 (0: none)",
+                                 args.timeout_seconds));
+  const bool sharded = !args.shard.empty();
+  const ShardSpec shard = sharded ? parseShard(args.shard) : ShardSpec{};
   std::error_code ec;
   if (fs::exists(args.out, ec) && !fs::is_directory(args.out, ec))
     throw InputError(fmt::format("{}: --out names a file; it must be a folder", args.out.string()));
-
-  // Every SPEC rendered once per fixture: the backends, --against, and the reference
-  // whose edge_dist/depth_gap classify every pair.
-  std::vector<std::string> render_specs;
-  auto addSpec = [&](const std::string& s) {
-    if (std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end())
-      render_specs.push_back(s);
-  };
-  addSpec("ref");
-  addSpec(against.text);
-  for (const BackendSpec& b : backends) addSpec(b.text);
 
   std::vector<fs::path> inputs = args.inputs;
   if (inputs.empty()) inputs.push_back(defaultCatalogDir());
   // Validate every fixture before rendering anything: bad input exits 2 with no output.
   std::vector<FixtureEntry> fixtures;
   std::set<std::string> slugs;
+  // Every render's estimate within the limits, too (the reference always renders).
+  const ResourceLimits limits = ResourceLimits::current();
+  const bool any_gl = against.kind == BackendSpec::Kind::Gl ||
+                      std::any_of(backends.begin(), backends.end(), [](const BackendSpec& b) {
+                        return b.kind == BackendSpec::Kind::Gl;
+                      });
   for (const fs::path& file : findFixtures(inputs)) {
     const Scene scene = loadScene(file);
+    checkResources(scene, RendererKind::Reference, limits);
+    if (any_gl) checkResources(scene, RendererKind::Gl, limits);
+    checkComparison(file.string(), scene.width, scene.height, limits);
     std::string slug = fixtureSlug(scene.name);
     for (int k = 2; !slugs.insert(slug).second; ++k)
       slug = fixtureSlug(scene.name) + "~" + std::to_string(k);
-    fixtures.push_back({fs::absolute(file), scene.name, slug, scene.tolerance});
+    fixtures.push_back({fs::absolute(file), scene.name, slug, scene.tolerance, rasterCost(scene)});
   }
   if (fixtures.empty()) throw InputError("run: no fixtures found in the given paths");
 
-  ReportFolder folder(args.out);
-  const fs::path frames_dir = folder.staging() / "frames";
-  std::vector<Job> jobs;  // fixture-major: job i renders fixture i / N with spec i % N
-  std::map<std::pair<std::size_t, std::string>, std::size_t> job_of;
-  for (std::size_t f = 0; f < fixtures.size(); ++f) {
-    const fs::path dir = frames_dir / fixtures[f].slug;
-    fs::create_directories(dir, ec);
-    if (ec) throw InputError(fmt::format("{}: cannot create: {}", dir.string(), ec.message()));
-    for (const std::string& spec : render_specs) {
-      job_of[{f, spec}] = jobs.size();
-      jobs.push_back(renderJob(fixtures[f].file, spec, dir / fixtureSlug(spec)));
+  // The whole run's pairs, in report order (fixture, then backend); a shard keeps its part.
+  std::vector<PairPlan> pairs;
+  for (std::size_t f = 0; f < fixtures.size(); ++f)
+    for (std::size_t b = 0; b < backends.size(); ++b)
+      if (backends[b].text != against.text) pairs.push_back({f, b, pairs.size()});
+  const std::size_t total_pairs = pairs.size();
+  // The reference renders too when --against has no uncertainty channels of its own.
+  const bool needs_ref = against.kind == BackendSpec::Kind::Gl;
+  nlohmann::json shard_block = nlohmann::json::object();
+  if (sharded) {
+    std::vector<ShardUnit> units;
+    units.reserve(pairs.size());
+    for (const PairPlan& p : pairs)
+      units.push_back(
+          {p.fixture, renderCost(fixtures[p.fixture].raster, backends[p.backend].text)});
+    std::vector<double> shared;
+    shared.reserve(fixtures.size());
+    for (const FixtureEntry& fx : fixtures)
+      shared.push_back(renderCost(fx.raster, against.text) +
+                       (needs_ref ? renderCost(fx.raster, "ref") : 0.0));
+    const std::vector<int> plan = assignShards(units, shared, shard.count);
+    std::vector<std::string> digest_parts = {against.text, std::to_string(shard.count)};
+    for (const BackendSpec& b : backends) digest_parts.push_back(b.text);
+    for (const std::string& t : args.tolerance) digest_parts.push_back(t);
+    for (const FixtureEntry& fx : fixtures) digest_parts.push_back(fx.name);
+    nlohmann::json indices = nlohmann::json::array();
+    std::vector<PairPlan> mine;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      if (plan[i] != shard.index - 1) continue;
+      mine.push_back(pairs[i]);
+      indices.push_back(pairs[i].index);
     }
+    pairs = std::move(mine);
+    shard_block = {{"index", shard.index},
+                   {"count", shard.count},
+                   {"pairs", total_pairs},
+                   {"plan", planDigest(digest_parts)},
+                   {"pair_indices", indices}};
   }
 
-  // Rendering: the line names the first fixture still rendering (k of N; the ones before
-  // it are done) and the SPECs running for it.
+  // What each fixture needs rendered: --against, the reference, its pairs' backends.
+  std::vector<std::vector<std::string>> needed(fixtures.size());
+  std::vector<std::vector<const PairPlan*>> pairs_of(fixtures.size());
+  for (const PairPlan& p : pairs) {
+    std::vector<std::string>& n = needed[p.fixture];
+    if (n.empty()) {
+      n.push_back(against.text);
+      if (needs_ref && against.text != "ref") n.emplace_back("ref");
+    }
+    if (std::find(n.begin(), n.end(), backends[p.backend].text) == n.end())
+      n.push_back(backends[p.backend].text);
+    pairs_of[p.fixture].push_back(&p);
+  }
+
+  ReportFolder folder(args.out);
+  const fs::path frames_dir = folder.staging() / "frames";
   const int parallel = args.jobs > 0
                            ? args.jobs
                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  Progress progress;
-  std::vector<std::size_t> left(fixtures.size(), render_specs.size());
-  std::vector<std::set<std::string>> running(fixtures.size());
-  auto showRender = [&] {
-    for (std::size_t f = 0; f < fixtures.size(); ++f) {
-      if (left[f] == 0) continue;
-      std::string specs;
-      for (const std::string& s : running[f]) specs += (specs.empty() ? "" : ", ") + s;
-      progress.show(fmt::format("[{}/{}] rendering {}{}", f + 1, fixtures.size(), fixtures[f].name,
-                                specs.empty() ? "" : " (" + specs + ")"));
-      return;
-    }
-  };
-  runJobs(
-      jobs, parallel,
-      [&](std::size_t i) {
-        running[i / render_specs.size()].insert(render_specs[i % render_specs.size()]);
-        showRender();
-      },
-      [&](std::size_t i) {
-        const std::size_t f = i / render_specs.size();
-        running[f].erase(render_specs[i % render_specs.size()]);
-        --left[f];
-        showRender();
-      });
-
-  auto frameDir = [&](std::size_t f, const std::string& spec) {
-    return frames_dir / fixtures[f].slug / fixtureSlug(spec);
-  };
-  // A frame a child said it wrote but that cannot be read is that backend's failure.
-  auto readRendered = [&](std::size_t f, const std::string& spec) {
-    try {
-      return readFrameDir(frameDir(f, spec));
-    } catch (const InputError& e) {
-      throw BackendError(fmt::format("{}: wrote an unreadable frame: {}", spec, e.what()));
-    }
-  };
   Report report;
   report.tool_version = kVersion;
   report.command = "run";
-  // Which legal variant each GL backend follows, probed once per backend for the run.
-  if (args.variants)
-    report.variants = detectVariants(render_specs, args.out / "variants", parallel);
-  for (std::size_t f = 0; f < fixtures.size(); ++f) {
-    const FixtureEntry& fx = fixtures[f];
-    progress.show(fmt::format("[{}/{}] comparing {}", f + 1, fixtures.size(), fx.name));
-    const Job& against_job = jobs[job_of[{f, against.text}]];
-    const Job& ref_job = jobs[job_of[{f, std::string("ref")}]];
-    for (const BackendSpec& b : backends) {
-      if (b.text == against.text) continue;
-      const Job& job = jobs[job_of[{f, b.text}]];
-      if (against_job.exit_code != 0) {
-        report.results.push_back(failedRenderResult(
-            fx.name, against.text, b.text,
-            against.text + ": " +
-                childFailure(against_job, {fx.name + ": ", against.text + ": "})));
-        continue;
-      }
-      if (job.exit_code != 0) {
-        report.results.push_back(failedRenderResult(
-            fx.name, against.text, b.text, childFailure(job, {fx.name + ": ", b.text + ": "})));
-        continue;
-      }
-      try {
-        Frame expected = readRendered(f, against.text);
-        const Frame actual = readRendered(f, b.text);
-        // A multisampled reference samples where the driver does (its frame.json positions).
-        if (expected.hasUncertainty() && against.kind == BackendSpec::Kind::Reference)
-          resampleReference(expected, actual, fx.file, against.reference);
-        if (expected.width != actual.width || expected.height != actual.height)
-          throw BackendError(fmt::format("{} drew {}x{}, {} drew {}x{}", against.text,
-                                         expected.width, expected.height, b.text, actual.width,
-                                         actual.height));
-        Frame ref;
-        const Frame* uncertainty = &expected;
-        if (!expected.hasUncertainty() && ref_job.exit_code == 0) {
-          ref = readRendered(f, "ref");
-          resampleReference(ref, actual, fx.file, ReferenceOptions{});
-          if (ref.width != expected.width || ref.height != expected.height)
-            throw BackendError(fmt::format("ref drew {}x{}, {} drew {}x{}", ref.width, ref.height,
-                                           against.text, expected.width, expected.height));
-          uncertainty = &ref;
-        }
-        // The tolerances were checked up front; an InputError from here on (a fixture
-        // changed under us) ends the run with exit 2 and no report.
-        const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
-        report.results.push_back(
-            comparePair(expected, actual, *uncertainty, tol, folder.staging()));
-      } catch (const BackendError& e) {
-        report.results.push_back(errorResult(fx.name, against.text, b.text, e.what()));
-      }
+  report.shard = shard_block;
+  std::vector<std::optional<PairResult>> results(pairs.size());
+  {
+    WorkerPool pool({parallel, args.timeout_seconds, folder.staging() / "workers"});
+    // Which legal variant each GL backend follows, probed once per backend for the run:
+    // first in the queue, so that the workers start (and load their drivers) on them.
+    std::vector<std::string> render_specs;
+    for (const auto& n : needed)
+      for (const std::string& s : n)
+        if (std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end())
+          render_specs.push_back(s);
+    VariantProbes probes;
+    std::vector<std::size_t> probe_tickets;
+    if (args.variants) {
+      probes = prepareVariantProbes(render_specs, folder.staging() / "variants");
+      for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool.submit(r));
     }
+    std::vector<RenderOutcome> probe_outcomes(probe_tickets.size());
+    std::size_t probes_left = probe_tickets.size();
+    const auto probes_start = std::chrono::steady_clock::now();
+    double probe_seconds = 0.0;
+
+    std::map<std::size_t, std::pair<std::size_t, std::string>> ticket_of;  // -> fixture, spec
+    std::vector<std::map<std::string, RenderOutcome>> got(fixtures.size());
+    std::vector<std::size_t> left(fixtures.size(), 0);
+    for (std::size_t f = 0; f < fixtures.size(); ++f) {
+      left[f] = needed[f].size();
+      for (const std::string& spec : needed[f])
+        ticket_of[pool.submit({fixtures[f].file, spec})] = {f, spec};
+    }
+
+    auto compareFixture = [&](std::size_t f) {
+      const FixtureEntry& fx = fixtures[f];
+      std::map<std::string, RenderOutcome>& outs = got[f];
+      const fs::path dir = frames_dir / fx.slug;
+      std::set<std::string> kept;
+      // Frames (and what the worker printed) of the renders a non-passing pair shows.
+      auto keepFrame = [&](const std::string& spec) -> fs::path {
+        fs::path frame_dir = dir / fixtureSlug(spec);
+        if (kept.insert(spec).second) {
+          const RenderOutcome& o = outs.at(spec);
+          if (o.ok) writeFrameDir(o.frame, frame_dir);
+          if (!o.log.empty()) writeText(fs::path(frame_dir) += ".log", o.log);
+        }
+        return frame_dir;
+      };
+      const RenderOutcome& a = outs.at(against.text);
+      for (const PairPlan* p : pairs_of[f]) {
+        const std::string& spec = backends[p->backend].text;
+        const RenderOutcome& b = outs.at(spec);
+        PairResult r;
+        if (!a.ok) {
+          keepFrame(against.text);
+          r = failedRenderResult(
+              fx.name, against.text, spec,
+              against.text + ": " + stripNames(a.error, {fx.name + ": ", against.text + ": "}));
+        } else if (!b.ok) {
+          keepFrame(spec);
+          r = failedRenderResult(fx.name, against.text, spec,
+                                 stripNames(b.error, {fx.name + ": ", spec + ": "}));
+        } else {
+          try {
+            const Frame& actual = b.frame;
+            // A multisampled reference samples where the driver does (its frame.json
+            // positions): rendered again here when they differ.
+            Frame resampled;
+            const Frame* expected_frame = &a.frame;
+            if (against.kind == BackendSpec::Kind::Reference && needsResample(a.frame, actual)) {
+              resampled = a.frame;
+              resampleReference(resampled, actual, fx.file, against.reference);
+              expected_frame = &resampled;
+            }
+            const Frame& expected = *expected_frame;
+            if (expected.width != actual.width || expected.height != actual.height)
+              throw BackendError(fmt::format("{} drew {}x{}, {} drew {}x{}", against.text,
+                                             expected.width, expected.height, spec, actual.width,
+                                             actual.height));
+            const Frame* uncertainty = &expected;
+            const bool use_ref =
+                !expected.hasUncertainty() && outs.count("ref") && outs.at("ref").ok;
+            Frame resampled_ref;
+            if (use_ref) {
+              const Frame* ref_frame = &outs.at("ref").frame;
+              if (needsResample(*ref_frame, actual)) {
+                resampled_ref = *ref_frame;
+                resampleReference(resampled_ref, actual, fx.file, ReferenceOptions{});
+                ref_frame = &resampled_ref;
+              }
+              const Frame& ref = *ref_frame;
+              if (ref.width != expected.width || ref.height != expected.height)
+                throw BackendError(fmt::format("ref drew {}x{}, {} drew {}x{}", ref.width,
+                                               ref.height, against.text, expected.width,
+                                               expected.height));
+              uncertainty = &ref;
+            }
+            // The tolerances were checked up front; an InputError from here on (a fixture
+            // changed under us) ends the run with exit 2 and no report.
+            const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
+            ClassMaps maps;
+            r = compareNamed(expected, actual, *uncertainty, tol, &maps);
+            if (args.keep_frames || r.status != Status::Pass) {
+              const fs::path da = keepFrame(against.text);
+              const fs::path db = keepFrame(spec);
+              if (use_ref) keepFrame("ref");
+              writePairImages(expected, actual, maps, folder.pairDirectory(r), r,
+                              {readyPicture(da, expected), readyPicture(db, actual)});
+            }
+          } catch (const BackendError& e) {
+            r = errorResult(fx.name, against.text, spec, e.what());
+          }
+        }
+        results[static_cast<std::size_t>(p - pairs.data())] = std::move(r);
+      }
+      outs.clear();  // the frames are done with
+    };
+
+    CompareQueue comparer(std::max(1, parallel / 2), compareFixture);
+    Progress progress;
+    std::size_t done = 0;
+    std::size_t first_open = 0;
+    std::string input_failure;
+    const auto to_render = static_cast<std::size_t>(
+        std::count_if(left.begin(), left.end(), [](std::size_t n) { return n > 0; }));
+    while (pool.outstanding() > 0) {
+      // Frames wait in memory until compared: do not render far ahead of the comparator.
+      const bool start_more = comparer.backlog() < 2 * static_cast<std::size_t>(parallel) + 2;
+      for (auto& [ticket, outcome] : pool.poll(start_more ? 200 : 20, start_more)) {
+        if (const auto it = std::find(probe_tickets.begin(), probe_tickets.end(), ticket);
+            it != probe_tickets.end()) {
+          probe_outcomes[static_cast<std::size_t>(it - probe_tickets.begin())] = std::move(outcome);
+          if (--probes_left == 0)
+            probe_seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - probes_start)
+                    .count();
+          continue;
+        }
+        // A worker that judged the fixture bad input (a file changed since it was checked)
+        // ends the run as bad input does before rendering: exit 2, nothing written.
+        if (outcome.input_error && input_failure.empty()) input_failure = outcome.error;
+        const auto [f, spec] = ticket_of.at(ticket);
+        got[f][spec] = std::move(outcome);
+        if (--left[f] == 0) {
+          comparer.push(f);
+          ++done;
+        }
+      }
+      if (comparer.failed() || !input_failure.empty()) break;
+      while (first_open < fixtures.size() && left[first_open] == 0) ++first_open;
+      if (first_open < fixtures.size())
+        progress.show(
+            fmt::format("[{}/{}] rendering {}", done, to_render, fixtures[first_open].name));
+    }
+    progress.clear();
+    comparer.finish();  // rethrows a comparison's InputError: exit 2, no report
+    if (!input_failure.empty()) throw InputError(input_failure);
+    if (args.variants) report.variants = analyseVariants(probes, probe_outcomes, probe_seconds);
   }
-  progress.clear();
+  for (std::optional<PairResult>& r : results) report.results.push_back(std::move(*r));
   applyExpectations(known, report);
   folder.commit(report);
   printSummary(report, args.out, std::cout);

@@ -5,12 +5,10 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
-#include <map>
 
 #include <fmt/format.h>
 
 #include "app/backends.h"
-#include "app/debug_support.h"
 #include "compare/variants.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
@@ -21,47 +19,49 @@
 namespace rc {
 namespace fs = std::filesystem;
 
-nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::path& work_dir,
-                              int parallel) {
-  std::vector<std::string> gl_specs;
+namespace {
+
+// The probes go through a fixture file, like every GL render; the reference renders
+// the file's scene too, so both see exactly the same (float) vertices.
+const std::map<std::string, Scene>& probeScenes() {
+  static const std::map<std::string, Scene> probes = {
+      {"subpixel", variants::subpixelProbe()},
+      {"tie_break", variants::tieBreakProbe().scene},
+      {"depth_rounding", variants::depthProbe().scene}};
+  return probes;
+}
+
+}  // namespace
+
+VariantProbes prepareVariantProbes(const std::vector<std::string>& specs,
+                                   const fs::path& work_dir) {
+  VariantProbes out;
+  out.work_dir = work_dir;
   for (const std::string& s : specs) {
     if (parseBackendSpec(s).kind != BackendSpec::Kind::Gl) continue;
-    if (std::find(gl_specs.begin(), gl_specs.end(), s) == gl_specs.end()) gl_specs.push_back(s);
+    if (std::find(out.gl_specs.begin(), out.gl_specs.end(), s) == out.gl_specs.end())
+      out.gl_specs.push_back(s);
   }
-  nlohmann::json out = nlohmann::json::object();
-  if (gl_specs.empty()) return out;
-  const auto start = std::chrono::steady_clock::now();
-
-  // The probes go through a fixture file, like every GL render; the reference renders
-  // the file's scene too, so both see exactly the same (float) vertices.
-  const variants::TieBreakProbe tie = variants::tieBreakProbe();
-  const variants::DepthProbe depth = variants::depthProbe();
-  const std::map<std::string, Scene> probes = {{"subpixel", variants::subpixelProbe()},
-                                               {"tie_break", tie.scene},
-                                               {"depth_rounding", depth.scene}};
+  if (out.gl_specs.empty()) return out;
   const fs::path probe_dir = work_dir / "probes";
   fs::create_directories(probe_dir);
-  std::map<std::string, fs::path> files;
-  for (const auto& [name, scene] : probes) {
-    files[name] = probe_dir / (name + ".json");
-    writeSceneFile(scene, files[name]);
+  for (const auto& [name, scene] : probeScenes()) {
+    out.files[name] = fs::absolute(probe_dir / (name + ".json"));
+    writeSceneFile(scene, out.files[name]);
   }
+  for (const std::string& spec : out.gl_specs)
+    for (const auto& [name, file] : out.files) out.requests.push_back({file, spec});
+  return out;
+}
 
-  std::vector<Job> jobs;
-  std::map<std::pair<std::string, std::string>, std::size_t> job_of;
-  for (const std::string& spec : gl_specs) {
-    const fs::path dir = work_dir / fixtureSlug(spec);
-    fs::create_directories(dir);
-    for (const auto& [name, file] : files) {
-      job_of[{spec, name}] = jobs.size();
-      jobs.push_back(renderJob(file, spec, dir / name));
-    }
-  }
-  runJobs(jobs, parallel);
-
+nlohmann::json analyseVariants(const VariantProbes& probes,
+                               const std::vector<RenderOutcome>& outcomes, double seconds) {
+  nlohmann::json out = nlohmann::json::object();
+  if (probes.gl_specs.empty()) return out;
+  const auto start = std::chrono::steady_clock::now();
   // ref:subpixel=N for every candidate N, once for all backends.
   std::map<int, Frame> reference;
-  const Scene subpixel_scene = loadScene(files["subpixel"]);
+  const Scene subpixel_scene = loadScene(probes.files.at("subpixel"));
   for (int n = variants::kMinCandidateBits; n <= variants::kMaxCandidateBits; ++n) {
     ReferenceOptions options;
     options.subpixel_bits = n;
@@ -69,24 +69,29 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
     reference[n] = renderReference(subpixel_scene, options);
   }
   const double shared_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const variants::TieBreakProbe tie = variants::tieBreakProbe();
+  const variants::DepthProbe depth = variants::depthProbe();
 
-  for (const std::string& spec : gl_specs) {
-    nlohmann::json v = nlohmann::json::object();
-    std::string error;
-    for (const auto& [name, file] : files) {
-      const Job& job = jobs[job_of[{spec, name}]];
-      if (job.exit_code != 0 && error.empty()) error = name + " probe: " + childFailure(job);
+  for (const std::string& spec : probes.gl_specs) {
+    std::map<std::string, const RenderOutcome*> got;
+    for (std::size_t i = 0; i < probes.requests.size(); ++i) {
+      if (probes.requests[i].spec != spec) continue;
+      for (const auto& [name, file] : probes.files)
+        if (file == probes.requests[i].fixture) got[name] = &outcomes[i];
     }
+    std::string error;
+    for (const auto& [name, outcome] : got)
+      if (!outcome->ok && error.empty()) error = name + " probe: " + outcome->error;
     if (!error.empty()) {
       out[spec] = {{"error", error}};
       continue;
     }
+    nlohmann::json v = nlohmann::json::object();
     try {
-      const fs::path dir = work_dir / fixtureSlug(spec);
-      const Frame sub = readFrameDir(dir / "subpixel");
-      const Frame tb = readFrameDir(dir / "tie_break");
-      const Frame dr = readFrameDir(dir / "depth_rounding");
+      const fs::path dir = probes.work_dir / fixtureSlug(spec);
+      for (const auto& [name, outcome] : got) writeFrameDir(outcome->frame, dir / name);
+      const Frame& sub = got.at("subpixel")->frame;
       if (sub.meta.contains("renderer")) v["renderer"] = sub.meta["renderer"];
       if (sub.meta.contains("stack")) v["stack"] = sub.meta["stack"];
       auto key = [&](const char* name) {
@@ -108,15 +113,19 @@ nlohmann::json detectVariants(const std::vector<std::string>& specs, const fs::p
             "subpixel: the driver snaps to {} bits, coarser than the {} bits its frames carry "
             "for the snap band: legal edge pixels may be reported hard",
             subpixel.best, subpixel.band));
-      v["tie_break"] = variants::toJson(variants::analyseTieBreak(tie, tb));
-      v["depth_rounding"] = variants::toJson(variants::analyseDepthRounding(depth, dr));
+      v["tie_break"] = variants::toJson(variants::analyseTieBreak(tie, got.at("tie_break")->frame));
+      v["depth_rounding"] =
+          variants::toJson(variants::analyseDepthRounding(depth, got.at("depth_rounding")->frame));
       v["probe_seconds"] = shared_seconds;
     } catch (const InputError& e) {
       v = {{"error", e.what()}};
     }
     out[spec] = v;
   }
-  std::ofstream(work_dir / "variants.json") << out.dump(2) << '\n';
+  const fs::path file_path = probes.work_dir / "variants.json";
+  std::ofstream file(file_path);
+  file << out.dump(2) << '\n';
+  if (!file.flush()) throw InputError(fmt::format("{}: cannot write", file_path.string()));
   return out;
 }
 

@@ -12,9 +12,23 @@ target_compile_options(rc_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow
 add_library(rc_strict_fp INTERFACE)
 target_compile_options(rc_strict_fp INTERFACE -ffp-contract=off -fno-fast-math -fno-math-errno)
 
-# The asan-ubsan preset sets RASTERCHECK_SANITIZE=ON.
+# The asan-ubsan preset sets RASTERCHECK_SANITIZE=ON. Any UBSan finding stops the
+# program (-fno-sanitize-recover), so that a test with undefined behaviour fails.
 option(RASTERCHECK_SANITIZE "Build with AddressSanitizer and UBSan" OFF)
 if(RASTERCHECK_SANITIZE)
-  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer)
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all
+                      -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined -fno-sanitize-recover=all)
+endif()
+
+# The fuzz preset (clang) sets RASTERCHECK_FUZZ=ON: every library is instrumented for
+# libFuzzer's coverage and built with ASan and UBSan; tests/fuzz adds the fuzz_* targets.
+option(RASTERCHECK_FUZZ "Build the libFuzzer targets (clang)" OFF)
+if(RASTERCHECK_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "RASTERCHECK_FUZZ needs clang (the fuzz preset sets it)")
+  endif()
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
+                      -fno-omit-frame-pointer)
   add_link_options(-fsanitize=address,undefined)
 endif()

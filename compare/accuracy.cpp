@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "compare/report_read.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
 
@@ -20,68 +21,6 @@ using nlohmann::json;
 namespace {
 
 // --- reading -------------------------------------------------------------------------
-
-// Reads fields of one report.json; every error names the file and the JSON path.
-class ReportReader {
- public:
-  explicit ReportReader(fs::path file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-    throw InputError(fmt::format("{}: {}: {}", file_.string(), path, what));
-  }
-
-  const json& member(const json& j, const char* key, const std::string& path) const {
-    if (!j.is_object() || !j.contains(key)) fail(path + "." + key, "missing");
-    return j[key];
-  }
-  std::string text(const json& j, const char* key, const std::string& path) const {
-    const json& v = member(j, key, path);
-    if (!v.is_string()) fail(path + "." + key, "must be a string");
-    return v.get<std::string>();
-  }
-  // Numbers the writer may leave out or write as null (non-finite): 0 then.
-  double number(const json& j, const char* key, const std::string& path) const {
-    if (!j.is_object() || !j.contains(key) || j[key].is_null()) return 0.0;
-    if (!j[key].is_number()) fail(path + "." + key, "must be a number");
-    return j[key].get<double>();
-  }
-  std::uint64_t count(const json& j, const char* key, const std::string& path) const {
-    const double v = number(j, key, path);
-    if (v < 0) fail(path + "." + key, "must not be negative");
-    return static_cast<std::uint64_t>(v);
-  }
-  std::optional<double> optionalNumber(const json& j, const char* key,
-                                       const std::string& path) const {
-    if (!j.is_object() || !j.contains(key) || j[key].is_null()) return std::nullopt;
-    return number(j, key, path);
-  }
-  std::optional<PixelRef> pixel(const json& j, const char* key, const std::string& path) const {
-    if (!j.is_object() || !j.contains(key) || j[key].is_null()) return std::nullopt;
-    const json& v = j[key];
-    if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() || !v[1].is_number_integer())
-      fail(path + "." + key, "must be [x, y]");
-    return PixelRef{v[0].get<int>(), v[1].get<int>()};
-  }
-  Status status(const json& j, const char* key, const std::string& path) const {
-    if (!j.is_object() || !j.contains(key)) return Status::Pass;
-    const std::string s = text(j, key, path);
-    for (Status st :
-         {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported})
-      if (s == toString(st)) return st;
-    fail(path + "." + key, fmt::format("unknown status \"{}\"", s));
-  }
-
- private:
-  fs::path file_;
-};
-
-json readJsonFile(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(fmt::format("{}: cannot be read", file.string()));
-  json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded()) throw InputError(fmt::format("{}: not valid JSON", file.string()));
-  return doc;
-}
 
 // The "tags" of a fixture file, or nullopt when it cannot be read.
 std::optional<std::vector<std::string>> fixtureTags(const fs::path& file) {
@@ -352,6 +291,7 @@ AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
                               const std::vector<fs::path>& catalogs) {
   AccuracyData data;
   std::map<std::string, fs::path> files;
+  std::map<std::string, std::vector<std::string>> row_tags;  // rows that carry their tags
   std::map<std::tuple<std::string, std::string, std::string>, AccuracyPair> pairs;
   for (const fs::path& run : runs) {
     data.sources.push_back(run.string());
@@ -362,6 +302,16 @@ AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
     if (!results.is_array()) r.fail("results", "must be an array");
     for (std::size_t i = 0; i < results.size(); ++i) {
       AccuracyPair p = readPair(r, results[i], fmt::format("results[{}]", i));
+      // Rows name their fixture's file and tags since runs keep frames of failing pairs only.
+      const json& row = results[i];
+      if (row.contains("tags") && row["tags"].is_array()) {
+        std::vector<std::string>& t = row_tags[p.fixture];
+        t.clear();
+        for (const json& tag : row["tags"])
+          if (tag.is_string()) t.push_back(tag.get<std::string>());
+      }
+      if (row.contains("fixture_file") && row["fixture_file"].is_string())
+        files.emplace(p.fixture, row["fixture_file"].get<std::string>());
       pairs[{p.expected, p.actual, p.fixture}] = std::move(p);
     }
     if (doc.contains("variants")) {
@@ -385,7 +335,9 @@ AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
     auto it = tags.find(p.fixture);
     if (it == tags.end()) {
       std::optional<std::vector<std::string>> found;
-      if (auto f = files.find(p.fixture); f != files.end()) found = fixtureTags(f->second);
+      if (auto t = row_tags.find(p.fixture); t != row_tags.end()) found = t->second;
+      if (!found)
+        if (auto f = files.find(p.fixture); f != files.end()) found = fixtureTags(f->second);
       if (!found)
         if (auto c = catalog.find(p.fixture); c != catalog.end()) found = fixtureTags(c->second);
       it = tags.emplace(p.fixture, found.value_or(std::vector<std::string>{})).first;

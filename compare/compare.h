@@ -135,7 +135,9 @@ struct KnownFailure {
 
 struct PairResult {
   std::string fixture;
-  std::string expected;  // backend specs, e.g. "ref", "gl:egl:llvmpipe"
+  std::string fixture_file;       // the fixture file, when the frames name it (frame.json)
+  std::vector<std::string> tags;  // the fixture's tags, when the frames name them
+  std::string expected;           // backend specs, e.g. "ref", "gl:egl:llvmpipe"
   std::string actual;
   // The fixture's render state (frame.json "state": the fixture's state block with every
   // default filled in) and the actual side's GL version string ("" for the reference):

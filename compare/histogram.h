@@ -19,6 +19,7 @@ class ErrorHistogram {
   ErrorHistogram(double quantum, bool exact_multiples);
 
   void add(double value) { ++bins_[binOf(value)]; }
+  void add(double value, std::uint64_t count) { bins_[binOf(value)] += count; }
   // Adds `count` values v with floor(v / quantum) == bin < kLinearBins, for callers that
   // count small values in their own tables first.
   void addToLinearBin(int bin, std::uint64_t count) { bins_[bin] += count; }

@@ -1,8 +1,16 @@
 // report.html: one self-contained page (inline CSS and JS, no network; images are the
-// relative files beside it). Summary first, then a fixture x backend matrix when there are
-// several backends, a sortable and filterable table of every pair, and per pair the
-// images side by side with legends and the numbers.
+// relative files beside it), built to stay usable at tens of thousands of pairs: the
+// summary, per-backend counts, a fixture x backend matrix (only fixtures with a
+// non-passing pair when there are many), then the pairs table with failures first, grouped
+// by signature (what failed, how), passing pairs one group with a count per backend,
+// filters by text, status, backend, class and tag; per pair the images side by side with
+// legends and the numbers, images loaded only when the pair is opened. The page carries
+// the pairs as data and its script builds rows and sections from them: every one at once
+// for small reports, a group's rows when it is opened and a pair's section when that is
+// opened for large ones (docs/reports.md, docs/scaling.md).
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <set>
@@ -15,9 +23,8 @@
 
 namespace rc {
 namespace fs = std::filesystem;
-namespace {
 
-std::string esc(std::string_view s) {
+std::string htmlEscape(std::string_view s) {
   std::string out;
   out.reserve(s.size());
   for (char ch : s) {
@@ -44,6 +51,10 @@ std::string esc(std::string_view s) {
   return out;
 }
 
+namespace {
+
+std::string esc(std::string_view s) { return htmlEscape(s); }
+
 // Percent-encodes a relative path for src/href, keeping '/'.
 std::string urlPath(const std::string& path) {
   std::string out;
@@ -63,29 +74,11 @@ std::string relativeUrl(const fs::path& file, const fs::path& base) {
   return urlPath(rel.generic_string());
 }
 
-std::string number(double v) {
-  if (std::isnan(v)) return "NaN";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  return fmt::format("{:.4g}", v);
-}
-
 std::string hex(const Rgb8& c) { return fmt::format("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]); }
 
 std::string badge(Status s) {
   return fmt::format("<span class=\"badge {0}\">{0}</span>", toString(s));
 }
-
-// One table cell with a sort key: numbers sort numerically, text alphabetically.
-std::string cell(const std::string& text, const std::string& key, bool numeric) {
-  return fmt::format("<td data-v=\"{}\"{}>{}</td>", esc(key), numeric ? " class=\"n\"" : "", text);
-}
-std::string numCell(double v) {
-  return cell(esc(number(v)), std::isfinite(v) ? fmt::format("{}", v) : "1e308", true);
-}
-std::string countCell(std::uint64_t v) {
-  return cell(fmt::format("{}", v), fmt::format("{}", v), true);
-}
-std::string emptyCell() { return cell("&mdash;", "-1", true); }
 
 constexpr const char* kStyle = R"CSS(
 body{font:14px/1.4 system-ui,sans-serif;margin:0 24px 48px;color:#222;background:#fafafa}
@@ -123,33 +116,264 @@ img.broken{outline:3px solid #c62828}
 #matrix td a{color:inherit;text-decoration:none}
 #matrix td.cellstatus{text-align:center}
 #variants td{white-space:normal;max-width:420px;vertical-align:top}
+.controls select{padding:3px}
+tr.group-head th{background:#fff;text-align:left;cursor:pointer;font-weight:600;position:static}
+tr.group-head .sig{font-family:ui-monospace,monospace;font-size:12px}
+tr.group-head .by{color:#666;font-weight:normal;font-size:12px}
+tbody.collapsed tr.pair-row,tbody.collapsed tr.detail-row{display:none}
+tbody.collapsed .fold::before{content:"\25B8 "}tbody .fold::before{content:"\25BE "}
+tr.detail-row > td{white-space:normal;background:#f6f6f6}
+tr.group-head:hover th{background:#f4f4f4}
 .hidden{display:none}
 )CSS";
-
 constexpr const char* kScript = R"JS(
 (function () {
+  var D = JSON.parse(document.getElementById('report-data').textContent);
+  // Per pair: fixture, expected, actual, status, column, classes not passing, tag ids,
+  // group, the row's 12 numbers (null for error rows).
+  var P = D.pairs;
+  var X = D.details;  // per pair: what its section shows (null: a passing pair without images)
   var table = document.getElementById('results');
-  var body = table ? table.tBodies[0] : null;
   var filter = document.getElementById('filter');
-  var statusFilter = document.getElementById('status-filter');
+  var statusF = document.getElementById('status-filter');
+  var backendF = document.getElementById('backend-filter');
+  var classF = document.getElementById('class-filter');
+  var tagF = document.getElementById('tag-filter');
   var shown = document.getElementById('shown');
-  function apply() {
-    var text = filter.value.toLowerCase();
-    var st = statusFilter.value;
-    var visible = 0;
-    var rows = body ? body.rows : [];
-    for (var i = 0; i < rows.length; i++) {
-      var row = rows[i];
-      var s = row.getAttribute('data-status');
-      var ok = (!text || row.getAttribute('data-text').indexOf(text) >= 0) &&
-               (!st || s === st || (st === 'not-pass' && s !== 'pass'));
-      row.classList.toggle('hidden', !ok);
-      var pair = document.getElementById(row.getAttribute('data-pair'));
-      if (pair) pair.classList.toggle('hidden', !ok);
-      if (ok) visible++;
-    }
-    shown.textContent = visible + ' of ' + rows.length + ' pairs shown';
+  var pending = 0, ready = false;
+
+  function esc(t) {
+    return String(t).replace(/[&<>"']/g, function (c) {
+      return {'&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;'}[c];
+    });
   }
+  // Numbers as the C++ side prints them (4 significant digits); strings are non-finite.
+  function num(v) {
+    if (v === null || v === undefined) return '&mdash;';
+    if (typeof v === 'string') return v;
+    return String(+v.toPrecision(4));
+  }
+  function badge(s) { return '<span class="badge ' + s + '">' + s + '</span>'; }
+  function at(x, y, h) { return x < 0 ? '(none)' : '(' + x + ',' + y + ') window (' + x + ',' + (h - 1 - y) + ')'; }
+
+  function matches(k) {
+    var p = P[k], text = filter.value.toLowerCase(), st = statusF.value;
+    if (text && (p[0] + ' ' + p[1] + ' ' + p[2] + ' ' + p[3]).toLowerCase().indexOf(text) < 0) return false;
+    if (st && p[3] !== st && !(st === 'not-pass' && p[3] !== 'pass')) return false;
+    if (backendF.value !== '' && String(p[4]) !== backendF.value) return false;
+    if (classF.value && p[5].indexOf(classF.value) < 0) return false;
+    if (tagF.value !== '' && p[6].indexOf(+tagF.value) < 0) return false;
+    return true;
+  }
+
+  // Marks for people (broken images get a red outline) and for automated checks.
+  function report() {
+    var ok = 0, bad = 0;
+    for (var i = 0; i < document.images.length; i++) {
+      var img = document.images[i];
+      if (!img.getAttribute('src')) continue;
+      if (img.complete && img.naturalWidth > 0) ok++; else bad++;
+    }
+    var b = document.body;
+    b.setAttribute('data-images-ok', ok);
+    b.setAttribute('data-images-failed', bad);
+    b.setAttribute('data-rows-rendered', table.querySelectorAll('tr.pair-row').length);
+    b.setAttribute('data-pairs-rendered', document.querySelectorAll('details.pair').length);
+    if (ready && pending === 0 && !b.hasAttribute('data-ready')) {
+      b.setAttribute('data-ready', '1');
+      b.setAttribute('data-ready-ms', Math.round(performance.now()));
+    }
+  }
+  function settled(e) {
+    if (e.type === 'error') e.target.classList.add('broken');
+    pending--;
+    report();
+  }
+  // Images load when their pair is opened, not with the page.
+  function loadImages(root) {
+    var imgs = root.querySelectorAll('img[data-src]');
+    for (var i = 0; i < imgs.length; i++) {
+      var img = imgs[i];
+      pending++;
+      img.addEventListener('load', settled);
+      img.addEventListener('error', settled);
+      img.src = img.getAttribute('data-src');
+      img.removeAttribute('data-src');
+    }
+  }
+  function watch(details) {
+    if (details.open) loadImages(details);
+    details.addEventListener('toggle', function () { if (details.open) loadImages(details); });
+  }
+
+  // ---- one pair's section: images with legends, then the numbers ----
+  function figure(x, kind, caption, legend) {
+    if (!x.f || !x.f[kind]) return '';
+    var url = x.img + x.f[kind];
+    var h = x.wh[0] > 0 ? Math.floor(240 * x.wh[1] / x.wh[0]) : 240;
+    return '<figure><a href="' + url + '"><img data-src="' + url + '" alt="' + esc(caption) +
+        '" width="240" height="' + h + '"></a><figcaption>' + esc(caption) + '</figcaption>' +
+        (legend || '') + '</figure>';
+  }
+  function sw(cls, label) { return '<span><i class="sw ' + cls + '"></i>' + label + '</span>'; }
+  function heatLegend(scale, unit) {
+    return '<div class="ramp"></div><div class="ramp-labels"><span>0</span><span>log scale</span><span>' +
+        num(scale) + ' ' + unit + '</span></div><div class="legend">' + sw('nc', 'not compared') +
+        sw('nf', 'NaN/Inf') + '</div>';
+  }
+  function table2(title, status, rows) {
+    var out = '<table><tr><th colspan="2">' + title + ' ' + badge(status) + '</th></tr>';
+    for (var i = 0; i < rows.length; i++)
+      out += '<tr><td>' + esc(rows[i][0]) + '</td><td class="n">' + esc(rows[i][1]) + '</td></tr>';
+    return out + '</table>';
+  }
+  function section(k) {
+    var p = P[k], x = X[k] || {}, open = p[3] !== 'pass';
+    var out = '<details class="pair" id="pair-' + k + '"' + (open ? ' open' : '') + '><summary><h3>' +
+        esc(p[0]) + ' &mdash; ' + esc(p[1]) + ' vs ' + esc(p[2]) + ' ' + badge(p[3]) + '</h3></summary>';
+    out += '<div class="describe">' + esc(x.d || ('PASS ' + p[0] + ' ' + p[1] + ' vs ' + p[2])) + '</div>';
+    if (p[3] === 'error' || p[3] === 'not_supported') return out + '</details>';
+    var v = x.v;
+    var vis = v ? '<div class="legend">' + sw('c1', 'match') + sw('c3', 'missing ' + v[4]) +
+        sw('c2', 'missing (ambiguous) ' + (v[3] - v[4])) + sw('c5', 'extra ' + v[6]) +
+        sw('c4', 'extra (ambiguous) ' + (v[5] - v[6])) + sw('c7', 'wrong_primitive ' + v[8]) +
+        sw('c6', 'wrong_primitive (ambiguous) ' + (v[7] - v[8])) + sw('c0', 'background') + '</div>' : '';
+    var hs = x.hs || [1, 1];
+    out += '<div class="images">' + figure(x, 'expected', 'expected: ' + p[1]) +
+        figure(x, 'actual', 'actual: ' + p[2]) + figure(x, 'visibility', 'visibility classes', vis) +
+        figure(x, 'depth_heat', 'depth |dZ| (steps)', heatLegend(hs[0], 'steps')) +
+        figure(x, 'shading_heat', 'shading max |dC| (8-bit units)', heatLegend(hs[1], 'units')) + '</div>';
+    if (x.f && x.f.diff_exr)
+      out += '<div class="meta">float channels: <a href="' + x.img + x.f.diff_exr + '">' +
+          esc(x.f.diff_exr) + '</a></div>';
+    if (!v) {
+      // A passing pair of a large report: the row's numbers.
+      var n = p[8];
+      return out + '<div class="numbers">' + table2('key numbers', p[3], [
+        ['hard px', num(n[0])], ['ambiguous px', num(n[1])], ['depth max (steps)', num(n[5])],
+        ['depth p99', num(n[6])], ['shading max (8-bit)', num(n[8])], ['PSNR (dB)', num(n[10])]]) +
+        '</div><div class="meta">every number of this pair is in report.json</div></details>';
+    }
+    var z = x.z, s = x.s, t = x.t, h = x.wh[1], cs = x.cs;
+    out += '<div class="numbers">';
+    out += table2('visibility', cs[0], [
+      ['mismatched', v[0]], ['ambiguous', v[1]], ['hard', v[2]],
+      ['missing (hard)', v[3] + ' (' + v[4] + ')'], ['extra (hard)', v[5] + ' (' + v[6] + ')'],
+      ['wrong_primitive (hard)', v[7] + ' (' + v[8] + ')'], ['excused by depth_gap', v[9]],
+      ['band (px)', num(v[10])], ['uncertainty channels', v[11] ? 'yes' : 'no'],
+      ['thresholds warn / fail', t[0] + ' / ' + t[1]], ['worst', at(v[12], v[13], h)]]);
+    out += table2('depth', cs[1], [
+      ['compared', z[0]], ['max (steps)', num(z[1])], ['mean', num(z[2])], ['p99', num(z[3])],
+      ['over tolerance', z[4]], ['over fail', z[5]], ['non-finite', z[6]], ['blended, uncertain', z[7]],
+      ['slope band (px)', num(z[8])], ['format', x.fmt[0]],
+      ['thresholds warn / fail', t[2] + ' / ' + t[3] + ' + ' + t[4] + ' x slope x band'],
+      ['worst', at(z[9], z[10], h)], ['worst steps / allowance', num(z[11]) + ' / ' + num(z[12])]]);
+    out += table2('shading', cs[2], [
+      ['compared', s[0]], ['max abs (8-bit)', num(s[1])], ['mean abs', num(s[2])], ['rmse', num(s[3])],
+      ['psnr (dB)', num(s[4]) + (s[3] > 0 ? '' : ' (identical)')], ['p99', num(s[5])],
+      ['over warn', s[6]], ['over fail', s[7]], ['texel choice excused', s[17]],
+      ['blended, uncertain', s[18]], ['non-finite', s[8]],
+      ['max R G B A', num(s[9]) + ' ' + num(s[10]) + ' ' + num(s[11]) + ' ' + num(s[12])],
+      ['format', x.fmt[1]], ['thresholds warn / fail', num(t[5]) + ' / ' + num(t[6]) + ' + allowance'],
+      ['allowance', x.a], ['worst', at(s[13], s[14], h)],
+      ['worst error / allowance', num(s[15]) + ' / ' + num(s[16])]]);
+    if (x.nf) {
+      var names = ['R', 'G', 'B', 'A', 'Z'], rows = [];
+      for (var c = 0; c < 5; c++)
+        rows.push([names[c], x.nf[0][c] + '/' + x.nf[1][c] + ' | ' + x.nf[2][c] + '/' + x.nf[3][c]]);
+      out += table2('NaN/Inf: expected | actual', 'fail', rows);
+    }
+    return out + '</div></details>';
+  }
+
+  // ---- the pairs table ----
+  function cell(html, key, numeric) {
+    var td = document.createElement('td');
+    td.setAttribute('data-v', key);
+    if (numeric) td.className = 'n';
+    td.innerHTML = html;
+    return td;
+  }
+  var ORDER = {pass: 0, warn: 1, fail: 2, error: 3, not_supported: 4};
+  function buildRow(k) {
+    var p = P[k], tr = document.createElement('tr');
+    tr.className = 'pair-row';
+    tr.setAttribute('data-k', k);
+    tr.appendChild(cell('<a href="#pair-' + k + '">' + esc(p[0]) + '</a>', p[0], false));
+    tr.appendChild(cell(esc(p[1]), p[1], false));
+    tr.appendChild(cell(esc(p[2]), p[2], false));
+    tr.appendChild(cell(badge(p[3]), String(ORDER[p[3]]), true));
+    for (var i = 0; i < 12; i++) {
+      var v = p[8] ? p[8][i] : null;
+      tr.appendChild(cell(num(v), v === null ? '-1' : (typeof v === 'string' ? '1e308' : String(v)), true));
+    }
+    return tr;
+  }
+  // A group's rows are built the first time it is opened.
+  function fill(body) {
+    if (!body.hasAttribute('data-lazy')) return;
+    body.removeAttribute('data-lazy');
+    var g = +body.getAttribute('data-group'), frag = document.createDocumentFragment();
+    for (var k = 0; k < P.length; k++) if (P[k][7] === g) frag.appendChild(buildRow(k));
+    body.appendChild(frag);
+    apply();
+  }
+  function rowOf(k) { return table.querySelector('tr.pair-row[data-k="' + k + '"]'); }
+
+  // Opens pair k: its section below the table (small reports) or a row under its table row.
+  function openPair(k) {
+    if (!(k >= 0 && k < P.length)) return null;
+    var el = document.getElementById('pair-' + k);
+    if (!el && D.big) {
+      var body = table.querySelector('tbody[data-group="' + P[k][7] + '"]');
+      fill(body);
+      body.classList.remove('collapsed');
+      var row = rowOf(k), tr = document.createElement('tr'), td = document.createElement('td');
+      tr.className = 'detail-row';
+      tr.setAttribute('data-k', k);
+      td.colSpan = 16;
+      td.innerHTML = section(k);
+      tr.appendChild(td);
+      row.parentNode.insertBefore(tr, row.nextSibling);
+      el = document.getElementById('pair-' + k);
+      watch(el);
+    }
+    if (el) el.open = true;
+    return el;
+  }
+  function openTarget() {
+    var h = location.hash.slice(1);
+    if (h === 'open-all') {
+      for (var k = 0; k < P.length; k++) openPair(k);
+      return;
+    }
+    var m = /^pair-(\d+)$/.exec(h);
+    var el = m ? openPair(+m[1]) : null;
+    // Large reports: the pair's row, with its section under it, below the sticky header.
+    var row = el && D.big ? rowOf(+m[1]) : null;
+    if (row) window.scrollTo(0, row.getBoundingClientRect().top + window.scrollY - 40);
+    else if (el) el.scrollIntoView();
+  }
+
+  function apply() {
+    var visible = 0, per = {};
+    for (var k = 0; k < P.length; k++) if (matches(k)) { visible++; per[P[k][7]] = (per[P[k][7]] || 0) + 1; }
+    var rows = table.querySelectorAll('tr.pair-row, tr.detail-row');
+    for (var i = 0; i < rows.length; i++) {
+      var k2 = +rows[i].getAttribute('data-k'), ok = matches(k2);
+      rows[i].classList.toggle('hidden', !ok);
+      var sec = D.big ? null : document.getElementById('pair-' + k2);
+      if (sec) sec.classList.toggle('hidden', !ok);
+    }
+    var groups = table.tBodies;
+    for (var g = 0; g < groups.length; g++) {
+      var n = per[groups[g].getAttribute('data-group')] || 0;
+      groups[g].classList.toggle('hidden', n === 0);
+      groups[g].querySelector('.count').textContent = n;
+    }
+    shown.textContent = visible + ' of ' + P.length + ' pairs shown';
+  }
+
   function sortBy(th) {
     var index = Array.prototype.indexOf.call(th.parentNode.children, th);
     var numeric = th.getAttribute('data-type') === 'num';
@@ -157,240 +381,233 @@ constexpr const char* kScript = R"JS(
     var heads = th.parentNode.children;
     for (var k = 0; k < heads.length; k++) heads[k].classList.remove('asc', 'desc');
     th.classList.add(asc ? 'asc' : 'desc');
-    var rows = Array.prototype.slice.call(body.rows);
-    rows.sort(function (a, b) {
-      var x = a.cells[index].getAttribute('data-v'), y = b.cells[index].getAttribute('data-v');
-      var c = numeric ? parseFloat(x) - parseFloat(y) : x.localeCompare(y);
-      return asc ? c : -c;
+    for (var g = 0; g < table.tBodies.length; g++) {
+      var body = table.tBodies[g];
+      var rows = Array.prototype.slice.call(body.querySelectorAll('tr.pair-row'));
+      rows.sort(function (a, b) {
+        var x = a.cells[index].getAttribute('data-v'), y = b.cells[index].getAttribute('data-v');
+        var c = numeric ? parseFloat(x) - parseFloat(y) : x.localeCompare(y);
+        return asc ? c : -c;
+      });
+      rows.forEach(function (r) {
+        var detail = body.querySelector('tr.detail-row[data-k="' + r.getAttribute('data-k') + '"]');
+        body.appendChild(r);
+        if (detail) body.appendChild(detail);
+      });
+    }
+  }
+
+  // Small reports: every row and every section now; large ones: on demand.
+  var bodies = table.tBodies;
+  for (var b = 0; b < bodies.length; b++) if (!D.big) fill(bodies[b]);
+  if (!D.big) {
+    var html = '';
+    for (var k = 0; k < P.length; k++) html += section(k);
+    document.getElementById('details').innerHTML = html;
+  }
+  var ths = table.tHead.rows[0].cells;
+  for (var i = 0; i < ths.length; i++)
+    ths[i].addEventListener('click', function (e) { sortBy(e.currentTarget); });
+  var gheads = table.querySelectorAll('tr.group-head');
+  for (var j = 0; j < gheads.length; j++)
+    gheads[j].addEventListener('click', function (e) {
+      var body = e.currentTarget.parentNode;
+      fill(body);
+      body.classList.toggle('collapsed');
     });
-    rows.forEach(function (r) { body.appendChild(r); });
-  }
-  if (table) {
-    var ths = table.tHead.rows[0].cells;
-    for (var i = 0; i < ths.length; i++)
-      ths[i].addEventListener('click', function (e) { sortBy(e.currentTarget); });
-  }
-  // Links to a folded pair unfold it.
-  function openTarget() {
-    var el = location.hash ? document.getElementById(location.hash.slice(1)) : null;
-    if (el && el.tagName === 'DETAILS') el.open = true;
-  }
+  [filter, statusF, backendF, classF, tagF].forEach(function (el) {
+    el.addEventListener(el.tagName === 'INPUT' ? 'input' : 'change', apply);
+  });
+  var sections = document.querySelectorAll('details.pair');
+  for (var s = 0; s < sections.length; s++) watch(sections[s]);
   window.addEventListener('hashchange', openTarget);
   openTarget();
-  filter.addEventListener('input', apply);
-  statusFilter.addEventListener('change', apply);
   apply();
-  // Marks for people (broken images get a red outline) and for automated checks.
-  function imagesDone() {
-    var ok = 0, bad = 0;
-    for (var i = 0; i < document.images.length; i++) {
-      var img = document.images[i];
-      if (img.complete && img.naturalWidth > 0) ok++;
-      else { bad++; img.classList.add('broken'); }
-    }
-    document.body.setAttribute('data-images-ok', ok);
-    document.body.setAttribute('data-images-failed', bad);
-    document.body.setAttribute('data-ready', '1');
-  }
-  document.body.setAttribute('data-rows-rendered', body ? body.rows.length : 0);
-  document.body.setAttribute('data-pairs-rendered', document.querySelectorAll('details.pair').length);
-  if (document.readyState === 'complete') imagesDone();
-  else window.addEventListener('load', imagesDone);
+  ready = true;
+  report();
 })();
 )JS";
 
-std::string visibilityLegend(const PairResult& r) {
-  const VisibilityStats& v = r.visibility;
-  struct Entry {
-    PixelClass cls;
-    std::uint64_t count;
-  };
-  const std::uint64_t missing_amb = v.missing - v.missing_hard;
-  const std::uint64_t extra_amb = v.extra - v.extra_hard;
-  const std::uint64_t wrong_amb = v.wrong_primitive - v.wrong_primitive_hard;
-  const Entry entries[] = {{PixelClass::Match, 0},
-                           {PixelClass::MissingHard, v.missing_hard},
-                           {PixelClass::MissingAmbiguous, missing_amb},
-                           {PixelClass::ExtraHard, v.extra_hard},
-                           {PixelClass::ExtraAmbiguous, extra_amb},
-                           {PixelClass::WrongHard, v.wrong_primitive_hard},
-                           {PixelClass::WrongAmbiguous, wrong_amb},
-                           {PixelClass::Background, 0}};
-  std::string out = "<div class=\"legend\">";
-  for (const Entry& e : entries) {
-    const bool counted = e.cls != PixelClass::Match && e.cls != PixelClass::Background;
-    out += fmt::format("<span><i class=\"sw\" style=\"background:{}\"></i>{}{}</span>",
-                       hex(classColor(e.cls)), esc(toString(e.cls)),
-                       counted ? fmt::format(" {}", e.count) : std::string());
+// Colours of the legends, from the same tables the images use.
+std::string legendStyle() {
+  std::string gradient;
+  for (const Rgb8& c : heatColorStops(9)) {
+    if (!gradient.empty()) gradient += ',';
+    gradient += hex(c);
   }
-  return out + "</div>";
+  std::string out = fmt::format(".ramp{{background:linear-gradient(to right,{})}}", gradient);
+  for (int c = 0; c < kPixelClassCount; ++c)
+    out += fmt::format(".sw.c{}{{background:{}}}", c, hex(classColor(static_cast<PixelClass>(c))));
+  out += fmt::format(".sw.nc{{background:{}}}.sw.nf{{background:{}}}", hex(kNotComparedColor),
+                     hex(kNonFiniteColor));
+  return out;
 }
 
-std::string heatLegend(double scale, const char* unit, const std::string& gradient) {
-  return fmt::format(
-      "<div class=\"ramp\" style=\"background:linear-gradient(to right,{})\"></div>"
-      "<div class=\"ramp-labels\"><span>0</span><span>log scale</span><span>{} {}</span></div>"
-      "<div class=\"legend\"><span><i class=\"sw\" style=\"background:{}\"></i>not compared</span>"
-      "<span><i class=\"sw\" style=\"background:{}\"></i>NaN/Inf</span></div>",
-      gradient, esc(number(scale)), unit, hex(kNotComparedColor), hex(kNonFiniteColor));
+// JSON has no NaN or Inf: those are the strings the page prints for them. Six
+// significant digits are more than the page shows (four) and keep the data small.
+nlohmann::json jnum(double v) {
+  if (std::isnan(v)) return "NaN";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return std::stod(fmt::format("{:.6g}", v));
 }
 
-std::string figure(const PairResult& r, const char* kind, const char* caption,
-                   const fs::path& report_dir, const std::string& legend) {
-  const auto it = r.images.find(kind);
-  if (it == r.images.end()) return "";
-  const std::string url = relativeUrl(it->second, report_dir);
-  return fmt::format(
-      "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\" width=\"{2}\" height=\"{3}\"></a>"
-      "<figcaption>{1}</figcaption>{4}</figure>",
-      url, esc(caption), 240, r.width > 0 ? 240 * r.height / r.width : 240, legend);
-}
-
-std::string rowsTable(const char* title, Status status,
-                      const std::vector<std::pair<std::string, std::string>>& rows) {
-  std::string out =
-      fmt::format("<table><tr><th colspan=\"2\">{} {}</th></tr>", title, badge(status));
-  for (const auto& [k, v] : rows)
-    out += fmt::format("<tr><td>{}</td><td class=\"n\">{}</td></tr>", esc(k), esc(v));
-  return out + "</table>";
-}
-
-std::string at(const PixelRef& p, int height) { return where(p, height); }
-
-std::string pairSection(const PairResult& r, std::size_t k, const fs::path& report_dir,
-                        const std::string& gradient) {
-  // Passing pairs start folded so that a large run shows what needs attention.
-  std::string out = fmt::format(
-      "<details class=\"pair\" id=\"pair-{}\" data-status=\"{}\"{}><summary><h3>{} &mdash; {} "
-      "vs {} {}</h3></summary>",
-      k, toString(r.status), r.status == Status::Pass ? "" : " open", esc(r.fixture),
-      esc(r.expected), esc(r.actual), badge(r.status));
-  out += fmt::format("<div class=\"describe\">{}</div>", esc(describe(r)));
-  if (r.status == Status::Error || r.status == Status::NotSupported) return out + "</details>";
-
-  out += "<div class=\"images\">";
-  out += figure(r, "expected", ("expected: " + r.expected).c_str(), report_dir, "");
-  out += figure(r, "actual", ("actual: " + r.actual).c_str(), report_dir, "");
-  out += figure(r, "visibility", "visibility classes", report_dir, visibilityLegend(r));
-  out += figure(r, "depth_heat", "depth |dZ| (steps)", report_dir,
-                heatLegend(r.depth_heat_scale, "steps", gradient));
-  out += figure(r, "shading_heat", "shading max |dC| (8-bit units)", report_dir,
-                heatLegend(r.shading_heat_scale, "units", gradient));
-  out += "</div>";
-  if (const auto it = r.images.find("diff_exr"); it != r.images.end())
-    out += fmt::format("<div class=\"meta\">float channels: <a href=\"{0}\">{1}</a></div>",
-                       relativeUrl(it->second, report_dir), esc(it->second.filename().string()));
-
+// What pair k's section shows. `full`: every number (pairs that did not pass, and every
+// pair of a small report); else only the images and their scales (null without images),
+// the section then shows the row's numbers.
+nlohmann::json sectionData(const PairResult& r, const fs::path& report_dir, bool full) {
+  using nlohmann::json;
+  json x = json::object();
+  if (!r.images.empty()) {
+    // One folder per pair: its URL once, the file names per kind.
+    std::string dir;
+    bool one_dir = true;
+    for (const auto& [kind, file] : r.images) {
+      const std::string d = relativeUrl(file.parent_path(), report_dir) + "/";
+      if (dir.empty()) dir = d;
+      one_dir = one_dir && d == dir;
+    }
+    json files = json::object();
+    for (const auto& [kind, file] : r.images)
+      files[kind] = one_dir ? urlPath(file.filename().string()) : relativeUrl(file, report_dir);
+    x["img"] = one_dir ? dir : "";
+    x["f"] = files;
+  }
+  if (r.status == Status::Error || r.status == Status::NotSupported) {
+    x["d"] = describe(r);
+    return x;
+  }
+  x["wh"] = {r.width, r.height};
+  x["hs"] = {jnum(r.depth_heat_scale), jnum(r.shading_heat_scale)};
+  if (!full) return r.images.empty() ? json() : x;
   const VisibilityStats& v = r.visibility;
   const DepthStats& d = r.depth;
   const ShadingStats& s = r.shading;
   const Tolerances& t = r.tolerances;
-  out += "<div class=\"numbers\">";
-  out += rowsTable(
-      "visibility", v.status,
-      {{"mismatched", fmt::format("{}", v.mismatched)},
-       {"ambiguous", fmt::format("{}", v.ambiguous)},
-       {"hard", fmt::format("{}", v.hard)},
-       {"missing (hard)", fmt::format("{} ({})", v.missing, v.missing_hard)},
-       {"extra (hard)", fmt::format("{} ({})", v.extra, v.extra_hard)},
-       {"wrong_primitive (hard)",
-        fmt::format("{} ({})", v.wrong_primitive, v.wrong_primitive_hard)},
-       {"excused by depth_gap", fmt::format("{}", v.ambiguous_by_depth_gap)},
-       {"band (px)", number(v.band_px)},
-       {"uncertainty channels", v.uncertainty_available ? "yes" : "no"},
-       {"thresholds warn / fail", fmt::format("{} / {}", t.visibility.warn, t.visibility.fail)},
-       {"worst", at(v.worst, r.height)}});
-  out +=
-      rowsTable("depth", d.status,
-                {{"compared", fmt::format("{}", d.compared)},
-                 {"max (steps)", number(d.max_steps)},
-                 {"mean", number(d.mean_steps)},
-                 {"p99", number(d.p99_steps)},
-                 {"over tolerance", fmt::format("{}", d.over_tolerance)},
-                 {"over fail", fmt::format("{}", d.over_fail)},
-                 {"non-finite", fmt::format("{}", d.nonfinite)},
-                 {"blended, uncertain", fmt::format("{}", d.blend_uncertain)},
-                 {"slope band (px)", number(d.band_px)},
-                 {"format", toString(t.depth_format)},
-                 {"thresholds warn / fail", fmt::format("{} / {} + {} x slope x band", t.depth.warn,
-                                                        t.depth.fail, t.depth_slope_factor)},
-                 {"worst", at(d.worst, r.height)},
-                 {"worst steps / allowance",
-                  fmt::format("{} / {}", number(d.worst_steps), number(d.worst_allowance))}});
-  out += rowsTable(
-      "shading", s.status,
-      {{"compared", fmt::format("{}", s.compared)},
-       {"max abs (8-bit)", number(s.max_abs)},
-       {"mean abs", number(s.mean_abs)},
-       {"rmse", number(s.rmse)},
-       {"psnr (dB)", s.rmse > 0.0 ? number(s.psnr_db) : number(s.psnr_db) + " (identical)"},
-       {"p99", number(s.p99_abs)},
-       {"over warn", fmt::format("{}", s.over_tolerance)},
-       {"over fail", fmt::format("{}", s.over_fail)},
-       {"texel choice excused", fmt::format("{}", s.texel_choice)},
-       {"blended, uncertain", fmt::format("{}", s.blend_uncertain)},
-       {"non-finite", fmt::format("{}", s.nonfinite)},
-       {"max R G B A",
-        fmt::format("{} {} {} {}", number(s.max_abs_rgba[0]), number(s.max_abs_rgba[1]),
-                    number(s.max_abs_rgba[2]), number(s.max_abs_rgba[3]))},
-       {"format", toString(t.color_format)},
-       {"thresholds warn / fail",
-        fmt::format("{:.4g} / {:.4g} + allowance", t.shading.warn, t.shading.fail)},
-       {"allowance", shadingAllowanceText(t, r.depth.band_px)},
-       {"worst", at(s.worst, r.height)},
-       {"worst error / allowance",
-        fmt::format("{} / {}", number(s.worst_abs), number(s.worst_allowance))}});
-  const std::uint64_t nf_e = r.nonfinite_expected.total();
-  const std::uint64_t nf_a = r.nonfinite_actual.total();
-  if (nf_e || nf_a) {
-    std::vector<std::pair<std::string, std::string>> rows;
-    for (std::size_t c = 0; c < kFrameChannels.size(); ++c)
-      rows.emplace_back(
-          kFrameChannels[c],
-          fmt::format("{}/{} | {}/{}", r.nonfinite_expected.nan[c], r.nonfinite_expected.inf[c],
-                      r.nonfinite_actual.nan[c], r.nonfinite_actual.inf[c]));
-    out += rowsTable("NaN/Inf: expected | actual", Status::Fail, rows);
-  }
-  out += "</div></details>";
-  return out;
+  if (r.status != Status::Pass) x["d"] = describe(r);
+  x["cs"] = {toString(v.status), toString(d.status), toString(s.status)};
+  x["v"] = {v.mismatched,
+            v.ambiguous,
+            v.hard,
+            v.missing,
+            v.missing_hard,
+            v.extra,
+            v.extra_hard,
+            v.wrong_primitive,
+            v.wrong_primitive_hard,
+            v.ambiguous_by_depth_gap,
+            jnum(v.band_px),
+            v.uncertainty_available ? 1 : 0,
+            v.worst.x,
+            v.worst.y};
+  x["z"] = {
+      d.compared,  jnum(d.max_steps),   jnum(d.mean_steps),     jnum(d.p99_steps), d.over_tolerance,
+      d.over_fail, d.nonfinite,         d.blend_uncertain,      jnum(d.band_px),   d.worst.x,
+      d.worst.y,   jnum(d.worst_steps), jnum(d.worst_allowance)};
+  x["s"] = {s.compared,
+            jnum(s.max_abs),
+            jnum(s.mean_abs),
+            jnum(s.rmse),
+            jnum(s.psnr_db),
+            jnum(s.p99_abs),
+            s.over_tolerance,
+            s.over_fail,
+            s.nonfinite,
+            jnum(s.max_abs_rgba[0]),
+            jnum(s.max_abs_rgba[1]),
+            jnum(s.max_abs_rgba[2]),
+            jnum(s.max_abs_rgba[3]),
+            s.worst.x,
+            s.worst.y,
+            jnum(s.worst_abs),
+            jnum(s.worst_allowance),
+            s.texel_choice,
+            s.blend_uncertain};
+  x["t"] = {jnum(t.visibility.warn), jnum(t.visibility.fail),    jnum(t.depth.warn),
+            jnum(t.depth.fail),      jnum(t.depth_slope_factor), jnum(t.shading.warn),
+            jnum(t.shading.fail)};
+  x["fmt"] = {toString(t.depth_format), toString(t.color_format)};
+  x["a"] = shadingAllowanceText(t, d.band_px);
+  if (r.nonfinite_expected.total() + r.nonfinite_actual.total() > 0)
+    x["nf"] = {r.nonfinite_expected.nan, r.nonfinite_expected.inf, r.nonfinite_actual.nan,
+               r.nonfinite_actual.inf};
+  return x;
 }
 
-std::string matrix(const Report& report) {
-  // One column per backend compared; labelled "actual vs expected" when the pairs do not
-  // all share one expected side (driver-vs-driver runs next to reference runs).
+// Reports up to this many pairs carry every pair's row and section in the page; larger
+// ones carry the passing rows and all sections as data (built when opened), so that the
+// page stays quick to open (docs/performance.md: 10,000 pairs).
+constexpr std::size_t kStaticPairs = 200;
+// The matrix lists every fixture up to this many, else only those that did not pass.
+constexpr std::size_t kMatrixRows = 40;
+
+// The column a pair belongs to: its actual backend, labelled "actual vs expected" when the
+// pairs do not all share one expected side (driver-vs-driver runs next to reference runs).
+struct Columns {
   bool one_expected = true;
+  std::vector<std::string> names;
+  std::vector<std::size_t> of;  // per result
+};
+
+Columns columnsOf(const Report& report) {
+  Columns c;
   for (const PairResult& r : report.results)
-    one_expected = one_expected && r.expected == report.results.front().expected;
-  auto column = [&](const PairResult& r) {
-    return one_expected ? r.actual : r.actual + " vs " + r.expected;
-  };
-  std::vector<std::string> backends;
+    c.one_expected = c.one_expected && r.expected == report.results.front().expected;
+  for (const PairResult& r : report.results) {
+    const std::string name = c.one_expected ? r.actual : r.actual + " vs " + r.expected;
+    auto it = std::find(c.names.begin(), c.names.end(), name);
+    if (it == c.names.end()) it = c.names.insert(c.names.end(), name);
+    c.of.push_back(static_cast<std::size_t>(it - c.names.begin()));
+  }
+  return c;
+}
+
+std::string matrix(const Report& report, const Columns& columns) {
   std::vector<std::string> fixtures;
-  std::map<std::pair<std::string, std::string>, std::pair<Status, std::size_t>> cells;
+  std::map<std::string, bool> all_pass;
+  std::map<std::pair<std::string, std::size_t>, std::pair<Status, std::size_t>> cells;
   for (std::size_t k = 0; k < report.results.size(); ++k) {
     const PairResult& r = report.results[k];
-    if (std::find(backends.begin(), backends.end(), column(r)) == backends.end())
-      backends.push_back(column(r));
-    if (std::find(fixtures.begin(), fixtures.end(), r.fixture) == fixtures.end())
-      fixtures.push_back(r.fixture);
-    auto key = std::make_pair(r.fixture, column(r));
+    if (!all_pass.count(r.fixture)) fixtures.push_back(r.fixture);
+    all_pass[r.fixture] =
+        all_pass.emplace(r.fixture, true).first->second && r.status == Status::Pass;
+    auto key = std::make_pair(r.fixture, columns.of[k]);
     auto it = cells.find(key);
     if (it == cells.end() || static_cast<int>(r.status) > static_cast<int>(it->second.first))
       cells[key] = {r.status, k};
   }
   // A run renders at least two backends (the compared one and --against), so it always
   // gets the matrix; a single `compare` does not.
-  if (backends.empty() || (backends.size() < 2 && report.command != "run")) return "";
+  if (columns.names.empty() || (columns.names.size() < 2 && report.command != "run")) return "";
+  // Many fixtures: only those with a pair that did not pass, the worst first, at most
+  // kMatrixRows of them (the pairs table lists them all).
+  std::vector<std::string> rows = fixtures;
+  std::size_t not_passing = fixtures.size();
+  if (fixtures.size() > kMatrixRows) {
+    std::erase_if(rows, [&](const std::string& f) { return all_pass[f]; });
+    not_passing = rows.size();
+    std::map<std::string, int> worst;
+    for (const auto& [key, cell] : cells)
+      worst[key.first] = std::max(worst[key.first], static_cast<int>(cell.first));
+    std::stable_sort(rows.begin(), rows.end(), [&](const std::string& a, const std::string& b) {
+      return worst[a] > worst[b];
+    });
+    if (rows.size() > kMatrixRows) rows.resize(kMatrixRows);
+  }
   std::string out = "<h2>Fixture &times; backend</h2>";
-  if (one_expected)
+  if (columns.one_expected)
     out += fmt::format("<div class=\"meta\">every backend compared against {}</div>",
                        esc(report.results.front().expected));
+  if (rows.size() < fixtures.size())
+    out += fmt::format(
+        "<div class=\"meta\">{} of the {} fixtures with a pair that did not pass, the worst "
+        "first ({} fixtures pass on every backend; the pairs table below lists every pair)</div>",
+        rows.size(), not_passing, fixtures.size() - not_passing);
   out += "<table id=\"matrix\"><tr><th>fixture</th>";
-  for (const std::string& b : backends) out += fmt::format("<th>{}</th>", esc(b));
+  for (const std::string& b : columns.names) out += fmt::format("<th>{}</th>", esc(b));
   out += "</tr>";
-  for (const std::string& f : fixtures) {
+  for (const std::string& f : rows) {
     out += fmt::format("<tr><td>{}</td>", esc(f));
-    for (const std::string& b : backends) {
+    for (std::size_t b = 0; b < columns.names.size(); ++b) {
       const auto it = cells.find({f, b});
       if (it == cells.end()) {
         out += "<td class=\"cellstatus\">&mdash;</td>";
@@ -402,6 +619,59 @@ std::string matrix(const Report& report) {
     out += "</tr>";
   }
   return out + "</table>";
+}
+
+// Verdict counts per backend column.
+std::string backendCounts(const Report& report, const Columns& columns) {
+  if (columns.names.size() < 2 && report.results.size() < 2) return "";
+  std::vector<std::array<std::uint64_t, 4>> n(columns.names.size(), {0, 0, 0, 0});
+  for (std::size_t k = 0; k < report.results.size(); ++k)
+    ++n[columns.of[k]][static_cast<std::size_t>(report.results[k].status)];
+  std::string out =
+      "<h2>Backends</h2><table id=\"backends\"><tr><th>backend</th><th>pass</th><th>warn</th>"
+      "<th>fail</th><th>error</th></tr>";
+  for (std::size_t b = 0; b < columns.names.size(); ++b)
+    out += fmt::format(
+        "<tr><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>"
+        "<td class=\"n\">{}</td></tr>",
+        esc(columns.names[b]), n[b][0], n[b][1], n[b][2], n[b][3]);
+  return out + "</table>";
+}
+
+// What a non-passing pair's failure looks like, for grouping alike failures: the classes
+// at the pair's status (visibility with its largest kind of hard mismatch), or for an
+// error row its message with the fixture name and every number taken out.
+std::string signature(const PairResult& r) {
+  if (r.status == Status::Error || r.status == Status::NotSupported) {
+    std::string m = r.error;
+    for (std::size_t at = 0;
+         !r.fixture.empty() && (at = m.find(r.fixture, at)) != std::string::npos;)
+      m.replace(at, r.fixture.size(), "<fixture>");
+    std::string out;
+    for (std::size_t i = 0; i < m.size(); ++i) {
+      if (std::isdigit(static_cast<unsigned char>(m[i]))) {
+        out += 'N';
+        while (i + 1 < m.size() &&
+               (std::isdigit(static_cast<unsigned char>(m[i + 1])) || m[i + 1] == '.'))
+          ++i;
+      } else {
+        out += m[i];
+      }
+    }
+    if (out.size() > 120) out = out.substr(0, 117) + "...";
+    return out;
+  }
+  std::vector<std::string> parts;
+  if (r.visibility.status == r.status) {
+    const VisibilityStats& v = r.visibility;
+    const char* kind = v.missing_hard >= v.extra_hard && v.missing_hard >= v.wrong_primitive_hard
+                           ? "missing"
+                           : (v.extra_hard >= v.wrong_primitive_hard ? "extra" : "wrong_primitive");
+    parts.push_back(fmt::format("visibility ({})", v.hard > 0 ? kind : "ambiguous"));
+  }
+  if (r.depth.status == r.status) parts.emplace_back("depth");
+  if (r.shading.status == r.status) parts.emplace_back("shading");
+  return fmt::format("{}", fmt::join(parts, " + "));
 }
 
 // The legal variants each GL backend follows (report.variants, see docs/debugging.md).
@@ -459,15 +729,44 @@ std::string variantsTable(const Report& report) {
 
 std::string reportHtml(const Report& report, const fs::path& report_dir) {
   const ReportSummary sum = report.summary();
-  std::string gradient;
-  for (const Rgb8& c : heatColorStops(9)) {
-    if (!gradient.empty()) gradient += ',';
-    gradient += hex(c);
+  const bool big = report.results.size() > kStaticPairs;
+  const Columns columns = columnsOf(report);
+
+  // Groups: one per (status, signature); the worst status first, then the largest.
+  struct Group {
+    Status status;
+    std::string signature;
+    std::vector<std::size_t> pairs;
+  };
+  std::vector<Group> groups;
+  std::map<std::pair<int, std::string>, std::size_t> group_of_key;
+  for (std::size_t k = 0; k < report.results.size(); ++k) {
+    const PairResult& r = report.results[k];
+    const auto key = std::make_pair(static_cast<int>(r.status), signature(r));
+    auto it = group_of_key.find(key);
+    if (it == group_of_key.end()) {
+      it = group_of_key.emplace(key, groups.size()).first;
+      groups.push_back({r.status, key.second, {}});
+    }
+    groups[it->second].pairs.push_back(k);
   }
+  std::stable_sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) {
+    if (a.status != b.status) return static_cast<int>(a.status) > static_cast<int>(b.status);
+    if (a.pairs.size() != b.pairs.size()) return a.pairs.size() > b.pairs.size();
+    return a.signature < b.signature;
+  });
+  std::vector<std::size_t> group_of(report.results.size());
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (std::size_t k : groups[g].pairs) group_of[k] = g;
+  std::vector<std::string> tags;
+  for (const PairResult& r : report.results)
+    for (const std::string& t : r.tags)
+      if (std::find(tags.begin(), tags.end(), t) == tags.end()) tags.push_back(t);
+  std::sort(tags.begin(), tags.end());
 
   std::string out = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">";
-  out += fmt::format("<title>{} report</title><style>{}</style></head><body>",
-                     esc(report.tool_name), kStyle);
+  out += fmt::format("<title>{} report</title><style>{}{}</style></head><body>",
+                     esc(report.tool_name), kStyle, legendStyle());
   out += fmt::format("<h1>{} report</h1><div class=\"meta\">{} {}{}</div>", esc(report.tool_name),
                      esc(report.tool_name), esc(report.tool_version),
                      report.command.empty() ? "" : " &middot; " + esc(report.command));
@@ -476,8 +775,9 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       "<div>warn<b>{}</b></div><div>fail<b>{}</b></div><div>error<b>{}</b></div>"
       "<div>not supported<b>{}</b></div><div>exit code<b>{}</b></div></div>",
       sum.total(), sum.pass, sum.warn, sum.fail, sum.error, sum.not_supported, exitCodeFor(report));
-  out += matrix(report);
-  out += variantsTable(report);
+  out += backendCounts(report, columns);
+  // Large reports: the groups of failures come before the (shortened) matrix.
+  if (!big) out += matrix(report, columns) + variantsTable(report);
 
   out +=
       "<h2>Pairs</h2><div class=\"controls\"><input id=\"filter\" type=\"search\" "
@@ -486,7 +786,17 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       "<option value=\"pass\">pass</option><option value=\"warn\">warn</option>"
       "<option value=\"fail\">fail</option><option value=\"error\">error</option>"
       "<option value=\"not_supported\">not supported</option></select>"
-      "<span id=\"shown\"></span></div>";
+      "<select id=\"backend-filter\"><option value=\"\">all backends</option>";
+  for (std::size_t b = 0; b < columns.names.size(); ++b)
+    out += fmt::format("<option value=\"{}\">{}</option>", b, esc(columns.names[b]));
+  out +=
+      "</select><select id=\"class-filter\"><option value=\"\">any class</option>"
+      "<option value=\"visibility\">visibility not pass</option><option value=\"depth\">depth "
+      "not pass</option><option value=\"shading\">shading not pass</option></select>"
+      "<select id=\"tag-filter\"><option value=\"\">all tags</option>";
+  for (std::size_t t = 0; t < tags.size(); ++t)
+    out += fmt::format("<option value=\"{}\">{}</option>", t, esc(tags[t]));
+  out += "</select><span id=\"shown\"></span></div>";
   out += "<table id=\"results\"><thead><tr>";
   const std::pair<const char*, bool> heads[] = {
       {"fixture", false},    {"expected", false},    {"actual", false},   {"status", true},
@@ -495,41 +805,64 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       {"shading max", true}, {"shading mean", true}, {"PSNR dB", true},   {"shading over", true}};
   for (const auto& [name, numeric] : heads)
     out += fmt::format("<th data-type=\"{}\">{}</th>", numeric ? "num" : "text", name);
-  out += "</tr></thead><tbody>";
+  out += "</tr></thead>";
+  // Group heads only: the script builds the rows (all of them at once for small reports).
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const Group& group = groups[g];
+    std::map<std::size_t, std::size_t> per_column;
+    for (std::size_t k : group.pairs) ++per_column[columns.of[k]];
+    std::string by;
+    for (const auto& [b, n] : per_column)
+      by += fmt::format("{}{} {}", by.empty() ? "" : ", ", columns.names[b], n);
+    out += fmt::format(
+        "<tbody data-group=\"{}\" data-lazy=\"1\"{}><tr class=\"group-head\"><th colspan=\"16\">"
+        "<span class=\"fold\"></span>{} <span class=\"sig\">{}</span> &mdash; <span "
+        "class=\"count\">{}</span> pairs <span class=\"by\">({})</span></th></tr></tbody>",
+        g, big ? " class=\"collapsed\"" : "", badge(group.status),
+        esc(group.status == Status::Pass ? std::string("every class passes") : group.signature),
+        group.pairs.size(), esc(by));
+  }
+  out += "</table>";
+  if (!big) out += "<h2>Details</h2><div id=\"details\"></div>";
+  if (big) out += matrix(report, columns) + variantsTable(report);
+
+  // Every pair as data: the rows, the filters, and what each section shows.
+  nlohmann::json pairs = nlohmann::json::array();
+  nlohmann::json sections = nlohmann::json::array();
   for (std::size_t k = 0; k < report.results.size(); ++k) {
     const PairResult& r = report.results[k];
-    std::string text = r.fixture + " " + r.expected + " " + r.actual + " " + toString(r.status);
-    std::transform(text.begin(), text.end(), text.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    out += fmt::format("<tr data-status=\"{}\" data-pair=\"pair-{}\" data-text=\"{}\">",
-                       toString(r.status), k, esc(text));
-    out += cell(fmt::format("<a href=\"#pair-{}\">{}</a>", k, esc(r.fixture)), r.fixture, false);
-    out += cell(esc(r.expected), r.expected, false);
-    out += cell(esc(r.actual), r.actual, false);
-    out += cell(badge(r.status), fmt::format("{}", static_cast<int>(r.status)), true);
-    if (r.status == Status::Error || r.status == Status::NotSupported) {
-      for (int c = 0; c < 12; ++c) out += emptyCell();
-    } else {
-      out += countCell(r.visibility.hard);
-      out += countCell(r.visibility.ambiguous);
-      out += countCell(r.visibility.missing);
-      out += countCell(r.visibility.extra);
-      out += countCell(r.visibility.wrong_primitive);
-      out += numCell(r.depth.max_steps);
-      out += numCell(r.depth.p99_steps);
-      out += countCell(r.depth.over_tolerance);
-      out += numCell(r.shading.max_abs);
-      out += numCell(r.shading.mean_abs);
-      out += numCell(r.shading.psnr_db);
-      out += countCell(r.shading.over_tolerance);
+    nlohmann::json classes = nlohmann::json::array();
+    if (r.status != Status::Error && r.status != Status::NotSupported) {
+      if (r.visibility.status != Status::Pass) classes.push_back("visibility");
+      if (r.depth.status != Status::Pass) classes.push_back("depth");
+      if (r.shading.status != Status::Pass) classes.push_back("shading");
     }
-    out += "</tr>";
+    nlohmann::json tag_ids = nlohmann::json::array();
+    for (const std::string& t : r.tags)
+      tag_ids.push_back(std::find(tags.begin(), tags.end(), t) - tags.begin());
+    nlohmann::json numbers;
+    if (r.status != Status::Error && r.status != Status::NotSupported)
+      numbers = {r.visibility.hard,        r.visibility.ambiguous,       r.visibility.missing,
+                 r.visibility.extra,       r.visibility.wrong_primitive, jnum(r.depth.max_steps),
+                 jnum(r.depth.p99_steps),  r.depth.over_tolerance,       jnum(r.shading.max_abs),
+                 jnum(r.shading.mean_abs), jnum(r.shading.psnr_db),      r.shading.over_tolerance};
+    pairs.push_back({r.fixture, r.expected, r.actual, toString(r.status), columns.of[k], classes,
+                     tag_ids, group_of[k], numbers});
+    sections.push_back(sectionData(r, report_dir, !big || r.status != Status::Pass));
   }
-  out += "</tbody></table>";
-
-  out += "<h2>Details</h2>";
-  for (std::size_t k = 0; k < report.results.size(); ++k)
-    out += pairSection(report.results[k], k, report_dir, gradient);
+  const nlohmann::json data = {{"big", big}, {"pairs", pairs}, {"details", sections}};
+  // Inside <script>, "</script>" or "<!--" in a name would end or confuse the element:
+  // JSON may spell every '<' as \u003c (it can only occur inside strings).
+  const std::string text = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string safe;
+  safe.reserve(text.size() + text.size() / 64);
+  for (const char ch : text) {
+    if (ch == '<')
+      safe += "\\u003c";
+    else
+      safe += ch;
+  }
+  out += fmt::format("<script type=\"application/json\" id=\"report-data\">{}</script>", safe);
   out += fmt::format("<script>{}</script></body></html>\n", kScript);
   return out;
 }

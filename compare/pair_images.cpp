@@ -29,9 +29,13 @@ using OIIO::TypeDesc;
 
 // PNGs for people: fast deflate (level 1) and one cheap row filter (SUB) write a 1080p
 // image several times faster than the defaults for files ~1.5x larger; these images are
-// looked at, not archived.
+// looked at, not archived. Above kStoreAbove pixels they are stored (level 0, no filter):
+// at 1080p deflate was ~12% of a whole `compare` process's CPU time, for 19 MB instead of
+// ~3 MB per pair (docs/performance.md).
 constexpr int kPngCompressionLevel = 1;
 constexpr int kPngFilterSub = 16;
+constexpr int kPngFilterNone = 8;
+constexpr std::size_t kPngStoreAbove = std::size_t{1} << 20;
 // diff.exr: mostly zero rows (background, no error) that fast zip (level 1) shrinks to a
 // few percent, at ~0.1 us per pixel. Above ~1 M pixels that is the longest single task of
 // a comparison (0.24 s CPU at 1080p, five times the comparison itself), so large frames
@@ -39,11 +43,16 @@ constexpr int kPngFilterSub = 16;
 constexpr const char* kDiffExrCompression = "zip:1";
 constexpr std::size_t kDiffExrCompressUpTo = std::size_t{1} << 20;
 
+bool storePng(int w, int h) {
+  return static_cast<std::size_t>(w) * static_cast<std::size_t>(h) > kPngStoreAbove;
+}
+
 void writeImage(const fs::path& file, ImageSpec spec, const TypeDesc& format, const void* data,
                 const fs::path& target) {
   if (file.extension() == ".png") {
-    spec.attribute("png:compressionLevel", kPngCompressionLevel);
-    spec.attribute("png:filter", kPngFilterSub);
+    const bool store = storePng(spec.width, spec.height);
+    spec.attribute("png:compressionLevel", store ? 0 : kPngCompressionLevel);
+    spec.attribute("png:filter", store ? kPngFilterNone : kPngFilterSub);
   }
   auto out = OIIO::ImageOutput::create(file.string());
   if (!out || !out->open(file.string(), spec) || !out->write_image(format, data) || !out->close())
@@ -79,7 +88,10 @@ void writePicture(const Frame& frame, const fs::path& ready, const fs::path& fil
     if (fs::copy_file(ready, file, fs::copy_options::overwrite_existing, ec)) return;
   }
   // Encoded as render's color.png is, from the frame that was compared.
-  writeColorPng(frame, file, FrameEncoding{"none", kPngCompressionLevel, kPngFilterSub});
+  const bool store = storePng(frame.width, frame.height);
+  writeColorPng(frame, file,
+                FrameEncoding{"none", store ? 0 : kPngCompressionLevel,
+                              store ? kPngFilterNone : kPngFilterSub});
 }
 
 float luminance(const float* c) {
@@ -106,6 +118,8 @@ std::vector<std::uint8_t> heatImage(const ClassMaps& maps, const std::vector<flo
       px = kNotComparedColor;
     } else if (std::isnan(values[i])) {
       px = kNonFiniteColor;
+    } else if (values[i] == 0.0f) {
+      px = lut[0];  // heatPosition(0) is 0: most compared pixels, without the log2
     } else {
       px = lut[static_cast<std::size_t>(
           roundHalfUp(heatPosition(values[i], scale) * static_cast<float>(kHeatLutSize - 1)))];
@@ -182,8 +196,17 @@ std::string safeName(const std::string& s) {
                     (ch >= '0' && ch <= '9') || ch == '.' || ch == '_' || ch == '-';
     out += ok ? ch : '_';
   }
+  if (out.size() > 100) out.resize(100);  // ASCII by now; names stay far below NAME_MAX
   if (out.empty() || out == "." || out == "..") out = "_" + out;
   return out;
+}
+
+std::string fixtureFolderName(const PairResult& result) {
+  return safeName(result.fixture.empty() ? "fixture" : result.fixture);
+}
+
+std::string pairFolderName(const PairResult& result) {
+  return safeName(result.expected) + "_vs_" + safeName(result.actual);
 }
 
 }  // namespace
@@ -249,8 +272,15 @@ std::vector<Rgb8> heatColorStops(int count) {
   return stops;
 }
 
+void setHeatScales(PairResult& result) {
+  result.depth_heat_scale = std::max({result.depth.max_steps, result.tolerances.depth.fail, 1.0});
+  result.shading_heat_scale =
+      std::max({result.shading.max_abs, result.tolerances.shading.fail, 1.0});
+}
+
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
-                     const fs::path& dir, PairResult& result, const PairPictures& pictures) {
+                     const fs::path& dir, PairResult& result, const PairPictures& pictures,
+                     bool with_diff_exr) {
   const int w = maps.width;
   const int h = maps.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
@@ -274,10 +304,8 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
   const fs::path tmp_visibility = files.stage(visibility_png);
   const fs::path tmp_depth = files.stage(depth_png);
   const fs::path tmp_shading = files.stage(shading_png);
-  const fs::path tmp_diff = files.stage(diff_exr);
-  result.depth_heat_scale = std::max({result.depth.max_steps, result.tolerances.depth.fail, 1.0});
-  result.shading_heat_scale =
-      std::max({result.shading.max_abs, result.tolerances.shading.fail, 1.0});
+  const fs::path tmp_diff = with_diff_exr ? files.stage(diff_exr) : fs::path();
+  setHeatScales(result);
   heatLut();  // built once, before the threads that share it
 
   runAll({
@@ -304,18 +332,38 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
         writeRgb8(tmp_shading, w, h, heatImage(maps, maps.shading_abs, result.shading_heat_scale),
                   shading_png);
       },
-      [&] { writeDiffExr(expected, actual, maps, result, tmp_diff, diff_exr); },
+      [&] {
+        if (with_diff_exr) writeDiffExr(expected, actual, maps, result, tmp_diff, diff_exr);
+      },
   });
 
   files.commit();
-  result.images = {{"expected", expected_png},     {"actual", actual_png},
-                   {"visibility", visibility_png}, {"depth_heat", depth_png},
-                   {"shading_heat", shading_png},  {"diff_exr", diff_exr}};
+  result.images = {{"expected", expected_png},
+                   {"actual", actual_png},
+                   {"visibility", visibility_png},
+                   {"depth_heat", depth_png},
+                   {"shading_heat", shading_png}};
+  if (with_diff_exr) result.images["diff_exr"] = diff_exr;
 }
 
 fs::path pairDirectory(const fs::path& out_dir, const PairResult& result) {
-  return out_dir / "pairs" / safeName(result.fixture.empty() ? "fixture" : result.fixture) /
-         (safeName(result.expected) + "_vs_" + safeName(result.actual));
+  return out_dir / "pairs" / fixtureFolderName(result) / pairFolderName(result);
+}
+
+fs::path PairFolders::take(const fs::path& out_dir, const PairResult& result) {
+  auto [slot, fresh] = fixture_folder_.try_emplace(result.fixture);
+  if (fresh) {
+    const std::string wanted = fixtureFolderName(result);
+    std::string name = wanted;
+    for (int k = 2; !fixture_folders_taken_.insert(name).second; ++k)
+      name = fmt::format("{}~{}", wanted, k);
+    slot->second = name;
+  }
+  const std::string wanted = pairFolderName(result);
+  std::string name = wanted;
+  for (int k = 2; !pair_folders_taken_.insert(slot->second + "/" + name).second; ++k)
+    name = fmt::format("{}~{}", wanted, k);
+  return out_dir / "pairs" / slot->second / name;
 }
 
 }  // namespace rc

@@ -5,6 +5,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -46,16 +48,35 @@ struct PairPictures {
 };
 
 // Writes into `dir` (created if needed), all files concurrently: expected.png, actual.png,
-// visibility.png, depth_heat.png, shading_heat.png and diff.exr (float channels id_class,
-// depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG, dB, dA; see
-// docs/reports.md), and records them in result.images and the heat scales in result.
-// Throws InputError when a file cannot be written; then none of them is left behind.
+// visibility.png, depth_heat.png, shading_heat.png and, with_diff_exr, diff.exr (float
+// channels id_class, depth_steps, depth_tolerance, shading_abs, shading_tolerance, dR, dG,
+// dB, dA; see docs/reports.md), and records them in result.images and the heat scales in
+// result. Throws InputError when a file cannot be written; then none of them is left behind.
 void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps& maps,
                      const std::filesystem::path& dir, PairResult& result,
-                     const PairPictures& pictures = {});
+                     const PairPictures& pictures = {}, bool with_diff_exr = true);
+
+// The values at the top of the two heat maps' colour scales (what writePairImages sets):
+// max(largest error, fail threshold, 1) for depth steps and shading units.
+void setHeatScales(PairResult& result);
 
 // A folder for one pair's images under a report folder: <out>/pairs/<fixture>/<expected>
-// _vs_<actual>, every name reduced to [A-Za-z0-9._-] (fixture "a/b" becomes "a_b").
+// _vs_<actual>, every name reduced to [A-Za-z0-9._-] (fixture "a/b" becomes "a_b") and
+// to at most 100 characters.
 std::filesystem::path pairDirectory(const std::filesystem::path& out_dir, const PairResult& result);
+
+// The pair folders of one report, unique whatever the names: pairDirectory's choice, with
+// "~2", "~3"... added to the fixture folder when another fixture's name reduces to the
+// same one ("dup/a b" and "dup/a_b"), and to the pair folder when a fixture name has the
+// same pair twice (two fixture files with one name). Deterministic in call order.
+class PairFolders {
+ public:
+  std::filesystem::path take(const std::filesystem::path& out_dir, const PairResult& result);
+
+ private:
+  std::map<std::string, std::string> fixture_folder_;  // fixture name -> its folder
+  std::set<std::string> fixture_folders_taken_;
+  std::set<std::string> pair_folders_taken_;  // "<fixture folder>/<pair folder>"
+};
 
 }  // namespace rc

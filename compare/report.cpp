@@ -159,6 +159,8 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
       known.push_back({{"id", k.id}, {"class", k.cls}, {"reason", k.reason}});
     j["known"] = known;
   }
+  if (!r.fixture_file.empty()) j["fixture_file"] = r.fixture_file;
+  if (!r.tags.empty()) j["tags"] = r.tags;
   if (r.status == Status::Error || r.status == Status::NotSupported) {
     // The contract's shape with nothing compared: every class "error" (or
     // "not_supported"), zero counts.
@@ -284,6 +286,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
             {"exit_code", exitCodeFor(report)}};
   if (!report.command.empty()) j["command"] = report.command;
   if (!report.variants.empty()) j["variants"] = report.variants;
+  if (!report.shard.empty()) j["shard"] = report.shard;
   return j;
 }
 

@@ -33,6 +33,9 @@ struct Report {
   std::vector<PairResult> results;
   // Per GL backend, the legal variants it follows (app/variants.h; empty: not probed).
   nlohmann::json variants = nlohmann::json::object();
+  // A part of a sharded run (`run --shard K/N`): which part, and where its rows go in the
+  // whole run, for `merge` (compare/merge.h). Empty for a whole run.
+  nlohmann::json shard = nlohmann::json::object();
 
   ReportSummary summary() const;
 };

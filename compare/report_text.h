@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "compare/compare.h"
 
@@ -14,6 +15,8 @@ std::string where(const PixelRef& p, int height);
 std::string visibilityText(const PairResult& r);
 std::string depthText(const PairResult& r);
 std::string shadingText(const PairResult& r);
+// Text made safe for HTML element content and attribute values (& < > " ').
+std::string htmlEscape(std::string_view text);
 // The shading allowance formula with the pair's numbers filled in.
 std::string shadingAllowanceText(const Tolerances& t, double slope_band_px);
 

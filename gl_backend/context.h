@@ -25,6 +25,9 @@ class Context {
   virtual void makeCurrent() = 0;
   // Unbinds it, so that another thread may bind it later.
   virtual void release() = 0;
+  // Replaces the GL context by a new one on the same display (the driver stays loaded),
+  // unbound; every GL object of the old one is gone. Throws BackendError on failure.
+  virtual void renew() = 0;
   // The provider's getProcAddress (eglGetProcAddress / OSMesaGetProcAddress).
   virtual ProcLoader loader() const = 0;
   // "egl", "egl-device" or "osmesa" (frame.json "platform").

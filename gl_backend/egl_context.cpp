@@ -94,16 +94,7 @@ class EglContext final : public Context {
     }
     if (!hasExtension(exts, "EGL_KHR_surfaceless_context"))
       throw BackendError("the EGL display lacks EGL_KHR_surfaceless_context");
-    if (eglBindAPI(EGL_OPENGL_API) == EGL_FALSE) failEgl("eglBindAPI(EGL_OPENGL_API)");
-    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
-                              3,
-                              EGL_CONTEXT_MINOR_VERSION,
-                              3,
-                              EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                              EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                              EGL_NONE};
-    context_ = eglCreateContext(display_, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
-    if (context_ == EGL_NO_CONTEXT) failEgl("eglCreateContext (OpenGL 3.3 core, no config)");
+    createContext();
   }
 
   ~EglContext() override {
@@ -125,10 +116,30 @@ class EglContext final : public Context {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   }
 
+  void renew() override {
+    release();
+    eglDestroyContext(display_, context_);
+    context_ = EGL_NO_CONTEXT;
+    createContext();
+  }
+
   ProcLoader loader() const override { return &eglLoader; }
   const char* platform() const override { return platform_; }
 
  private:
+  void createContext() {
+    if (eglBindAPI(EGL_OPENGL_API) == EGL_FALSE) failEgl("eglBindAPI(EGL_OPENGL_API)");
+    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                              3,
+                              EGL_CONTEXT_MINOR_VERSION,
+                              3,
+                              EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                              EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                              EGL_NONE};
+    context_ = eglCreateContext(display_, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
+    if (context_ == EGL_NO_CONTEXT) failEgl("eglCreateContext (OpenGL 3.3 core, no config)");
+  }
+
   EGLDisplay display_;
   EGLContext context_ = EGL_NO_CONTEXT;
   bool initialized_ = false;

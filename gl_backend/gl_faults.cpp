@@ -15,7 +15,8 @@ namespace {
 
 constexpr const char* kValidFaults =
     "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
-    "shader_compile_error";
+    "shader_compile_error, move_vertex=ID, texel_offset=N, blend_factor=one|swapped, "
+    "hang=FIXTURE|*, crash=FIXTURE|*";
 
 [[noreturn]] void badFault(std::string_view entry, std::string_view why) {
   throw InputError(
@@ -38,8 +39,12 @@ T number(std::string_view entry, std::string_view value) {
 
 bool Faults::any() const {
   return drop_primitive != 0 || depth_bias_steps != 0 || light_scale != 1.0 ||
-         no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error;
+         no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
+         texel_offset != 0.0 || blend_factor != Blend::Correct || !hang.empty() || !crash.empty();
 }
+
+bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }
+bool Faults::crashes(const std::string& fixture) const { return crash == "*" || crash == fixture; }
 
 std::string Faults::describe() const {
   std::vector<std::string> parts;
@@ -49,6 +54,12 @@ std::string Faults::describe() const {
   if (no_inverse_transpose) parts.emplace_back("no_inverse_transpose");
   if (shift_x_px != 0.0) parts.push_back(fmt::format("shift_x={}", shift_x_px));
   if (shader_compile_error) parts.emplace_back("shader_compile_error");
+  if (move_vertex != 0) parts.push_back(fmt::format("move_vertex={}", move_vertex));
+  if (texel_offset != 0.0) parts.push_back(fmt::format("texel_offset={}", texel_offset));
+  if (blend_factor != Blend::Correct)
+    parts.push_back(fmt::format("blend_factor={}", blend_factor == Blend::One ? "one" : "swapped"));
+  if (!hang.empty()) parts.push_back("hang=" + hang);
+  if (!crash.empty()) parts.push_back("crash=" + crash);
   return fmt::format("{}", fmt::join(parts, ","));
 }
 
@@ -65,7 +76,8 @@ Faults parseFaults(std::string_view text) {
     const std::string_view value = has_value ? entry.substr(eq + 1) : std::string_view{};
     const bool flag = name == "no_inverse_transpose" || name == "shader_compile_error";
     const bool valued = name == "drop_primitive" || name == "depth_bias" || name == "light_scale" ||
-                        name == "shift_x";
+                        name == "shift_x" || name == "move_vertex" || name == "texel_offset" ||
+                        name == "blend_factor" || name == "hang" || name == "crash";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
     if (name == "drop_primitive") {
@@ -77,6 +89,22 @@ Faults parseFaults(std::string_view text) {
       f.light_scale = number<double>(entry, value);
     } else if (name == "shift_x") {
       f.shift_x_px = number<double>(entry, value);
+    } else if (name == "move_vertex") {
+      f.move_vertex = number<std::uint32_t>(entry, value);
+      if (f.move_vertex == 0) badFault(entry, "primitive ids start at 1");
+    } else if (name == "texel_offset") {
+      f.texel_offset = number<double>(entry, value);
+    } else if (name == "blend_factor") {
+      if (value == "one") {
+        f.blend_factor = Faults::Blend::One;
+      } else if (value == "swapped") {
+        f.blend_factor = Faults::Blend::Swapped;
+      } else {
+        badFault(entry, "must be one or swapped");
+      }
+    } else if (name == "hang" || name == "crash") {
+      if (value.empty()) badFault(entry, "needs a fixture name or *");
+      (name == "hang" ? f.hang : f.crash) = std::string(value);
     } else if (name == "no_inverse_transpose") {
       f.no_inverse_transpose = true;
     } else {

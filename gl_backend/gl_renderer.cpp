@@ -1,10 +1,13 @@
 // renderGl: the process-wide GL session, the FBO, the draw sequence of drawPasses() and
 // the readback into a Frame (top row first). See gl_backend.h and docs/gl_backend.md.
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -126,7 +129,8 @@ struct Program {
   GLint light_intensity = -1, specular_model = -1, attenuation = -1;
   GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
   GLint opacity = -1, has_texture = -1, texture = -1;
-  GLint fault_depth_bias = -1, fault_shift_ndc = -1;  // -1 unless compiled with the fault
+  GLint fault_depth_bias = -1, fault_shift_ndc = -1,
+        fault_texel_offset = -1;  // -1 unless compiled with the fault
 };
 
 // The FBO of the last render, kept for the next one of the same size and formats:
@@ -240,6 +244,13 @@ std::string describeStack(const Session& s, const gl::LoadedMesa& mesa) {
   return out;
 }
 
+void enableDebugOutput(Session& s) {
+  if (s.gl.DebugMessageCallback == nullptr) return;
+  s.gl.Enable(GL_DEBUG_OUTPUT);
+  s.gl.Enable(GL_DEBUG_OUTPUT_SYNCHRONOUS);  // errors arrive inside the failing call
+  s.gl.DebugMessageCallback(&onDebugMessage, &s);
+}
+
 std::unique_ptr<Session> createSession(const GlSpec& spec) {
   const std::string& forced = gl::testing::hooks().gallium_driver;
   const std::string gallium = forced.empty() ? spec.driver : forced;
@@ -286,13 +297,24 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
   }
   chooseSubpixelBits(*s);
   s->stack = describeStack(*s, loaded);
-  if (gl.DebugMessageCallback != nullptr) {
-    gl.Enable(GL_DEBUG_OUTPUT);
-    gl.Enable(GL_DEBUG_OUTPUT_SYNCHRONOUS);  // errors arrive inside the failing call
-    gl.DebugMessageCallback(&onDebugMessage, s.get());
-  }
+  enableDebugOutput(*s);
   checkGl(*s, "context creation");
   return s;
+}
+
+// A new context for the next render, on the driver this process already loaded: every
+// render starts from a fresh context's state, as it did when each render was a process
+// of its own. Reusing one context showed softpipe's results depend on the fixture drawn
+// before (rgba8 with blending: 5 of 120 random scenes; docs/gl_backend.md).
+void renewContext(Session& s) {
+  s.programs.clear();  // their objects go with the old context
+  s.framebuffer = Framebuffer{};
+  s.debug_errors.clear();
+  s.context->renew();
+  s.context->makeCurrent();
+  s.gl.load(s.context->loader());
+  enableDebugOutput(s);
+  checkGl(s, "context creation");
 }
 
 // Returns the session for spec, made current on this thread.
@@ -317,7 +339,7 @@ Session& acquireSession(const GlSpec& spec) {
         "process): run {} in its own process",
         spec.driver, have.driver, toString(spec)));
   }
-  g_session->context->makeCurrent();
+  renewContext(*g_session);
   return *g_session;
 }
 
@@ -347,6 +369,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   shader_faults.depth_bias = faults.depth_bias_steps != 0;
   shader_faults.shift_x = faults.shift_x_px != 0.0;
   shader_faults.compile_error = faults.shader_compile_error;
+  shader_faults.texel_offset = faults.texel_offset != 0.0;
   gl::ProgramSource source = gl::programSource(max_lights, shader_faults);
   const gl::testing::Hooks& hooks = gl::testing::hooks();
   if (!hooks.vertex_shader.empty()) source.vertex = hooks.vertex_shader;
@@ -406,6 +429,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   p.texture = loc("u_texture");
   p.fault_depth_bias = loc("u_fault_depth_bias");
   p.fault_shift_ndc = loc("u_fault_shift_ndc");
+  p.fault_texel_offset = loc("u_fault_texel_offset");
   return s.programs.emplace(key, p).first->second;
 }
 
@@ -629,6 +653,9 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
   if (p.fault_shift_ndc >= 0) {
     gl.Uniform1f(p.fault_shift_ndc, static_cast<GLfloat>(2.0 * faults.shift_x_px / scene.width));
   }
+  if (p.fault_texel_offset >= 0) {
+    gl.Uniform1f(p.fault_texel_offset, static_cast<GLfloat>(faults.texel_offset));
+  }
   if (p.fault_depth_bias >= 0) {
     const int bits = depthBits(scene.state.depth_format);  // d32f: one step is 2^-24
     const double step = bits > 0 ? 1.0 / (std::ldexp(1.0, bits) - 1.0) : std::ldexp(1.0, -24);
@@ -685,6 +712,13 @@ void setFixedState(const gl::Functions& gl, const Scene& scene) {
   gl.BlendEquation(GL_FUNC_ADD);
   gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   gl.Disablei(GL_BLEND, 1);  // R32UI ids never blend (GL ignores blending on integer buffers)
+}
+
+// The test-only fault blend_factor: the classic wrong blend functions.
+void setFaultedBlend(const gl::Functions& gl, const gl::testing::Faults& faults) {
+  using Blend = gl::testing::Faults::Blend;
+  if (faults.blend_factor == Blend::One) gl.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (faults.blend_factor == Blend::Swapped) gl.BlendFunc(GL_ONE_MINUS_SRC_ALPHA, GL_SRC_ALPHA);
 }
 
 void clearFramebuffer(const gl::Functions& gl, const Scene& scene) {
@@ -1027,6 +1061,19 @@ gl::testing::Faults activeFaults() {
   return faults;
 }
 
+// The test-only hang and crash faults: what a driver stuck in a fence or faulting in its
+// rasterizer looks like from outside (gl_testing.h).
+void injectStall(const gl::testing::Faults& faults, const std::string& fixture) {
+  if (faults.crashes(fixture)) {
+    std::signal(SIGSEGV, SIG_DFL);  // a sanitizer's handler would turn it into an exit code
+    std::raise(SIGSEGV);
+  }
+  if (faults.hangs(fixture)) {
+    std::fflush(nullptr);
+    for (;;) ::pause();
+  }
+}
+
 Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   if (scene.width <= 0 || scene.height <= 0) {
     throw InputError(
@@ -1121,10 +1168,12 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
 
   start = Clock::now();
   setFixedState(gl, scene);
+  setFaultedBlend(gl, faults);
   if (samples > 1) gl.Enable(GL_MULTISAMPLE);  // multisample rasterization into `ms`
   clearFramebuffer(gl, scene);
   drawPassesGl(gl, program, scene, data, textures);
   gl.Finish();
+  injectStall(faults, scene.name);
   checkGl(s, "draw");
   const double draw_ms = msSince(start);
 

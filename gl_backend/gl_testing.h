@@ -24,8 +24,26 @@ struct Faults {
   bool no_inverse_transpose = false;  // normals by the model matrix, not its inverse transpose
   double shift_x_px = 0.0;            // shift_x=PX: geometry moved PX pixels right (window)
   bool shader_compile_error = false;  // shader_compile_error: the fragment shader breaks
+  // move_vertex=ID: the first vertex of triangle ID alone is moved one pixel right in
+  // window space (the rest of the scene is untouched): a geometry error of one vertex.
+  std::uint32_t move_vertex = 0;
+  // texel_offset=N: every texture is sampled N texels to the right of the texel the
+  // coordinate names (the neighbouring texel for N = 1): an addressing error.
+  double texel_offset = 0.0;
+  // blend_factor=one|swapped: alpha blending with the wrong factors, src*1 + dst*(1-a)
+  // or src*(1-a) + dst*a, instead of src*a + dst*(1-a).
+  enum class Blend { Correct, One, Swapped };
+  Blend blend_factor = Blend::Correct;
+  // hang=NAME / crash=NAME: the render of the fixture named NAME ("*": every fixture) never
+  // returns (blocks after the draw, as a driver stuck in a fence would) or dies with
+  // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.
+  std::string hang;
+  std::string crash;
 
   bool any() const;
+  // Whether hang / crash apply to the fixture named `fixture`.
+  bool hangs(const std::string& fixture) const;
+  bool crashes(const std::string& fixture) const;
   // The canonical comma-separated form (parseFaults(describe()) gives the same faults).
   std::string describe() const;
 };

@@ -65,6 +65,31 @@ class OsMesaContext final : public Context {
  public:
   explicit OsMesaContext(const std::string& mesa_dir) {
     osmesa(mesa_dir);  // loads the library on the process's first context
+    createContext();
+  }
+  ~OsMesaContext() override { osmesa().destroy_context(context_); }
+
+  void makeCurrent() override {
+    // OSMesa needs a colour buffer to become current; everything is drawn into the
+    // backend's FBO, so a 1x1 one is enough.
+    if (osmesa().make_current(context_, pixel_.data(), GL_UNSIGNED_BYTE, 1, 1) == 0)
+      throw BackendError("OSMesaMakeCurrent failed");
+  }
+  // OSMesa cannot unbind a context (OSMesaMakeCurrent(NULL...) is not portable across
+  // versions); the context simply stays current on this thread.
+  void release() override {}
+
+  void renew() override {
+    osmesa().destroy_context(context_);
+    context_ = nullptr;
+    createContext();
+  }
+
+  ProcLoader loader() const override { return &osmesaLoader; }
+  const char* platform() const override { return "osmesa"; }
+
+ private:
+  void createContext() {
     const int attribs[] = {OSMESA_FORMAT,
                            OSMESA_RGBA,
                            OSMESA_DEPTH_BITS,
@@ -84,22 +109,7 @@ class OsMesaContext final : public Context {
     if (context_ == nullptr)
       throw BackendError("OSMesaCreateContextAttribs (OpenGL 3.3 core) failed");
   }
-  ~OsMesaContext() override { osmesa().destroy_context(context_); }
 
-  void makeCurrent() override {
-    // OSMesa needs a colour buffer to become current; everything is drawn into the
-    // backend's FBO, so a 1x1 one is enough.
-    if (osmesa().make_current(context_, pixel_.data(), GL_UNSIGNED_BYTE, 1, 1) == 0)
-      throw BackendError("OSMesaMakeCurrent failed");
-  }
-  // OSMesa cannot unbind a context (OSMesaMakeCurrent(NULL...) is not portable across
-  // versions); the context simply stays current on this thread.
-  void release() override {}
-
-  ProcLoader loader() const override { return &osmesaLoader; }
-  const char* platform() const override { return "osmesa"; }
-
- private:
   OSMesaContext context_ = nullptr;
   std::array<unsigned char, 4> pixel_{};
 };

@@ -140,12 +140,21 @@ uniform float u_opacity;
 #ifdef RC_FAULT_DEPTH_BIAS
 uniform float u_fault_depth_bias;  // test-only: STEPS / (2^bits - 1)
 #endif
+#ifdef RC_FAULT_TEXEL_OFFSET
+uniform float u_fault_texel_offset;  // test-only: texels to the right
+#endif
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_primitive_id;
 
 void main() {
+#ifdef RC_FAULT_TEXEL_OFFSET
+  vec2 texel = vec2(1.0 / vec2(textureSize(u_texture, 0)));
+  vec2 uv = v_uv + vec2(u_fault_texel_offset * texel.x, 0.0);
+  vec3 tex = u_has_texture != 0 ? texture(u_texture, uv).rgb : vec3(1.0);
+#else
   vec3 tex = u_has_texture != 0 ? texture(u_texture, v_uv).rgb : vec3(1.0);
+#endif
   vec3 ambient_diffuse;
   vec3 specular;
   if (u_shading == 0) {
@@ -174,6 +183,7 @@ ProgramSource programSource(int max_lights, const ShaderFaults& faults) {
   std::string header = fmt::format(kHeader, max_lights);
   if (faults.depth_bias) header += "#define RC_FAULT_DEPTH_BIAS\n";
   if (faults.shift_x) header += "#define RC_FAULT_SHIFT_X\n";
+  if (faults.texel_offset) header += "#define RC_FAULT_TEXEL_OFFSET\n";
   std::string fragment_header = header;
   if (faults.compile_error) fragment_header += "#define RC_FAULT_COMPILE_ERROR\n";
   return {header + kLighting + kVertexMain, fragment_header + kLighting + kFragmentMain};

@@ -33,6 +33,7 @@ struct ShaderFaults {
   bool depth_bias = false;     // gl_FragDepth = gl_FragCoord.z + u_fault_depth_bias
   bool shift_x = false;        // gl_Position.x += u_fault_shift_ndc * gl_Position.w
   bool compile_error = false;  // the fragment shader calls a function that does not exist
+  bool texel_offset = false;   // texture() samples at v_uv + u_fault_texel_offset texels in s
 };
 
 // The program for scenes with up to max_lights lights (array sizes are compile-time

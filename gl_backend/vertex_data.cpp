@@ -79,6 +79,15 @@ void store(float (&dst)[3], const glm::dvec3& v) {
   dst[2] = static_cast<float>(v.z);
 }
 
+// The fault move_vertex: `world` moved one pixel right in window space (NDC x + 2/width
+// at the same clip w, so the same depth and the same pixel row), back in world space.
+glm::dvec3 onePixelRight(const glm::dvec3& world, const glm::dmat4& view_projection, int width) {
+  glm::dvec4 clip = view_projection * glm::dvec4(world, 1.0);
+  clip.x += 2.0 / width * clip.w;
+  const glm::dvec4 back = glm::inverse(view_projection) * clip;
+  return glm::dvec3(back) / back.w;
+}
+
 }  // namespace
 
 VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes,
@@ -123,9 +132,16 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
         out.runs.push_back(DrawRun{material, first, 0});
       out.runs.back().vertex_count += 3;
 
-      for (std::uint32_t vi : tri) {
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t vi = tri[k];
         Vertex& v = data.vertices.emplace_back();
-        store(v.world_position, wm.positions[vi]);
+        // The fault move_vertex=ID: only this triangle's first vertex (the buffer is
+        // unindexed, so the triangles sharing it keep theirs); lighting and the flat
+        // centroid stay where they were, so the error is geometry alone.
+        const bool moved = k == 0 && prim.id == faults.move_vertex;
+        store(v.world_position, moved
+                                    ? onePixelRight(wm.positions[vi], view_projection, scene.width)
+                                    : wm.positions[vi]);
         const glm::vec3& n = wm.normals[vi];
         v.world_normal[0] = n.x;
         v.world_normal[1] = n.y;

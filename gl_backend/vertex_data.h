@@ -47,7 +47,7 @@ struct VertexData {
 // Builds the buffer for drawPasses(scene). Triangles with a non-finite world or clip
 // position are left out; their ids stay unused. Throws InputError for indices out of
 // range (material, vertex) or attribute arrays whose size does not match the positions.
-// Of the test-only faults, drop_primitive and no_inverse_transpose act here.
+// Of the test-only faults, drop_primitive, move_vertex and no_inverse_transpose act here.
 VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes,
                            const testing::Faults& faults = {});
 

@@ -39,3 +39,22 @@ run fixtures/scenes --backends "$drivers" --against gl:egl:llvmpipe --out "$work
   --expectations fixtures/expectations.json \
   --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\` and \`rastercheck run fixtures/scenes --backends $drivers --against gl:egl:llvmpipe\`, then \`rastercheck accuracy\` on both run folders)" \
   --out docs/accuracy.md
+
+# The random-scene campaigns and mutation studies (scripts/campaign.sh, scripts/mutations.sh)
+# write their results to docs/results/; the document lists them.
+results_section() {
+  echo
+  echo "## Random-scene campaigns and the mutation study"
+  echo
+  echo "How they are run, what a group and its signature are, and how the mutation study"
+  echo "counts a fault as caught: [campaigns.md](campaigns.md). Latest results:"
+  echo
+  local any=0 f
+  for f in docs/results/campaign-*.md docs/results/mutations-*.md; do
+    [[ -f $f ]] || continue
+    any=1
+    echo "- [${f#docs/}](${f#docs/})"
+  done
+  [[ $any -eq 1 ]] || echo "- none yet (run scripts/campaign.sh and scripts/mutations.sh)"
+}
+results_section >>docs/accuracy.md

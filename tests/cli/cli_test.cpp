@@ -187,7 +187,15 @@ TEST(CliCompare, IdenticalFramesPassWithTheSummaryAndReportPath) {
   EXPECT_NE(r.out.find("1 pairs: 1 pass"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.substr(r.out.size() - 5), "PASS\n") << r.out;
   expectReportFiles(out);
-  EXPECT_TRUE(fs::is_directory(out / "pairs" / "coverage_triangle_fan"));
+  const fs::path pair = out / "pairs" / "coverage_triangle_fan" / "ref_vs_ref_subpixel_8";
+  EXPECT_TRUE(fs::is_regular_file(pair / "visibility.png"));
+  // A passing pair gets no diff.exr (75 MB at 1080p) unless asked for.
+  EXPECT_FALSE(fs::exists(pair / "diff.exr"));
+  EXPECT_EQ(readFile(out / "report.json").find("diff_exr"), std::string::npos);
+  const Result forced = run("compare " + a.string() + " " + b.string() + " --diff-exr --out " +
+                            out.string());
+  EXPECT_EQ(forced.code, 0) << forced.out;
+  EXPECT_TRUE(fs::is_regular_file(pair / "diff.exr"));
 }
 
 TEST(CliCompare, AFailingPairExitsOne) {
@@ -245,7 +253,16 @@ TEST(CliRun, ExitCodesZeroOneTwoThree) {
             std::string::npos)
       << r.out;
   expectReportFiles(dir / "pass");
-  EXPECT_TRUE(fs::is_directory(dir / "pass" / "frames"));
+  // Frames and pair images only for pairs that do not pass, unless --keep-frames.
+  EXPECT_FALSE(fs::exists(dir / "pass" / "frames"));
+  EXPECT_FALSE(fs::exists(dir / "pass" / "pairs"));
+  r = run("run " + catalog("coverage/triangle_fan.json") +
+          " --backends ref:subpixel=8 --keep-frames --out " + (dir / "kept").string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::is_regular_file(dir / "kept" / "frames" / "coverage__triangle_fan" /
+                                  "ref_subpixel_8" / "frame.exr"));
+  EXPECT_TRUE(fs::is_regular_file(dir / "kept" / "pairs" / "coverage_triangle_fan" /
+                                  "ref_vs_ref_subpixel_8" / "diff.exr"));
 
   // 1: painter's order cannot draw interpenetrating quads.
   r = run("run " + crafted("interpenetrating.json") + " --backends ref:painter --out " +
@@ -307,7 +324,7 @@ TEST(CliRun, ARunReplacesWhatAnEarlierRunLeftAndNothingElse) {
   fs::create_directories(out);
   std::ofstream(out / "notes.txt") << "mine";
   Result r = run("run " + catalog("coverage/triangle_fan.json") +
-                 " --backends ref:subpixel=8 --out " + out.string());
+                 " --backends ref:subpixel=8 --keep-frames --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_TRUE(fs::is_directory(out / "pairs" / "coverage_triangle_fan"));
   const std::string first_report = readFile(out / "report.json");
@@ -319,8 +336,8 @@ TEST(CliRun, ARunReplacesWhatAnEarlierRunLeftAndNothingElse) {
   EXPECT_EQ(readFile(out / "report.json"), first_report);
 
   // Another catalog: the first run's pairs and frames are gone, the user's file stays.
-  r = run("run " + catalog("coverage/jittered_grid.json") + " --backends ref:subpixel=8 --out " +
-          out.string());
+  r = run("run " + catalog("coverage/jittered_grid.json") +
+          " --backends ref:subpixel=8 --keep-frames --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_FALSE(fs::exists(out / "pairs" / "coverage_triangle_fan"));
   EXPECT_FALSE(fs::exists(out / "frames" / "coverage__triangle_fan"));

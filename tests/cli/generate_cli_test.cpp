@@ -51,7 +51,8 @@ int lineCount(const std::string& s) {
 bool hasLeftovers(const fs::path& parent) {
   for (const auto& e : fs::directory_iterator(parent))
     if (e.path().filename().string().find(".staging-") != std::string::npos ||
-        e.path().filename().string().find(".old-") != std::string::npos)
+        e.path().filename().string().find(".old-") != std::string::npos ||
+        e.path().filename().string().rfind(".rastercheck-", 0) == 0)
       return true;
   return false;
 }

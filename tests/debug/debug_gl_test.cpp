@@ -87,8 +87,10 @@ TEST(DebugGl, DriverVsDriverRunClassifiesProbesAndReports) {
                                catalog("coverage/slivers_and_centres.json") + " " +
                                catalog("shading/sphere_gouraud_low.json") + " " +
                                catalog("zbuffer/cyclic_overlap_zbuffer.json");
-  const Result r = run("run " + fixtures + " --backends " + kLlvmpipe + "," + kSoftpipe +
-                       ",ref:painter --against " + kLlvmpipe + " --out " + dir.string());
+  // --keep-frames: the frames of passing pairs too, to read their frame.json below.
+  const Result r =
+      run("run " + fixtures + " --backends " + kLlvmpipe + "," + kSoftpipe +
+          ",ref:painter --against " + kLlvmpipe + " --keep-frames --out " + dir.string());
   const json report = json::parse(std::ifstream(dir / "report.json"));
   {
     SCOPED_TRACE("classification");

@@ -17,6 +17,7 @@
 
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
+#include "fixtures/output_folder.h"
 
 namespace fs = std::filesystem;
 
@@ -132,14 +133,15 @@ std::string fileBytes(const fs::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Every entry of the directory that holds `dir` whose name starts with "." + dir's name:
-// the temporary siblings writeFrameDir uses.
+// Every entry of the directory that holds `dir` that is its staging folder
+// (".rastercheck-staging." + dir's name) or an earlier version's temporary sibling.
 std::vector<std::string> tempSiblings(const fs::path& dir) {
   std::vector<std::string> out;
   const std::string prefix = "." + dir.filename().string();
   for (const auto& e : fs::directory_iterator(dir.parent_path())) {
     const std::string name = e.path().filename().string();
-    if (name.rfind(prefix, 0) == 0) out.push_back(name);
+    if (name.rfind(prefix, 0) == 0 || name.rfind(".rastercheck-staging" + prefix, 0) == 0)
+      out.push_back(name);
   }
   return out;
 }
@@ -302,7 +304,7 @@ TEST(FrameIo, FailedReplacementLeavesTheOldFrame) {
       std::vector<std::string> before;
       for (const char* name : {"frame.exr", "color.png", "frame.json"})
         before.push_back(fileBytes(dir / name));
-      rc::testing::frame_dir_renames_before_failure = budget;
+      rc::testing::output_renames_before_failure = budget;
       bool threw = false;
       try {
         rc::writeFrameDir(otherFrame(), dir);
@@ -310,7 +312,7 @@ TEST(FrameIo, FailedReplacementLeavesTheOldFrame) {
         threw = true;
         EXPECT_NE(std::string(e.what()).find("injected rename failure"), std::string::npos);
       }
-      rc::testing::frame_dir_renames_before_failure = -1;
+      rc::testing::output_renames_before_failure = -1;
       const std::string where =
           (with_other_file ? "per-file, " : "swap, ") + std::to_string(budget) + " renames allowed";
       EXPECT_TRUE(tempSiblings(dir).empty()) << where;

@@ -287,6 +287,121 @@ TEST_F(GlFault, ShiftXMovesTheImageRight) {
   EXPECT_GT(same_depth, (kSize - kShift) * kSize * 9 / 10) << "max " << max_dz << " steps";
 }
 
+TEST_F(GlFault, MoveVertexMovesOneVertexOfOneTriangle) {
+  const Scene s = faultScene();
+  const Frame clean = render(s);
+  constexpr std::uint32_t kMoved = 3;  // the front quad's first triangle (0, 1, 2)
+  Faults f;
+  f.move_vertex = kMoved;
+  const Frame faulted = renderFaulted(s, f);
+  EXPECT_EQ(faulted.meta.at("fault_injected"), "move_vertex=3");
+  std::size_t changed = 0;
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const std::size_t i = clean.index(x, y);
+      if (faulted.id[i] == clean.id[i]) {
+        if (clean.id[i] != kMoved) {
+          EXPECT_EQ(faulted.depth[i], clean.depth[i]) << "pixel (" << x << ", " << y << ")";
+          EXPECT_TRUE(sameColor(faulted, clean, i)) << "pixel (" << x << ", " << y << ")";
+        }
+        continue;
+      }
+      ++changed;
+      EXPECT_TRUE(clean.id[i] == kMoved || faulted.id[i] == kMoved)
+          << "pixel (" << x << ", " << y << "): " << clean.id[i] << " -> " << faulted.id[i]
+          << ": only triangle 3 may change";
+      // The corner (-0.5, -0.3) is at image (16, 41.6); moving it one pixel right along
+      // the quad's bottom edge opens a sliver between triangle 3's new edge and
+      // triangle 4's diagonal (to the corner (0.1, 0.5), image (35.2, 16)): only there.
+      EXPECT_TRUE(x >= 15 && x <= 36 && y >= 15 && y <= 42) << "pixel (" << x << ", " << y << ")";
+    }
+  }
+  // The sliver: 1 px wide at the corner, tapering over the 25.6 px height of the
+  // diagonal, about 13 px; far from the ~250 px of the whole triangle.
+  EXPECT_GT(changed, 5u);
+  EXPECT_LT(changed, 40u);
+}
+
+// A full-image quad with an 8x8 texture of distinct texels (8 px each), nearest, repeat,
+// lit by ambient light only: each pixel shows its texel's colour.
+Scene texelScene() {
+  Scene s = orthoScene(kSize, kSize);
+  s.name = "gltest/texels";
+  s.ambient_light = glm::dvec3(1.0);
+  auto texture = std::make_shared<Texture>();
+  texture->path = "generated-8x8";
+  texture->width = 8;
+  texture->height = 8;
+  for (int t = 0; t < 64; ++t) {
+    texture->rgba.insert(texture->rgba.end(),
+                         {static_cast<std::uint8_t>(t * 4), static_cast<std::uint8_t>(255 - t * 3),
+                          static_cast<std::uint8_t>((t * 37) % 256), 255});
+  }
+  Material m = lit({1.0, 1.0, 1.0});
+  m.diffuse = glm::dvec3(0.0);
+  m.specular = glm::dvec3(0.0);
+  m.texture = texture;
+  const std::size_t mat = addMaterial(s, m);
+  s.objects.push_back(quad(-1.0, -1.0, 1.0, 1.0, 0.0, mat));
+  return s;
+}
+
+TEST_F(GlFault, TexelOffsetSamplesTheNeighbouringTexel) {
+  const Scene s = texelScene();
+  const Frame clean = render(s);
+  Faults f;
+  f.texel_offset = 1.0;
+  const Frame faulted = renderFaulted(s, f);
+  EXPECT_EQ(faulted.meta.at("fault_injected"), "texel_offset=1");
+  constexpr int kTexelPx = kSize / 8;
+  std::size_t differs = 0;
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const std::size_t i = clean.index(x, y);
+      ASSERT_EQ(faulted.id[i], clean.id[i]);
+      EXPECT_EQ(faulted.depth[i], clean.depth[i]);
+      // The texel to the right (repeat wraps the last column to the first) is what the
+      // clean image shows one texel width further right.
+      const std::size_t right = clean.index((x + kTexelPx) % kSize, y);
+      EXPECT_TRUE(sameColorAt(faulted, i, clean, right, 1e-6))
+          << "pixel (" << x << ", " << y << ")";
+      differs += sameColor(faulted, clean, i, 1e-3) ? 0 : 1;
+    }
+  }
+  EXPECT_EQ(differs, clean.pixelCount()) << "every texel differs from its right neighbour";
+}
+
+class GlFaultBlend : public GlFault, public ::testing::WithParamInterface<Faults::Blend> {};
+
+TEST_P(GlFaultBlend, WrongBlendFactorChangesOnlyBlendedPixels) {
+  Scene s = faultScene();
+  s.state.blend = Blend::Alpha;
+  s.materials[1].opacity = 0.3;  // the front quad and the ball
+  const Frame clean = render(s);
+  Faults f;
+  f.blend_factor = GetParam();
+  const Frame faulted = renderFaulted(s, f);
+  std::size_t blended = 0;
+  for (std::size_t i = 0; i < clean.pixelCount(); ++i) {
+    ASSERT_EQ(faulted.id[i], clean.id[i]);
+    EXPECT_EQ(faulted.depth[i], clean.depth[i]);
+    if (clean.id[i] <= 2) {
+      EXPECT_TRUE(sameColor(faulted, clean, i)) << "opaque or background pixel " << i;
+      continue;
+    }
+    // src*1 + dst*(1-a) differs from src*a + dst*(1-a) wherever the transparent fragment
+    // has colour; src*(1-a) + dst*a wherever src and dst differ (not at a = 0.5, hence 0.3).
+    if (!sameColor(faulted, clean, i, 1e-3)) ++blended;
+  }
+  EXPECT_GT(blended, 300u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Factors, GlFaultBlend,
+                         ::testing::Values(Faults::Blend::One, Faults::Blend::Swapped),
+                         [](const auto& p) {
+                           return std::string(p.param == Faults::Blend::One ? "one" : "swapped");
+                         });
+
 TEST_F(GlFault, ShaderCompileErrorIsABackendErrorWithTheLog) {
   Faults f;
   f.shader_compile_error = true;
@@ -333,16 +448,36 @@ TEST(GlFaultParse, CanonicalFormRoundTrips) {
   const std::string text = f.describe();
   EXPECT_EQ(text,
             "drop_primitive=12,depth_bias=-3,light_scale=0.5,no_inverse_transpose,shift_x=2.5");
+  const Faults more = gl::testing::parseFaults("blend_factor=swapped,texel_offset=1,move_vertex=7");
+  EXPECT_EQ(more.move_vertex, 7u);
+  EXPECT_EQ(more.texel_offset, 1.0);
+  EXPECT_EQ(more.blend_factor, Faults::Blend::Swapped);
+  EXPECT_EQ(more.describe(), "move_vertex=7,texel_offset=1,blend_factor=swapped");
+  EXPECT_EQ(gl::testing::parseFaults("blend_factor=one").describe(), "blend_factor=one");
   const Faults again = gl::testing::parseFaults(text);
   EXPECT_EQ(again.describe(), text);
   EXPECT_FALSE(gl::testing::parseFaults("").any());
+}
+
+TEST(GlFaultParse, HangAndCrashNameTheFixtureTheyHit) {
+  const Faults f = gl::testing::parseFaults("hang=coverage/triangle_fan,crash=*");
+  EXPECT_TRUE(f.any());
+  EXPECT_TRUE(f.hangs("coverage/triangle_fan"));
+  EXPECT_FALSE(f.hangs("coverage/other"));
+  EXPECT_TRUE(f.crashes("anything"));
+  EXPECT_EQ(f.describe(), "hang=coverage/triangle_fan,crash=*");
+  EXPECT_EQ(gl::testing::parseFaults(f.describe()).describe(), f.describe());
+  const Faults none = gl::testing::parseFaults("light_scale=2");
+  EXPECT_FALSE(none.hangs("x"));
+  EXPECT_FALSE(none.crashes("x"));
 }
 
 TEST(GlFaultParse, BadEntriesAreInputErrorsNamingTheVariable) {
   for (const char* bad :
        {"frobnicate", "drop_primitive", "drop_primitive=0", "drop_primitive=x", "depth_bias=1.5",
         "light_scale=nan", "light_scale=", "no_inverse_transpose=1", "shift_x=inf",
-        "shader_compile_error=yes", "light_scale=2,bogus=1"}) {
+        "shader_compile_error=yes", "light_scale=2,bogus=1", "move_vertex=0", "move_vertex",
+        "texel_offset=x", "blend_factor=zero", "blend_factor", "hang", "hang=", "crash"}) {
     try {
       gl::testing::parseFaults(bad);
       ADD_FAILURE() << bad << " was accepted";

@@ -1,0 +1,424 @@
+// `rastercheck campaign --mutations --seed S --count N --backends SPEC,... --out DIR`: the
+// mutation study (debug/mutation_study.h). Per batch of random scenes, child `rastercheck
+// render` processes draw the reference and each GL backend without fault, then each GL
+// backend once per fault with RASTERCHECK_GL_FAULT set (the primitive a fault needs is
+// drawn from what the clean frame shows); the three comparisons of each (scene, backend,
+// fault) are made here with the comparator, exactly as `compare` makes them. Results go to
+// DIR/mutations/<first>-<last>.json per batch, renamed into place when complete, and
+// DIR/mutations.md and mutations.json are written from all of them: interruptible and
+// resumable like the failure campaign.
+#include <algorithm>
+#include <chrono>
+#include <iostream>
+#include <regex>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "app/backends.h"
+#include "app/campaign_support.h"
+#include "app/commands.h"
+#include "app/debug_support.h"
+#include "app/paths.h"
+#include "app/report_support.h"
+#include "compare/atomic_file.h"
+#include "compare/compare.h"
+#include "compare/report.h"
+#include "debug/mutation_study.h"
+#include "fixtures/catalog.h"
+#include "fixtures/errors.h"
+#include "fixtures/frame_io.h"
+#include "fixtures/loader.h"
+#include "gl_backend/gl_testing.h"
+
+namespace rc {
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+std::set<std::string> failingClasses(const PairResult& r) {
+  std::set<std::string> out;
+  if (r.visibility.status == Status::Fail) out.insert("visibility");
+  if (r.depth.status == Status::Fail) out.insert("depth");
+  if (r.shading.status == Status::Fail) out.insert("shading");
+  return out;
+}
+
+// What the scene offers the faults: its state and materials (the clean frame adds the
+// visible primitives).
+MutationScene sceneFacts(const Scene& scene) {
+  MutationScene m;
+  m.depth_format = toString(scene.state.depth_format);
+  for (const Object& o : scene.objects) {
+    const Material& mat = scene.materials[o.material];
+    if (o.mesh.triangles.empty()) continue;
+    m.textured = m.textured || mat.texture != nullptr;
+    m.blended = m.blended || (scene.state.blend == Blend::Alpha && mat.opacity < 1.0);
+  }
+  return m;
+}
+
+std::vector<std::uint32_t> visibleIds(const Frame& frame) {
+  std::set<std::uint32_t> ids(frame.id.begin(), frame.id.end());
+  ids.erase(0);
+  return {ids.begin(), ids.end()};
+}
+
+class MutationStudy {
+ public:
+  explicit MutationStudy(const CampaignArgs& args, std::vector<const MutationFault*> faults)
+      : args_(args),
+        faults_(std::move(faults)),
+        scene_options_(campaignSceneOptions(args)),
+        jobs_(args.jobs > 0 ? args.jobs
+                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))),
+        folder_(fs::absolute(args.out).lexically_normal(), identity(), args.command_line) {
+    parseToleranceArgs(args.tolerance, cli_);
+  }
+
+  int run() {
+    const auto start = Clock::now();
+    scenes_ = folder_.ensureScenes(scene_options_);
+    readFinished();
+    if (folder_.resumed())
+      status_.note(fmt::format("continuing the mutation study in {}: {} of {} scenes already done",
+                               folder_.dir().string(), scenesDone(), scenes_.size()));
+    else
+      status_.note(fmt::format("starting a mutation study in {}: {} scenes x {} x {} faults",
+                               folder_.dir().string(), scenes_.size(),
+                               fmt::join(args_.backends, ", "), faults_.size()));
+    for (const auto& [first, last] : pendingRanges()) {
+      if (interrupt_.interrupted()) break;
+      runRange(first, last);
+    }
+    status_.clear();
+    const int code = writeReport();
+    if (interrupt_.interrupted()) {
+      status_.note(fmt::format(
+          "interrupted after {}: kept {} of {} scenes; run the same command again to continue",
+          durationText(std::chrono::duration<double>(Clock::now() - start).count()), scenesDone(),
+          scenes_.size()));
+      folder_.removeWork();
+      interrupt_.reraise();
+    }
+    return code;
+  }
+
+ private:
+  json identity() const {
+    std::vector<std::string> names;
+    for (const MutationFault* f : faults_) names.emplace_back(f->name);
+    return {{"mode", "mutations"},
+            {"seed", scene_options_.seed},
+            {"profile", toString(scene_options_.profile)},
+            {"max_size", fmt::format("{}x{}", scene_options_.max_width, scene_options_.max_height)},
+            {"meshes", scene_options_.mesh_root.string()},
+            {"backends", args_.backends},
+            {"tolerance", args_.tolerance},
+            {"batch", args_.batch},
+            {"faults", names}};
+  }
+
+  fs::path resultsDir() const { return folder_.dir() / "mutations"; }
+
+  std::uint64_t scenesDone() const {
+    std::uint64_t n = 0;
+    for (const auto& [first, last] : finished_) n += last - first + 1;
+    return n;
+  }
+
+  void readFinished() {
+    static const std::regex pattern(R"(([0-9]{5,})-([0-9]{5,})\.json)");
+    std::error_code ec;
+    if (!fs::is_directory(resultsDir(), ec)) return;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(resultsDir(), ec)) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const fs::path& file : files) {
+      std::smatch m;
+      const std::string name = file.filename().string();
+      if (!std::regex_match(name, m, pattern)) continue;
+      const std::uint64_t first = std::stoull(m[1]), last = std::stoull(m[2]);
+      if (last >= scenes_.size()) continue;
+      const json doc = readJson(file);
+      if (!doc.is_array()) throw InputError(fmt::format("{}: must be an array", file.string()));
+      for (std::size_t i = 0; i < doc.size(); ++i)
+        results_.push_back(mutationResultFromJson(doc[i], fmt::format("{}[{}]", file.string(), i)));
+      finished_.emplace_back(first, last);
+    }
+  }
+
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> pendingRanges() const {
+    std::vector<bool> done(scenes_.size(), false);
+    for (const auto& [first, last] : finished_)
+      for (std::uint64_t i = first; i <= last; ++i) done[i] = true;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> out;
+    for (std::uint64_t i = 0; i < scenes_.size(); ++i) {
+      if (done[i]) continue;
+      if (!out.empty() && out.back().second + 1 == i &&
+          out.back().second - out.back().first + 1 < static_cast<std::uint64_t>(args_.batch))
+        out.back().second = i;
+      else
+        out.emplace_back(i, i);
+    }
+    return out;
+  }
+
+  void showProgress(std::uint64_t first, std::uint64_t last, const char* stage, std::size_t done,
+                    std::size_t total) {
+    const std::uint64_t scenes = scenesDone();
+    const std::string eta =
+        measured_scenes_ == 0
+            ? std::string("--")
+            : durationText(measured_seconds_ / static_cast<double>(measured_scenes_) *
+                           static_cast<double>(scenes_.size() - scenes));
+    status_.show(fmt::format("mutations: scenes {}/{}; {}..{}: {} {}/{}; ETA {}", scenes,
+                             scenes_.size(), first, last, stage, done, total, eta));
+  }
+
+  bool runStage(std::vector<Job>& jobs, std::uint64_t first, std::uint64_t last,
+                const char* stage) {
+    std::size_t finished = 0;
+    auto tick = [&] { showProgress(first, last, stage, finished, jobs.size()); };
+    tick();
+    runCampaignJobs(jobs, jobs_, interrupt_, tick, [&](std::size_t) { ++finished; });
+    return !interrupt_.interrupted();
+  }
+
+  void runRange(std::uint64_t first, std::uint64_t last) {
+    const auto start = Clock::now();
+    const fs::path work = folder_.work() / fmt::format("{:05}-{:05}", first, last);
+    std::error_code ec;
+    fs::remove_all(work, ec);
+    auto sceneDir = [&](std::uint64_t i) { return work / fmt::format("{:05}", i); };
+    auto backendDir = [&](std::uint64_t i, const std::string& b) {
+      return sceneDir(i) / fixtureSlug(b);
+    };
+
+    // Stage 1: the reference and every backend without fault.
+    std::vector<Job> jobs;
+    for (std::uint64_t i = first; i <= last; ++i) {
+      fs::create_directories(sceneDir(i), ec);
+      jobs.push_back(renderJob(scenes_[i].file, "ref", sceneDir(i) / "ref"));
+      for (const std::string& b : args_.backends) {
+        fs::create_directories(backendDir(i, b), ec);
+        jobs.push_back(renderJob(scenes_[i].file, b, backendDir(i, b) / "clean"));
+      }
+    }
+    for (Job& j : jobs) j.env = folder_.childEnv();
+    if (!runStage(jobs, first, last, "clean renders")) return;
+    auto ok = [&](const fs::path& dir) {
+      return fs::exists(dir / "frame.json", ec) && fs::exists(dir / "frame.exr", ec);
+    };
+
+    // Stage 2: each fault, set for what the clean frame shows.
+    struct Planned {
+      std::uint64_t scene;
+      std::string backend;
+      const MutationFault* fault;
+      std::string setting;
+    };
+    std::vector<Planned> planned;
+    std::vector<Job> faulted;
+    std::map<std::uint64_t, Scene> loaded;
+    for (std::uint64_t i = first; i <= last; ++i) {
+      loaded.emplace(i, loadScene(scenes_[i].file));
+      MutationScene facts = sceneFacts(loaded.at(i));
+      for (const std::string& b : args_.backends) {
+        const fs::path clean = backendDir(i, b) / "clean";
+        facts.visible_ids.clear();
+        try {
+          if (ok(clean)) facts.visible_ids = visibleIds(readFrameDir(clean));
+        } catch (const InputError&) {
+          // An unreadable frame: the comparison below reports it as an error.
+        }
+        for (const MutationFault* f : faults_) {
+          Planned p{i, b, f, ok(clean) ? faultSetting(*f, facts, scene_options_.seed, i) : ""};
+          if (!p.setting.empty() && ok(sceneDir(i) / "ref")) {
+            Job job = renderJob(scenes_[i].file, b, backendDir(i, b) / f->name);
+            job.env = folder_.childEnv();
+            job.env.push_back(std::string(gl::testing::kFaultVariable) + "=" + p.setting);
+            faulted.push_back(std::move(job));
+          }
+          planned.push_back(std::move(p));
+        }
+      }
+    }
+    if (!runStage(faulted, first, last, "faulted renders")) return;
+
+    // The three comparisons of each (scene, backend, fault).
+    std::vector<MutationResult> results;
+    std::map<std::pair<std::uint64_t, std::string>, std::optional<Frame>> clean_frames;
+    std::map<std::uint64_t, std::optional<Frame>> refs;
+    std::map<std::pair<std::uint64_t, std::string>, std::set<std::string>> controls;
+    // A frame that is missing or cannot be read is nullopt: its rows are errors.
+    auto readIf = [&](const fs::path& dir) -> std::optional<Frame> {
+      if (!ok(dir)) return std::nullopt;
+      try {
+        return readFrameDir(dir);
+      } catch (const InputError&) {
+        return std::nullopt;
+      }
+    };
+    auto failure = [&](const fs::path& dir, const std::string& what) {
+      fs::path log = dir;
+      log += ".log";
+      return fmt::format("{} did not render: {}", what, lastLogLine(log));
+    };
+    for (const Planned& p : planned) {
+      MutationResult r;
+      r.fixture = scenes_[p.scene].name;
+      r.fixture_file = scenes_[p.scene].file.string();
+      r.backend = p.backend;
+      r.fault = p.fault->name;
+      r.setting = p.setting;
+      const Scene& scene = loaded.at(p.scene);
+      if (!refs.contains(p.scene)) refs[p.scene] = readIf(sceneDir(p.scene) / "ref");
+      const auto key = std::make_pair(p.scene, p.backend);
+      if (!clean_frames.contains(key))
+        clean_frames[key] = readIf(backendDir(p.scene, p.backend) / "clean");
+      const std::optional<Frame>& ref = refs[p.scene];
+      const std::optional<Frame>& clean = clean_frames[key];
+      try {
+        if (!ref) {
+          r.verdict = MutationVerdict::Error;
+          r.note = failure(sceneDir(p.scene) / "ref", "the reference");
+        } else if (!clean) {
+          r.verdict = MutationVerdict::Error;
+          r.note = failure(backendDir(p.scene, p.backend) / "clean", p.backend);
+        } else if (p.setting.empty()) {
+          r.verdict = MutationVerdict::NotApplicable;
+        } else {
+          const fs::path faulted_dir = backendDir(p.scene, p.backend) / p.fault->name;
+          const std::optional<Frame> bad = readIf(faulted_dir);
+          if (!bad) {
+            r.verdict = MutationVerdict::Error;
+            r.note = failure(faulted_dir, p.backend + " with " + p.setting);
+          } else {
+            if (!controls.contains(key))
+              controls[key] = failingClasses(compareFrames(
+                  *ref, *clean, *ref, pairTolerances(*ref, *clean, scene.tolerance, cli_)));
+            r.control_fails = controls[key];
+            r.effect_fails = failingClasses(compareFrames(
+                *clean, *bad, *ref, pairTolerances(*clean, *bad, scene.tolerance, cli_)));
+            PairResult detected =
+                compareFrames(*ref, *bad, *ref, pairTolerances(*ref, *bad, scene.tolerance, cli_));
+            r.detected_fails = failingClasses(detected);
+            r.verdict =
+                judgeMutation(p.fault->cls, r.control_fails, r.effect_fails, r.detected_fails);
+            if (r.verdict == MutationVerdict::Missed) {
+              detected.fixture = r.fixture;
+              detected.expected = "ref";
+              detected.actual = p.backend + " with " + p.setting;
+              r.note = describe(detected);
+            }
+          }
+        }
+      } catch (const InputError& e) {
+        r.verdict = MutationVerdict::Error;
+        r.note = e.what();
+      }
+      results.push_back(std::move(r));
+    }
+    json doc = json::array();
+    for (const MutationResult& r : results) doc.push_back(toJson(r));
+    writeFileAtomically(resultsDir() / fmt::format("{:05}-{:05}.json", first, last),
+                        doc.dump(1) + "\n");
+    fs::remove_all(work, ec);
+    results_.insert(results_.end(), results.begin(), results.end());
+    finished_.emplace_back(first, last);
+    measured_scenes_ += last - first + 1;
+    measured_seconds_ += std::chrono::duration<double>(Clock::now() - start).count();
+  }
+
+  int writeReport() {
+    const MutationTallies tallies = tallyMutations(results_);
+    const bool complete = scenesDone() == scenes_.size();
+    json options = identity();
+    options["count"] = scenes_.size();
+    AtomicFileSet files;
+    files.stageText(
+        folder_.dir() / "mutations.md",
+        mutationMarkdown(tallies, args_.command_line, scenesDone(), scenes_.size(), complete));
+    files.stageText(folder_.dir() / "mutations.json",
+                    mutationJson(tallies, results_, args_.command_line, options, scenesDone(),
+                                 scenes_.size(), complete)
+                            .dump(1) +
+                        "\n");
+    files.commit();
+    bool missed = false, errors = false;
+    for (const auto& [backend, faults] : tallies) {
+      for (const MutationFault* f : faults_) {
+        const auto it = faults.find(f->name);
+        if (it == faults.end()) continue;
+        const MutationTally& t = it->second;
+        const auto n = [&](MutationVerdict v) {
+          const auto k = t.verdicts.find(v);
+          return k == t.verdicts.end() ? std::uint64_t{0} : k->second;
+        };
+        missed = missed || n(MutationVerdict::Missed) > 0;
+        errors = errors || n(MutationVerdict::Error) > 0;
+        std::cout << fmt::format(
+            "{} {}: caught {} of {} scenes where it changes a pixel beyond its allowance in "
+            "{} ({:.1f} %); {} not applicable, {} no effect, {} control fails, {} errors\n",
+            backend, f->name, n(MutationVerdict::Caught), t.counted(), f->cls,
+            100.0 * t.caughtFraction(), n(MutationVerdict::NotApplicable),
+            n(MutationVerdict::NoEffect), n(MutationVerdict::ControlFails),
+            n(MutationVerdict::Error));
+      }
+    }
+    std::cout << fmt::format("{} of {} scenes{}\n", scenesDone(), scenes_.size(),
+                             complete ? "" : " (incomplete)");
+    std::cout << "report: " << (folder_.dir() / "mutations.md").string() << '\n';
+    const int code = errors ? kExitBackend : missed ? kExitFail : kExitPass;
+    std::cout << (code == kExitBackend ? "ERROR" : code == kExitFail ? "FAILURE" : "PASS") << '\n';
+    return code;
+  }
+
+  const CampaignArgs& args_;
+  std::vector<const MutationFault*> faults_;
+  const RandomSceneOptions scene_options_;
+  const int jobs_;
+  CommandLineTolerances cli_;
+  InterruptGuard interrupt_;
+  CampaignFolder folder_;
+  StatusLine status_;
+  std::vector<CampaignScene> scenes_;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> finished_;
+  std::vector<MutationResult> results_;
+  std::uint64_t measured_scenes_ = 0;
+  double measured_seconds_ = 0.0;
+};
+
+}  // namespace
+
+int mutationCampaign(const CampaignArgs& args) {
+  if (args.backends.empty()) throw InputError("campaign: --backends needs at least one SPEC");
+  for (const std::string& b : args.backends) {
+    if (parseBackendSpec(b).kind != BackendSpec::Kind::Gl)
+      throw InputError(fmt::format(
+          "--backends {}: the mutation study injects GL faults; name GL backends only", b));
+  }
+  if (args.against != "ref")
+    throw InputError("--against: the mutation study compares with the reference (ref) only");
+  CommandLineTolerances cli;
+  parseToleranceArgs(args.tolerance, cli);
+  if (args.batch < 1) throw InputError(fmt::format("--batch: must be >= 1, got {}", args.batch));
+  std::vector<const MutationFault*> faults;
+  if (args.faults.empty()) {
+    for (const MutationFault& f : mutationFaults()) faults.push_back(&f);
+  } else {
+    for (const std::string& name : args.faults) {
+      const MutationFault* f = &mutationFault(name);
+      if (std::find(faults.begin(), faults.end(), f) == faults.end()) faults.push_back(f);
+    }
+  }
+  MutationStudy study(args, std::move(faults));
+  return study.run();
+}
+
+}  // namespace rc

@@ -1,0 +1,34 @@
+// rastercheck as users start it: answers `--version` before any heavy library is loaded,
+// and hands every other command to rastercheck-core beside it (execv, same arguments).
+// rastercheck-core links OpenImageIO and Assimp, whose ~260 shared libraries take
+// ~0.1 s to load and relocate at every process start (docs/performance.md); this program
+// links only the C and C++ runtimes. It must stay that way: no project library here.
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "app/version.h"
+
+int main(int argc, char** argv) {
+  if (argc == 2 && std::strcmp(argv[1], "--version") == 0) {
+    std::printf("rastercheck %s\n", rc::kVersion);
+    return 0;
+  }
+  // The core lives beside the launcher, wherever both were built or installed.
+  char self[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
+  std::string core = "rastercheck-core";
+  if (n > 0) {
+    std::string dir(self, static_cast<std::size_t>(n));
+    dir.resize(dir.rfind('/') + 1);
+    core = dir + core;
+  }
+  ::execv(core.c_str(), argv);
+  std::fprintf(stderr, "rastercheck: internal error: cannot start %s: %s\n", core.c_str(),
+               std::strerror(errno));
+  return 3;  // kExitBackend: the tool itself could not run
+}

@@ -1,0 +1,86 @@
+// See worker.h: the worker's request loop.
+#include "app/worker.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "app/backends.h"
+#include "app/commands.h"
+#include "fixtures/errors.h"
+#include "fixtures/frame_stream.h"
+#include "fixtures/loader.h"
+
+namespace rc::worker {
+namespace {
+
+bool writeAll(int fd, const char* data, std::size_t size) {
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    data += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+bool reply(ReplyKind kind, std::uint64_t id, const std::string& payload) {
+  ReplyHeader h{};
+  std::memcpy(h.tag, kReplyTag, sizeof h.tag);
+  h.kind = kind;
+  h.id = id;
+  h.length = payload.size();
+  return writeAll(kReplyFd, reinterpret_cast<const char*>(&h), sizeof h) &&
+         writeAll(kReplyFd, payload.data(), payload.size());
+}
+
+}  // namespace
+
+}  // namespace rc::worker
+
+namespace rc {
+
+// Serves requests until stdin ends: exit 0, or 3 when the reply pipe broke. A fixture or
+// render that fails is a reply, not an exit.
+int workerCommand(const std::string& spec) {
+  using namespace worker;
+  const BackendSpec backend = parseBackendSpec(spec);
+  std::string line;
+  while (std::getline(std::cin, line)) {
+    const nlohmann::json request = nlohmann::json::parse(line, nullptr, false);
+    if (request.is_discarded() || !request.contains("id") || !request.contains("fixture")) {
+      std::cerr << "rastercheck worker: malformed request: " << line << '\n';
+      return kExitInput;
+    }
+    const auto id = request["id"].get<std::uint64_t>();
+    ReplyKind kind = ReplyKind::Frame;
+    std::string payload;
+    try {
+      const Scene scene = loadScene(request["fixture"].get<std::string>());
+      payload = encodeFrame(renderWith(backend, scene));
+    } catch (const InputError& e) {
+      kind = ReplyKind::InputError;
+      payload = e.what();
+    } catch (const BackendError& e) {
+      kind = ReplyKind::BackendError;
+      payload = e.what();
+    } catch (const std::exception& e) {
+      kind = ReplyKind::BackendError;
+      payload = std::string("internal error: ") + e.what();
+    }
+    std::fflush(nullptr);  // the log shows what this render printed before its reply
+    if (!reply(kind, id, payload)) return kExitBackend;
+  }
+  return kExitPass;
+}
+
+}  // namespace rc

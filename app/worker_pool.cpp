@@ -1,0 +1,348 @@
+// See worker_pool.h: posix_spawn, pipes and one poll() loop in the calling thread.
+#include "app/worker_pool.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "app/backends.h"
+#include "app/paths.h"
+#include "app/subprocess.h"
+#include "app/worker.h"
+#include "fixtures/catalog.h"
+#include "fixtures/errors.h"
+#include "fixtures/frame_stream.h"
+
+namespace rc {
+namespace fs = std::filesystem;
+namespace {
+
+// What a log slice may contribute: a driver printing megabytes must not fill memory.
+constexpr std::uintmax_t kMaxLogBytes = std::uintmax_t{64} * 1024;
+
+void closeFd(int& fd) {
+  if (fd >= 0) ::close(fd);
+  fd = -1;
+}
+
+std::string howItEnded(int status) {
+  if (WIFSIGNALED(status)) {
+    const char* name = sigdescr_np(WTERMSIG(status));
+    return fmt::format("crashed ({})", name ? name : fmt::format("signal {}", WTERMSIG(status)));
+  }
+  if (WIFEXITED(status)) return fmt::format("exited with code {}", WEXITSTATUS(status));
+  return "ended";
+}
+
+std::string formatSeconds(double s) { return fmt::format("{:g} s", s); }
+
+}  // namespace
+
+std::string lastErrorLine(const std::string& output) {
+  std::string last;
+  std::size_t start = 0;
+  while (start < output.size()) {
+    std::size_t end = output.find('\n', start);
+    if (end == std::string::npos) end = output.size();
+    if (end > start) last = output.substr(start, end - start);
+    start = end + 1;
+  }
+  for (const char* prefix :
+       {"rastercheck: backend error: ", "rastercheck: error: ", "rastercheck: internal error: "}) {
+    if (last.rfind(prefix, 0) == 0) last = last.substr(std::string(prefix).size());
+  }
+  return last;
+}
+
+WorkerPool::WorkerPool(Options options) : options_(std::move(options)) {
+  options_.max_busy = std::max(1, options_.max_busy);
+  // A worker that died leaves a broken request pipe: writing to it must fail, not kill us.
+  std::signal(SIGPIPE, SIG_IGN);
+  std::error_code ec;
+  fs::create_directories(options_.log_dir, ec);
+  if (ec)
+    throw InputError(fmt::format("{}: cannot create: {}", options_.log_dir.string(), ec.message()));
+}
+
+WorkerPool::~WorkerPool() {
+  for (auto& w : workers_) {
+    if (w->busy) ::kill(w->pid, SIGKILL);
+    closeFd(w->request_fd);  // an idle worker reads end-of-file and exits
+  }
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  for (auto& w : workers_) {
+    int status = 0;
+    while (::waitpid(w->pid, &status, WNOHANG) == 0) {
+      if (Clock::now() > deadline) {
+        ::kill(w->pid, SIGKILL);
+        ::waitpid(w->pid, &status, 0);
+        break;
+      }
+      ::usleep(1000);
+    }
+    closeFd(w->reply_fd);
+  }
+}
+
+std::size_t WorkerPool::submit(RenderRequest request) {
+  queue_.push_back({next_ticket_, std::move(request)});
+  return next_ticket_++;
+}
+
+WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
+  int request[2];
+  int reply[2];
+  if (::pipe2(request, O_CLOEXEC) != 0) return nullptr;
+  if (::pipe2(reply, O_CLOEXEC) != 0) {
+    ::close(request[0]);
+    ::close(request[1]);
+    return nullptr;
+  }
+  // Frames are large; a bigger pipe means fewer wake-ups (best effort).
+  ::fcntl(reply[0], F_SETPIPE_SZ, 1 << 20);
+  auto w = std::make_unique<Worker>();
+  w->spec = spec;
+  w->log = options_.log_dir / fmt::format("{}-{}.log", fixtureSlug(spec), started_);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, request[0], STDIN_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, reply[1], worker::kReplyFd);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, w->log.c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  const std::string exe = selfExecutable().string();
+  std::vector<std::string> args = {exe, "worker", "--backend", spec};
+  std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  // A spec naming another Mesa's folder needs LD_LIBRARY_PATH from the worker's start (the
+  // dynamic loader reads it once), as `render` re-executes itself with it.
+  std::vector<std::string> extra;
+  const BackendSpec backend = parseBackendSpec(spec);
+  if (backend.kind == BackendSpec::Kind::Gl)
+    for (const auto& [name, value] : startupEnvironment(backend.gl))
+      extra.push_back(name + "=" + value);
+  std::vector<std::string> env_text = childEnvironment(extra);
+  std::vector<char*> envp;
+  envp.reserve(env_text.size() + 1);
+  for (std::string& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int err = posix_spawn(&w->pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(request[0]);
+  ::close(reply[1]);
+  if (err != 0) {
+    ::close(request[1]);
+    ::close(reply[0]);
+    throw BackendError(fmt::format("cannot start {}: {}", exe, std::strerror(err)));
+  }
+  w->request_fd = request[1];
+  w->reply_fd = reply[0];
+  ::fcntl(w->reply_fd, F_SETFL, ::fcntl(w->reply_fd, F_GETFL) | O_NONBLOCK);
+  ++started_;
+  workers_.push_back(std::move(w));
+  return workers_.back().get();
+}
+
+bool WorkerPool::send(Worker& w, const Task& task) {
+  const std::string line =
+      nlohmann::json{{"id", task.ticket}, {"fixture", task.request.fixture.string()}}.dump(
+          -1, ' ', false, nlohmann::json::error_handler_t::replace) +
+      "\n";
+  std::error_code ec;
+  w.log_start = fs::file_size(w.log, ec);
+  if (ec) w.log_start = 0;
+  const char* p = line.data();
+  std::size_t left = line.size();
+  while (left > 0) {
+    const ssize_t n = ::write(w.request_fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;  // the worker is gone
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  w.busy = true;
+  w.ticket = task.ticket;
+  w.started = Clock::now();
+  w.reply.clear();
+  w.filled = 0;
+  ++busy_;
+  return true;
+}
+
+void WorkerPool::dispatch() {
+  while (!queue_.empty() && busy_ < static_cast<std::size_t>(options_.max_busy)) {
+    const Task task = queue_.front();
+    queue_.pop_front();
+    Worker* idle = nullptr;
+    for (auto& w : workers_)
+      if (!w->busy && w->spec == task.request.spec) idle = w.get();
+    if (idle != nullptr && send(*idle, task)) continue;
+    if (idle != nullptr) {
+      // It died while idle (nothing lost): reap it and start another.
+      std::vector<std::pair<std::size_t, RenderOutcome>> none;
+      retire(*idle, "", none, true);
+    }
+    Worker* fresh = startWorker(task.request.spec);
+    if (fresh == nullptr || !send(*fresh, task))
+      throw BackendError(
+          fmt::format("cannot start a worker for {}: {}", task.request.spec, std::strerror(errno)));
+  }
+}
+
+std::string WorkerPool::logSince(const Worker& w) const {
+  std::error_code ec;
+  const std::uintmax_t end = fs::file_size(w.log, ec);
+  if (ec || end <= w.log_start) return {};
+  const std::uintmax_t start = std::max(w.log_start, end - std::min(end, kMaxLogBytes));
+  std::ifstream in(w.log, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(start));
+  std::string text(end - start, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  return text;
+}
+
+void WorkerPool::retire(Worker& w, const std::string& why,
+                        std::vector<std::pair<std::size_t, RenderOutcome>>& done, bool kill) {
+  if (kill) ::kill(w.pid, SIGKILL);
+  int status = 0;
+  while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (w.busy) {
+    RenderOutcome out;
+    out.log = logSince(w);
+    const std::string last = lastErrorLine(out.log);
+    out.error = why.empty() ? howItEnded(status) + (last.empty() ? "" : ": " + last) : why;
+    done.emplace_back(w.ticket, std::move(out));
+    --busy_;
+  }
+  closeFd(w.request_fd);
+  closeFd(w.reply_fd);
+  w.pid = -1;
+  std::erase_if(workers_, [&](const std::unique_ptr<Worker>& p) { return p.get() == &w; });
+}
+
+void WorkerPool::readReply(Worker& w, std::vector<std::pair<std::size_t, RenderOutcome>>& done) {
+  constexpr std::size_t kHeader = sizeof(worker::ReplyHeader);
+  constexpr std::uint64_t kMaxPayload = std::uint64_t{1} << 36;
+  for (;;) {
+    // The header first, then exactly the payload it announces.
+    std::size_t want = kHeader;
+    if (w.filled >= kHeader) {
+      worker::ReplyHeader h{};
+      std::memcpy(&h, w.reply.data(), kHeader);
+      if (std::memcmp(h.tag, worker::kReplyTag, sizeof h.tag) != 0 || !w.busy || h.id != w.ticket ||
+          h.length > kMaxPayload) {
+        retire(w, "sent a malformed reply", done, true);
+        return;
+      }
+      want = kHeader + h.length;
+      if (w.filled == want) {
+        RenderOutcome out;
+        const std::string_view payload(w.reply.data() + kHeader, h.length);
+        out.log = logSince(w);
+        if (h.kind == worker::ReplyKind::Frame) {
+          try {
+            out.frame = decodeFrame(payload);
+            out.ok = true;
+          } catch (const InputError& e) {
+            out.error = e.what();
+          }
+        } else {
+          out.error = std::string(payload);
+          out.input_error = h.kind == worker::ReplyKind::InputError;
+        }
+        done.emplace_back(w.ticket, std::move(out));
+        w.busy = false;
+        --busy_;
+        std::string().swap(w.reply);
+        w.filled = 0;
+        return;
+      }
+    }
+    if (w.reply.size() < want) w.reply.resize(want);
+    const ssize_t n = ::read(w.reply_fd, w.reply.data() + w.filled, want - w.filled);
+    if (n > 0) {
+      w.filled += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) return;
+    retire(w, "", done, false);  // end of file: the worker ended
+    return;
+  }
+}
+
+std::vector<std::pair<std::size_t, RenderOutcome>> WorkerPool::poll(int wait_ms, bool start_more) {
+  std::vector<std::pair<std::size_t, RenderOutcome>> done;
+  if (start_more) dispatch();
+  // Sleep at most until the first watchdog deadline.
+  auto now = Clock::now();
+  int timeout = wait_ms;
+  const auto limit = std::chrono::duration<double>(options_.timeout_seconds);
+  if (options_.timeout_seconds > 0.0) {
+    for (const auto& w : workers_) {
+      if (!w->busy) continue;
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          w->started + std::chrono::duration_cast<Clock::duration>(limit) - now);
+      timeout = std::max(0, std::min(timeout, static_cast<int>(left.count()) + 1));
+    }
+  }
+  std::vector<pollfd> fds;
+  std::vector<Worker*> owners;
+  for (const auto& w : workers_) {
+    fds.push_back({w->reply_fd, POLLIN, 0});
+    owners.push_back(w.get());
+  }
+  if (::poll(fds.data(), fds.size(), timeout) < 0 && errno != EINTR)
+    throw BackendError(fmt::format("poll failed: {}", std::strerror(errno)));
+  for (std::size_t i = 0; i < fds.size(); ++i)
+    if (fds[i].revents != 0) readReply(*owners[i], done);  // may retire that worker
+  // The watchdog: a render past its time loses its worker.
+  if (options_.timeout_seconds > 0.0) {
+    now = Clock::now();
+    std::vector<Worker*> late;
+    for (const auto& w : workers_)
+      if (w->busy && now - w->started >= limit) late.push_back(w.get());
+    for (Worker* w : late)
+      retire(*w,
+             fmt::format("timed out after {} (the --timeout watchdog killed its worker)",
+                         formatSeconds(options_.timeout_seconds)),
+             done, true);
+  }
+  if (start_more) dispatch();
+  return done;
+}
+
+std::vector<RenderOutcome> WorkerPool::renderAll(const std::vector<RenderRequest>& requests) {
+  std::vector<std::size_t> tickets;
+  tickets.reserve(requests.size());
+  for (const RenderRequest& r : requests) tickets.push_back(submit(r));
+  std::vector<RenderOutcome> out(requests.size());
+  std::size_t left = requests.size();
+  while (left > 0) {
+    for (auto& [ticket, outcome] : poll(1000)) {
+      const auto it = std::find(tickets.begin(), tickets.end(), ticket);
+      if (it == tickets.end()) continue;
+      out[static_cast<std::size_t>(it - tickets.begin())] = std::move(outcome);
+      --left;
+    }
+  }
+  return out;
+}
+
+}  // namespace rc

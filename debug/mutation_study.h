@@ -1,0 +1,109 @@
+// The mutation study (`rastercheck campaign --mutations`, docs/campaigns.md): test-only GL
+// faults (gl_backend/gl_testing.h) injected into random scenes, and per fault the fraction
+// caught in the fault's class among the scenes where the fault changes some pixel beyond
+// its allowance. This file holds the faults, how each is set for one scene, the verdict of
+// one (scene, fault) from three comparisons, the tallies and the report; rendering and
+// comparing is the caller's.
+//
+// Definitions, per scene, backend and fault (frames: REF the reference, CLEAN the driver
+// without fault, FAULTED the driver with it; "fails in C" = that class's verdict is fail):
+//   control  = compare(REF, CLEAN)                      (what the harness sees without fault)
+//   effect   = compare(CLEAN, FAULTED, uncertainty REF) (what the fault did to the driver)
+//   detected = compare(REF, FAULTED)                    (what the harness sees with it)
+// The fault changes some pixel beyond its allowance when `effect` fails in the fault's
+// class; the scene counts for that fault only then, and only when `control` does not fail
+// in that class (else a failure would prove nothing). It is caught when `detected` fails
+// in the fault's class.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <set>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace rc {
+
+struct MutationFault {
+  const char* name;  // the RASTERCHECK_GL_FAULT name
+  const char* cls;   // the class it must be caught in
+  const char* what;  // for people
+};
+
+// light_scale (shading), depth_bias (depth), drop_primitive and move_vertex (visibility),
+// texel_offset and blend_factor (shading).
+std::span<const MutationFault> mutationFaults();
+// Throws InputError naming the valid names.
+const MutationFault& mutationFault(const std::string& name);
+
+// What the scene offers a fault, read from its clean driver frame and its fixture.
+struct MutationScene {
+  std::vector<std::uint32_t> visible_ids;  // primitive ids the clean frame shows, ascending
+  std::string depth_format = "d24";        // d16, d24 or d32f
+  bool textured = false;                   // some drawn material has a texture
+  bool blended = false;                    // blend alpha with a material of opacity < 1
+};
+
+// The RASTERCHECK_GL_FAULT value of `fault` for scene `index` of `seed`, e.g.
+// "drop_primitive=17"; empty when the fault cannot change the scene (no texture, no
+// blending, nothing visible). A primitive is drawn from the visible ones by a hash of
+// (seed, index, fault), the same on every run. depth_bias is 4 x the format's default
+// depth fail threshold (8 d16 steps, 64 d24 or d32f steps); light_scale is 1.01 (1 %
+// brighter); texel_offset is 1 texel; blend_factor is `one` (GL_ONE for GL_SRC_ALPHA).
+std::string faultSetting(const MutationFault& fault, const MutationScene& scene, std::uint64_t seed,
+                         std::uint64_t index);
+
+enum class MutationVerdict {
+  NotApplicable,  // faultSetting gave nothing
+  ControlFails,   // the clean driver already fails in the class: not counted
+  NoEffect,       // the fault changed nothing beyond the allowance in its class: not counted
+  Caught,
+  Missed,
+  Error,  // a render or comparison could not be done
+};
+const char* toString(MutationVerdict v);
+MutationVerdict mutationVerdictFromString(const std::string& text);  // throws InputError
+
+// The verdict from the classes each comparison fails in.
+MutationVerdict judgeMutation(const std::string& cls, const std::set<std::string>& control_fails,
+                              const std::set<std::string>& effect_fails,
+                              const std::set<std::string>& detected_fails);
+
+// One (scene, backend, fault).
+struct MutationResult {
+  std::string fixture;
+  std::string fixture_file;
+  std::string backend;
+  std::string fault;
+  std::string setting;  // RASTERCHECK_GL_FAULT value (empty: not applicable)
+  MutationVerdict verdict = MutationVerdict::NotApplicable;
+  std::set<std::string> control_fails;
+  std::set<std::string> effect_fails;
+  std::set<std::string> detected_fails;
+  std::string note;  // the error, or the detected comparison's description
+};
+nlohmann::json toJson(const MutationResult& r);
+MutationResult mutationResultFromJson(const nlohmann::json& j, const std::string& source);
+
+struct MutationTally {
+  std::uint64_t scenes = 0;
+  std::map<MutationVerdict, std::uint64_t> verdicts;
+  std::vector<const MutationResult*> missed;
+  std::uint64_t counted() const;  // caught + missed
+  double caughtFraction() const;  // caught / counted (1 when none counted)
+};
+// Per backend, per fault (in mutationFaults() order).
+using MutationTallies = std::map<std::string, std::map<std::string, MutationTally>>;
+MutationTallies tallyMutations(const std::vector<MutationResult>& results);
+
+// mutations.md and mutations.json of a study (`command` and `options` as the campaign's).
+std::string mutationMarkdown(const MutationTallies& tallies, const std::string& command,
+                             std::uint64_t scenes_run, std::uint64_t scenes_total, bool complete);
+nlohmann::json mutationJson(const MutationTallies& tallies, const std::vector<MutationResult>& all,
+                            const std::string& command, const nlohmann::json& options,
+                            std::uint64_t scenes_run, std::uint64_t scenes_total, bool complete);
+
+}  // namespace rc

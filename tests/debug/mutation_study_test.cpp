@@ -1,0 +1,119 @@
+// debug/mutation_study.h: how each fault is set for a scene, the verdict of one (scene,
+// fault) from its three comparisons, and the tallies (no rendering).
+#include "debug/mutation_study.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "fixtures/errors.h"
+
+namespace rc {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(MutationStudy, TheFaultsAndTheirClasses) {
+  std::vector<std::pair<std::string, std::string>> got;
+  for (const MutationFault& f : mutationFaults()) got.emplace_back(f.name, f.cls);
+  EXPECT_EQ(got, (std::vector<std::pair<std::string, std::string>>{{"light_scale", "shading"},
+                                                                   {"depth_bias", "depth"},
+                                                                   {"drop_primitive", "visibility"},
+                                                                   {"move_vertex", "visibility"},
+                                                                   {"texel_offset", "shading"},
+                                                                   {"blend_factor", "shading"}}));
+  EXPECT_EQ(std::string(mutationFault("depth_bias").cls), "depth");
+  EXPECT_THROW(mutationFault("shift_x"), InputError);
+}
+
+TEST(MutationStudy, SettingsFollowWhatTheSceneOffers) {
+  MutationScene scene;
+  scene.visible_ids = {3, 9, 12};
+  EXPECT_EQ(faultSetting(mutationFault("light_scale"), scene, 1, 0), "light_scale=1.01");
+  EXPECT_EQ(faultSetting(mutationFault("depth_bias"), scene, 1, 0), "depth_bias=64");
+  scene.depth_format = "d16";
+  EXPECT_EQ(faultSetting(mutationFault("depth_bias"), scene, 1, 0), "depth_bias=8");
+  EXPECT_EQ(faultSetting(mutationFault("texel_offset"), scene, 1, 0), "") << "no texture";
+  EXPECT_EQ(faultSetting(mutationFault("blend_factor"), scene, 1, 0), "") << "no blending";
+  scene.textured = scene.blended = true;
+  EXPECT_EQ(faultSetting(mutationFault("texel_offset"), scene, 1, 0), "texel_offset=1");
+  EXPECT_EQ(faultSetting(mutationFault("blend_factor"), scene, 1, 0), "blend_factor=one");
+}
+
+TEST(MutationStudy, PrimitivesAreDrawnFromTheVisibleOnesReproducibly) {
+  MutationScene scene;
+  scene.visible_ids = {3, 9, 12, 40, 41};
+  std::set<std::string> seen;
+  for (std::uint64_t index = 0; index < 64; ++index) {
+    const std::string s = faultSetting(mutationFault("drop_primitive"), scene, 5, index);
+    EXPECT_EQ(s, faultSetting(mutationFault("drop_primitive"), scene, 5, index));
+    seen.insert(s);
+  }
+  EXPECT_EQ(seen,
+            (std::set<std::string>{"drop_primitive=3", "drop_primitive=9", "drop_primitive=12",
+                                   "drop_primitive=40", "drop_primitive=41"}))
+      << "every visible primitive is drawn sometimes, never another";
+  EXPECT_THAT(faultSetting(mutationFault("move_vertex"), scene, 5, 0), HasSubstr("move_vertex="));
+  scene.visible_ids.clear();
+  EXPECT_EQ(faultSetting(mutationFault("drop_primitive"), scene, 5, 0), "") << "nothing drawn";
+}
+
+TEST(MutationStudy, VerdictsFromTheThreeComparisons) {
+  using V = MutationVerdict;
+  const std::set<std::string> none, depth{"depth"}, both{"depth", "visibility"};
+  EXPECT_EQ(judgeMutation("depth", depth, depth, depth), V::ControlFails);
+  EXPECT_EQ(judgeMutation("depth", none, none, depth), V::NoEffect);
+  EXPECT_EQ(judgeMutation("depth", none, {"visibility"}, both), V::NoEffect)
+      << "an effect in another class only does not count";
+  EXPECT_EQ(judgeMutation("depth", none, both, both), V::Caught);
+  EXPECT_EQ(judgeMutation("depth", none, depth, {"visibility"}), V::Missed)
+      << "caught only in another class is missed";
+  EXPECT_EQ(judgeMutation("depth", {"shading"}, depth, depth), V::Caught)
+      << "a control failure elsewhere does not matter";
+}
+
+TEST(MutationStudy, TalliesCountOnlyScenesWithAnEffect) {
+  auto result = [](const char* fault, MutationVerdict v) {
+    MutationResult r;
+    r.fixture = "random/s1/00001";
+    r.fixture_file = "/s/s1-00001.json";
+    r.backend = "gl:egl:llvmpipe";
+    r.fault = fault;
+    r.setting = std::string(fault) + "=1";
+    r.verdict = v;
+    r.effect_fails = {"depth"};
+    r.note = "FAIL ...";
+    return r;
+  };
+  const std::vector<MutationResult> results = {
+      result("depth_bias", MutationVerdict::Caught),
+      result("depth_bias", MutationVerdict::Caught),
+      result("depth_bias", MutationVerdict::Missed),
+      result("depth_bias", MutationVerdict::NoEffect),
+      result("depth_bias", MutationVerdict::ControlFails),
+      result("texel_offset", MutationVerdict::NotApplicable),
+  };
+  const MutationTallies t = tallyMutations(results);
+  const MutationTally& depth = t.at("gl:egl:llvmpipe").at("depth_bias");
+  EXPECT_EQ(depth.scenes, 5u);
+  EXPECT_EQ(depth.counted(), 3u);
+  EXPECT_DOUBLE_EQ(depth.caughtFraction(), 2.0 / 3.0);
+  ASSERT_EQ(depth.missed.size(), 1u);
+  EXPECT_EQ(t.at("gl:egl:llvmpipe").at("texel_offset").counted(), 0u);
+  EXPECT_DOUBLE_EQ(t.at("gl:egl:llvmpipe").at("texel_offset").caughtFraction(), 1.0);
+
+  const std::string md = mutationMarkdown(t, "rastercheck campaign --mutations", 5, 5, true);
+  EXPECT_THAT(md, HasSubstr("| `depth_bias` ("));
+  EXPECT_THAT(md, HasSubstr("| depth | 5 | 0 | 1 | 1 | 3 | 2 | 1 | 0 | 66.7 % |"));
+  EXPECT_THAT(md, HasSubstr("- `random/s1/00001` with `depth_bias=1`"));
+  const nlohmann::json j = mutationJson(t, results, "cmd", {}, 5, 5, true);
+  EXPECT_EQ(j["backends"]["gl:egl:llvmpipe"]["depth_bias"]["counted"], 3);
+  EXPECT_EQ(j["backends"]["gl:egl:llvmpipe"]["depth_bias"]["verdicts"]["missed"], 1);
+  EXPECT_EQ(mutationResultFromJson(j["results"][2], "x").verdict, MutationVerdict::Missed);
+  EXPECT_EQ(toJson(mutationResultFromJson(j["results"][0], "x")), j["results"][0]);
+  nlohmann::json bad = j["results"][0];
+  bad["verdict"] = "perhaps";
+  EXPECT_THROW(mutationResultFromJson(bad, "x"), InputError);
+}
+
+}  // namespace
+}  // namespace rc

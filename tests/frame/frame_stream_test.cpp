@@ -1,0 +1,71 @@
+// Frames through the worker pipe format (fixtures/frame_stream.h): every buffer and the
+// meta come back bit for bit, with and without the reference's channels, and damaged
+// bytes are refused with an InputError instead of a wrong frame.
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "fixtures/errors.h"
+#include "fixtures/frame_stream.h"
+
+namespace rc {
+namespace {
+
+Frame sample(bool uncertainty) {
+  Frame f;
+  const float clear[4] = {0.1f, 0.2f, 0.3f, 1.0f};
+  f.allocate(7, 5, clear, 1.0f, uncertainty);
+  for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+    f.color[i * 4] = static_cast<float>(i) / 3.0f;
+    f.depth[i] = static_cast<float>(i) * 1e-3f;
+    f.id[i] = static_cast<std::uint32_t>(i * 7919u);
+    if (uncertainty) {
+      // A different value in every channel, so that a swapped or dropped one shows.
+      const auto channels = f.uncertainty();
+      for (int c = 0; c < kUncertaintyChannels; ++c)
+        (*channels[c])[i] = static_cast<float>(i % 3) / 4.0f + static_cast<float>(c);
+      f.depth_gap[i] = i == 3 ? std::numeric_limits<float>::infinity() : static_cast<float>(i);
+    }
+  }
+  f.color[5] = std::numeric_limits<float>::quiet_NaN();
+  f.meta = {{"backend", "gl:egl:llvmpipe"}, {"fixture", "a/b"}, {"time_ms", 1.25}};
+  return f;
+}
+
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+TEST(FrameStream, RoundTripsEveryBufferBitForBit) {
+  for (const bool uncertainty : {false, true}) {
+    const Frame in = sample(uncertainty);
+    const Frame out = decodeFrame(encodeFrame(in));
+    EXPECT_EQ(out.width, in.width);
+    EXPECT_EQ(out.height, in.height);
+    EXPECT_TRUE(sameBits(out.color, in.color));
+    EXPECT_TRUE(sameBits(out.depth, in.depth));
+    EXPECT_EQ(out.id, in.id);
+    for (int c = 0; c < kUncertaintyChannels; ++c)
+      EXPECT_TRUE(sameBits(*out.uncertainty()[c], *in.uncertainty()[c]))
+          << kUncertaintyChannelInfo[c].name;
+    EXPECT_EQ(out.hasUncertainty(), uncertainty);
+    EXPECT_EQ(out.meta, in.meta);
+  }
+}
+
+TEST(FrameStream, DamagedBytesAreRefused) {
+  const std::string good = encodeFrame(sample(true));
+  EXPECT_THROW(decodeFrame(good.substr(0, good.size() - 1)), InputError);
+  EXPECT_THROW(decodeFrame(good + "x"), InputError);
+  EXPECT_THROW(decodeFrame("RCF1" + good.substr(4)), InputError);  // the older layout
+  EXPECT_THROW(decodeFrame(""), InputError);
+  std::string huge = good;
+  const std::uint32_t big = 1u << 20;
+  std::memcpy(huge.data() + 4, &big, sizeof big);  // width
+  EXPECT_THROW(decodeFrame(huge), InputError);
+}
+
+}  // namespace
+}  // namespace rc

@@ -1,0 +1,28 @@
+// The entry points the fuzzers drive (scripts/fuzz.sh) and the regression test replays:
+// any bytes as a fixture file, as a mesh file, as a texture image. Each returns normally
+// when the input is accepted or refused with one InputError, and aborts (a finding) on
+// anything else: another exception, or a refusal whose message is not one safe line.
+// Crashes and sanitizer reports are findings by themselves.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace rc::fuzz {
+
+// The bytes as fixture JSON, loaded as if the file sat in tests/fixtures/data (so its
+// meshes/ and textures/ resolve); the scene's resource estimate is computed too.
+void loadFixtureBytes(const std::uint8_t* data, std::size_t size);
+
+// The first byte picks the format (an index into the extensions below), the rest is the
+// file, imported with its materials and textures.
+void importMeshBytes(const std::uint8_t* data, std::size_t size);
+inline constexpr const char* kMeshExtensions[] = {"obj", "ply", "stl", "off", "gltf", "glb",
+                                                  "3ds", "dae", "fbx", "x",   "md2",  "ase"};
+
+// The first byte picks the format hint, the rest is the image, decoded from memory.
+void decodeTextureBytes(const std::uint8_t* data, std::size_t size);
+inline constexpr const char* kTextureExtensions[] = {"png", "jpg", "bmp", "tga", "exr",
+                                                     "hdr", "tif", "gif", "ppm", ""};
+
+}  // namespace rc::fuzz

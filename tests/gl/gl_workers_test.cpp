@@ -1,0 +1,138 @@
+// `run`'s long-lived workers against drivers that misbehave (RASTERCHECK_GL_FAULT hang and
+// crash, gl_backend/gl_testing.h): the render that hangs or crashes becomes one error row
+// naming the timeout or the signal, its worker is replaced, and the fixtures before and
+// after it are rendered and compared as usual. Also the faults themselves through
+// `render`, so that the run tests cannot pass by the faults doing nothing.
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/command.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+using Result = rc::test::CommandResult;
+
+Result run(const std::string& args, const std::string& env = "") {
+  return rc::test::runShell(env + " " RC_EXE " " + args);
+}
+
+std::string catalog(const std::string& rel) {
+  return std::string(RC_SOURCE_DIR) + "/fixtures/scenes/" + rel;
+}
+
+fs::path scratch(const std::string& name) {
+  fs::path p =
+      fs::temp_directory_path() / ("rc_gl_workers_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+// Three fixtures llvmpipe renders within tolerance; the middle one gets the fault.
+const std::string kFixtures = catalog("coverage/triangle_fan.json") + " " +
+                              catalog("zbuffer/interpenetrating_ab.json") + " " +
+                              catalog("shading/sphere_gouraud_low.json");
+constexpr const char* kVictim = "zbuffer/interpenetrating_ab";
+
+// Whether llvmpipe starts here at all (else the tests below have nothing to show).
+bool llvmpipeRuns(const fs::path& dir) {
+  const Result r = run("render " + catalog("coverage/triangle_fan.json") +
+                       " --backend gl:egl:llvmpipe --out " + (dir / "probe").string());
+  if (r.code == 0) return true;
+  const char* req = std::getenv("RASTERCHECK_REQUIRE_GL");
+  if (req != nullptr && std::string(req) == "1")
+    ADD_FAILURE() << "RASTERCHECK_REQUIRE_GL=1 but llvmpipe does not start: " << r.out;
+  return false;
+}
+
+// The run's rows by fixture; every other fixture passes or warns and the victim's row is
+// an error whose message contains `why`.
+void expectOneErrorRow(const fs::path& out, const std::string& why) {
+  const json report = json::parse(std::ifstream(out / "report.json"));
+  ASSERT_EQ(report["results"].size(), 3u) << report.dump(1);
+  for (const json& row : report["results"]) {
+    SCOPED_TRACE(row["fixture"].get<std::string>());
+    if (row["fixture"] == kVictim) {
+      EXPECT_EQ(row["status"], "error");
+      EXPECT_NE(row["error"].get<std::string>().find(why), std::string::npos) << row["error"];
+    } else {
+      EXPECT_TRUE(row["status"] == "pass" || row["status"] == "warn") << row.dump();
+    }
+  }
+  EXPECT_EQ(report["exit_code"], 3);
+}
+
+TEST(GlWorkers, AHangingDriverCostsOneRowAndTheRunGoesOn) {
+  const fs::path dir = scratch("hang");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  const auto start = std::chrono::steady_clock::now();
+  const Result r =
+      run("run " + kFixtures + " --backends gl:egl:llvmpipe --no-variants --timeout 3 " + "--out " +
+              (dir / "out").string(),
+          std::string("RASTERCHECK_GL_FAULT=hang=") + kVictim);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.code, 3) << r.out;
+  expectOneErrorRow(dir / "out", "timed out after 3 s");
+  EXPECT_LT(seconds, 60.0) << "the watchdog let the run wait";
+  // What the worker printed before it was killed is kept beside the frames.
+  EXPECT_TRUE(
+      fs::exists(dir / "out" / "frames" / "zbuffer__interpenetrating_ab" / "gl_egl_llvmpipe.log"));
+  fs::remove_all(dir);
+}
+
+TEST(GlWorkers, ACrashingDriverCostsOneRowAndTheRunGoesOn) {
+  const fs::path dir = scratch("crash");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  const Result r = run("run " + kFixtures + " --backends gl:egl:llvmpipe,gl:egl:softpipe " +
+                           "--no-variants --out " + (dir / "out").string(),
+                       std::string("RASTERCHECK_GL_FAULT=crash=") + kVictim);
+  EXPECT_EQ(r.code, 3) << r.out;
+  const json report = json::parse(std::ifstream(dir / "out" / "report.json"));
+  ASSERT_EQ(report["results"].size(), 6u);
+  int errors = 0;
+  for (const json& row : report["results"]) {
+    SCOPED_TRACE(row.dump());
+    if (row["fixture"] == kVictim) {
+      ++errors;
+      EXPECT_EQ(row["status"], "error");
+      EXPECT_NE(row["error"].get<std::string>().find("crashed (Segmentation fault)"),
+                std::string::npos);
+    } else {
+      // The fixture after the crash was rendered by a new worker for the same backend.
+      EXPECT_NE(row["status"], "error");
+    }
+  }
+  EXPECT_EQ(errors, 2);
+  fs::remove_all(dir);
+}
+
+TEST(GlWorkers, TheFaultsHangAndCrashARenderOnTheirOwn) {
+  const fs::path dir = scratch("faults");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  const std::string render = "render " + catalog("zbuffer/interpenetrating_ab.json") +
+                             " --backend gl:egl:llvmpipe --out " + (dir / "f").string();
+  const Result crashed = run(render, std::string("RASTERCHECK_GL_FAULT=crash=") + kVictim);
+  EXPECT_EQ(crashed.code, 128 + 11) << crashed.out;  // SIGSEGV
+  const Result hung = rc::test::runShell(std::string("RASTERCHECK_GL_FAULT=hang=") + kVictim +
+                                         " timeout -s KILL 3 " RC_EXE " " + render);
+  EXPECT_EQ(hung.code, 128 + 9) << hung.out;  // killed by timeout(1)
+  // Another fixture is not hit.
+  const Result other = run("render " + catalog("coverage/triangle_fan.json") +
+                               " --backend gl:egl:llvmpipe --out " + (dir / "g").string(),
+                           std::string("RASTERCHECK_GL_FAULT=crash=") + kVictim);
+  EXPECT_EQ(other.code, 0) << other.out;
+  fs::remove_all(dir);
+}
+
+}  // namespace
