@@ -308,6 +308,8 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
 // before (rgba8 with blending: 5 of 120 random scenes; docs/gl_backend.md).
 void renewContext(Session& s) {
   s.programs.clear();  // their objects go with the old context
+  s.sample_program = 0;
+  s.empty_vertex_array = 0;
   s.framebuffer = Framebuffer{};
   s.debug_errors.clear();
   s.context->renew();

@@ -31,7 +31,7 @@ std::string identifier(const std::string& s) {
   return out;
 }
 
-class ConformancePair : public testing::Test {
+class ConformancePair : public ::testing::Test {
  public:
   ConformancePair(fs::path file, std::string backend)
       : file_(std::move(file)), backend_(std::move(backend)) {}
@@ -80,7 +80,7 @@ class ConformancePair : public testing::Test {
     for (const std::string& c : required) ok = ok && failing.count(c) > 0;
     if (!ok) {
       const fs::path artifacts =
-          writeArtifacts(testing::UnitTest::GetInstance()->current_test_info()->name(), ref,
+          writeArtifacts(::testing::UnitTest::GetInstance()->current_test_info()->name(), ref,
                          *gl.frame, ref, result);
       for (const std::string& c : failing) {
         EXPECT_TRUE(allowed.count(c)) << "unexpected failure: " << describe(result);
@@ -116,9 +116,9 @@ void registerCatalog() {
       const std::string suite = identifier(topic);
       const std::string test = identifier(rest) + "__" + identifier(backend);
       // No value parameter: it would end up in the test's name as "# GetParam() = ...".
-      testing::RegisterTest(
+      ::testing::RegisterTest(
           suite.c_str(), test.c_str(), nullptr, nullptr, __FILE__, __LINE__,
-          [file, backend]() -> testing::Test* { return new ConformancePair(file, backend); });
+          [file, backend]() -> ::testing::Test* { return new ConformancePair(file, backend); });
     }
   }
 }
@@ -127,7 +127,7 @@ void registerCatalog() {
 
 int main(int argc, char** argv) {
   try {
-    testing::InitGoogleTest(&argc, argv);
+    ::testing::InitGoogleTest(&argc, argv);
     registerCatalog();
     return RUN_ALL_TESTS();
   } catch (const std::exception& e) {
