@@ -68,7 +68,7 @@ std::optional<PixelRef> ReportReader::pixel(const json& j, const char* key,
 Status ReportReader::status(const json& j, const char* key, const std::string& path) const {
   if (!j.is_object() || !j.contains(key)) return Status::Pass;
   const std::string s = text(j, key, path);
-  for (Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error})
+  for (Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported})
     if (s == toString(st)) return st;
   fail(path + "." + key, fmt::format("unknown status \"{}\"", s));
 }
@@ -159,10 +159,11 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
                          r.text(known[k], "reason", kat)});
     }
   }
-  if (p.status == Status::Error) {
-    p.error = row.contains("error") && row["error"].is_string() ? row["error"].get<std::string>()
-                                                                : std::string();
-    p.visibility.status = p.depth.status = p.shading.status = Status::Error;
+  if (p.status == Status::Error || p.status == Status::NotSupported) {
+    const char* why = p.status == Status::Error ? "error" : "not_supported";
+    p.error =
+        row.contains(why) && row[why].is_string() ? row[why].get<std::string>() : std::string();
+    p.visibility.status = p.depth.status = p.shading.status = p.status;
     return p;
   }
   p.width = static_cast<int>(r.number(row, "width", at));

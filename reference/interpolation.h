@@ -61,6 +61,10 @@ class FragmentInterpolator {
                       (r.num[2] + num_[2].ddx * dx) * inv);
   }
 
+  // Moves the depth plane by (ox, oy) px: depth at (x, y) is then the plane's value at
+  // (x + ox, y + oy) (multisampling: depth at the sample, attributes at the centre).
+  void shiftDepth(double ox, double oy) { z_.at_ref += z_.ddx * ox + z_.ddy * oy; }
+
   // Depth gradient magnitude |grad z| of the plane (window-z units per px).
   double depthSlope() const { return std::hypot(z_.ddx, z_.ddy); }
 

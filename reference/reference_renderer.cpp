@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "fixtures/errors.h"
+#include "fixtures/multisample.h"
 #include "fixtures/scene_logic.h"
 #include "reference/clipper.h"
 #include "reference/fragment_ops.h"
@@ -121,12 +122,24 @@ thread_local Scratch t_scratch;
 constexpr std::size_t kMaxKeptScratchPixels = std::size_t{1} << 22;
 constexpr std::size_t kMaxKeptScratchVertices = std::size_t{1} << 20;
 
+// One sample of a multisampled render: every pixel's coverage and depth are decided at
+// its centre + offset (px) instead of its centre. The snapped vertices move by the
+// offset rounded to the subpixel grid (exact for the standard patterns at >= 4 bits:
+// they are multiples of 1/16), as a rasterizer that snaps once and evaluates its edge
+// functions at the sample does; the depth plane and edge_dist use the exact offset.
+struct SampleShift {
+  bool active = false;
+  glm::dvec2 offset{0.0};  // sample position - (0.5, 0.5), px
+  std::int64_t units_x = 0;
+  std::int64_t units_y = 0;
+};
+
 class Renderer {
  public:
   // Renders into a framebuffer covering `clip` (GL window coordinates): the whole image,
   // or one pixel when trace is non-null.
   Renderer(const Scene& scene, const ReferenceOptions& options, const PixelRect& clip,
-           std::vector<FragmentTrace>* trace)
+           std::vector<FragmentTrace>* trace, const SampleShift& shift = {})
       : scene_(scene),
         options_(options),
         clip_(clip),
@@ -145,7 +158,8 @@ class Renderer {
         gouraud_(t_scratch.gouraud),
         depth_(t_scratch.depth),
         gaps_(t_scratch.gaps),
-        edges_(t_scratch.edges) {
+        edges_(t_scratch.edges),
+        shift_(shift) {
     shading_.reserve(scene.materials.size());
     for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
   }
@@ -158,6 +172,8 @@ class Renderer {
   void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
                    int count);
   void prepareTriangle(TriangleContext& t) const;
+  __attribute__((noinline)) void addSampleEdgeDistances(const WindowVertex* wv, int count,
+                                                        const double* reach);
   void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
                 const FragmentInterpolator& interp);
   template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
@@ -204,6 +220,7 @@ class Renderer {
   std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
   UncertaintyTracker& gaps_;           // scratch
   EdgeDistanceBatch& edges_;           // scratch
+  const SampleShift shift_;            // multisampling: the sample drawn
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
 };
@@ -341,6 +358,10 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     wv[i] = toWindow(poly[i], scene_.width, scene_.height);
     if (!std::isfinite(wv[i].x) || !std::isfinite(wv[i].y) || !std::isfinite(wv[i].z)) return;
     fv[i] = snapVertexScaled(wv[i].x, wv[i].y, snap_scale_);
+    if (shift_.active) {  // the sample position lands on the pixel centre
+      fv[i].x -= shift_.units_x;
+      fv[i].y -= shift_.units_y;
+    }
   }
 
   const bool ccw_is_front = scene_.state.front_face == FrontFace::CCW;
@@ -362,8 +383,13 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     }
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
-    if (rasterized || cullCouldFlip(wv, count, max_reach))
-      edges_.add(wv, count, reach);  // addEdgeDistances(), deferred (EdgeDistanceBatch)
+    if (rasterized || cullCouldFlip(wv, count, max_reach)) {
+      if (shift_.active) {
+        addSampleEdgeDistances(wv, count, reach);
+      } else {
+        edges_.add(wv, count, reach);  // addEdgeDistances(), deferred (EdgeDistanceBatch)
+      }
+    }
   }
 
   TriangleContext t;
@@ -384,6 +410,7 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     FragmentInterpolator interp;
     // A triangle of one stored colour needs no barycentrics (unless traced).
     interp.setup(wv[0], wv[i], wv[i + 1], !t.constant || trace_ != nullptr);
+    if (shift_.active) interp.shiftDepth(shift_.offset.x, shift_.offset.y);
     if (uncertainty_) {
       t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
       t.texel_choice = t.texture != nullptr;
@@ -412,6 +439,18 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     }
     shadeFan(t, coverage, interp);
   }
+}
+
+// Multisampling: edge_dist from the sample position (out of line, so that the
+// single-sample drawPolygon() compiles as it did before multisampling).
+void Renderer::addSampleEdgeDistances(const WindowVertex* wv, int count, const double* reach) {
+  WindowVertex moved[kMaxClipVertices];
+  for (int i = 0; i < count; ++i) {
+    moved[i] = wv[i];
+    moved[i].x -= shift_.offset.x;
+    moved[i].y -= shift_.offset.y;
+  }
+  addEdgeDistances(moved, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(), reach);
 }
 
 template <Shading kShading>
@@ -739,10 +778,152 @@ void Renderer::traceSpans(const TriangleContext& t, const TriangleCoverage& cove
   });
 }
 
+// How each uncertainty channel of a multisampled pixel follows from its samples' (a
+// pixel may differ wherever one of its samples may): the smallest distance or gap, the
+// largest slope, count or colour range.
+constexpr bool kTakeSmallest[kUncertaintyChannels] = {
+    true,   // edge_dist
+    true,   // depth_gap
+    false,  // depth_slope
+    false,  // gap_slope
+    true,   // texel_dist
+    false,  // texel_alt
+    false,  // blend_count
+    true,   // blend_gap
+    false,  // blend_slope
+    true,   // clear_gap
+    false,  // clear_slope
+    false,  // texel_gain
+};
+
+// Multisampling: one render per sample (SampleShift), then the resolve: the colour is the
+// mean of the samples' stored colours (converted to the colour format again), id, depth
+// and coverage by resolveSampleOwners(), the uncertainty channels reduced over the
+// samples (kTakeSmallest), per-sample edge_dist kept, and sample_alt.
+Frame renderMultisample(const Scene& scene, const ReferenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const int samples = scene.state.samples;
+  const bool given = !options.sample_positions.empty();
+  const std::vector<glm::dvec2> positions =
+      given ? options.sample_positions : standardSamplePositions(samples);
+  if (static_cast<int>(positions.size()) != samples)
+    throw InputError(sceneLabel(scene) + ": " + std::to_string(positions.size()) +
+                     " sample positions given for " + std::to_string(samples) + " samples");
+  for (const glm::dvec2& p : positions)
+    if (!(p.x >= 0.0 && p.x <= 1.0 && p.y >= 0.0 && p.y <= 1.0))
+      throw InputError(sceneLabel(scene) + ": sample position outside the pixel [0, 1]^2");
+
+  const double scale = std::ldexp(1.0, options.subpixel_bits);
+  Frame out;
+  std::vector<float> sample_color;  // per sample plane, RGBA
+  std::vector<double> sum;
+  std::uint64_t fragments = 0;
+  std::uint64_t triangles = 0;
+  bool on_grid = true;
+  for (int s = 0; s < samples; ++s) {
+    SampleShift shift;
+    shift.active = true;
+    shift.offset = positions[s] - glm::dvec2(0.5);
+    const double ux = shift.offset.x * scale;
+    const double uy = shift.offset.y * scale;
+    shift.units_x = static_cast<std::int64_t>(roundHalfEven(ux));
+    shift.units_y = static_cast<std::int64_t>(roundHalfEven(uy));
+    on_grid = on_grid && static_cast<double>(shift.units_x) == ux &&
+              static_cast<double>(shift.units_y) == uy;
+    Renderer renderer(scene, options, PixelRect{0, 0, scene.width, scene.height}, nullptr, shift);
+    Frame f = renderer.run();
+    const std::size_t n = f.pixelCount();
+    fragments += f.meta["fragments"].get<std::uint64_t>();
+    triangles = f.meta["triangles_rasterized"].get<std::uint64_t>();
+    if (s == 0) {
+      out.width = f.width;
+      out.height = f.height;
+      out.samples = samples;
+      out.meta = f.meta;
+      out.sample_id.resize(n * samples);
+      out.sample_depth.resize(n * samples);
+      sample_color.resize(n * 4 * samples);
+      sum.assign(n * 4, 0.0);
+      if (f.hasUncertainty()) {
+        out.sample_edge_dist.resize(n * samples);
+        const auto from = f.uncertainty();
+        const auto to = out.uncertainty();
+        for (int c = 0; c < kUncertaintyChannels; ++c) *to[c] = *from[c];
+      }
+    } else if (f.hasUncertainty()) {
+      const auto from = f.uncertainty();
+      const auto to = out.uncertainty();
+      for (int c = 0; c < kUncertaintyChannels; ++c) {
+        std::vector<float>& dst = *to[c];
+        const std::vector<float>& src = *from[c];
+        for (std::size_t i = 0; i < n; ++i)
+          dst[i] = kTakeSmallest[c] ? std::min(dst[i], src[i]) : std::max(dst[i], src[i]);
+      }
+    }
+    std::copy(f.id.begin(), f.id.end(), out.sample_id.begin() + static_cast<std::ptrdiff_t>(s * n));
+    std::copy(f.depth.begin(), f.depth.end(),
+              out.sample_depth.begin() + static_cast<std::ptrdiff_t>(s * n));
+    std::copy(f.color.begin(), f.color.end(),
+              sample_color.begin() + static_cast<std::ptrdiff_t>(s * n * 4));
+    if (f.hasUncertainty())
+      std::copy(f.edge_dist.begin(), f.edge_dist.end(),
+                out.sample_edge_dist.begin() + static_cast<std::ptrdiff_t>(s * n));
+    for (std::size_t k = 0; k < n * 4; ++k)
+      sum[k] += loadColor(f.color[k], scene.state.color_format);
+  }
+
+  const std::size_t n = out.pixelCount();
+  out.color.resize(n * 4);
+  for (std::size_t k = 0; k < n * 4; ++k)
+    out.color[k] = storeColor(sum[k] / samples, scene.state.color_format);
+  resolveSampleOwners(out);
+  if (out.hasUncertainty()) {
+    // sample_alt: the colour range (8-bit units, any channel) over the samples of the pixel
+    // and its eight neighbours.
+    out.sample_alt.assign(n, 0.0f);
+    const int w = out.width;
+    const int h = out.height;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        float lo[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+        float hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+        for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy) {
+          for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+            const std::size_t j = out.index(xx, yy);
+            for (int s = 0; s < samples; ++s) {
+              const float* c = &sample_color[(static_cast<std::size_t>(s) * n + j) * 4];
+              for (int k = 0; k < 4; ++k) {
+                lo[k] = std::min(lo[k], c[k]);
+                hi[k] = std::max(hi[k], c[k]);
+              }
+            }
+          }
+        }
+        float range = 0.0f;
+        for (int k = 0; k < 4; ++k)
+          if (std::isfinite(hi[k] - lo[k])) range = std::max(range, hi[k] - lo[k]);
+        out.sample_alt[out.index(x, y)] = 255.0f * range;
+      }
+    }
+  }
+  nlohmann::json pos = nlohmann::json::array();
+  for (const glm::dvec2& p : positions) pos.push_back({p.x, p.y});
+  out.meta["fragments"] = fragments;
+  out.meta["triangles_rasterized"] = triangles;
+  out.meta["multisample"] = {{"samples", samples},
+                             {"positions", pos},
+                             {"positions_source", given ? "given" : "standard"},
+                             {"positions_on_grid", on_grid}};
+  out.meta["timing_ms"]["render"] =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
 }  // namespace
 
 Frame renderReference(const Scene& scene, const ReferenceOptions& options) {
   validate(scene, options);
+  if (scene.state.samples > 1) return renderMultisample(scene, options);
   Renderer renderer(scene, options, PixelRect{0, 0, scene.width, scene.height}, nullptr);
   return renderer.run();
 }
