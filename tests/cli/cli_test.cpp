@@ -192,8 +192,8 @@ TEST(CliCompare, IdenticalFramesPassWithTheSummaryAndReportPath) {
   // A passing pair gets no diff.exr (75 MB at 1080p) unless asked for.
   EXPECT_FALSE(fs::exists(pair / "diff.exr"));
   EXPECT_EQ(readFile(out / "report.json").find("diff_exr"), std::string::npos);
-  const Result forced = run("compare " + a.string() + " " + b.string() + " --diff-exr --out " +
-                            out.string());
+  const Result forced =
+      run("compare " + a.string() + " " + b.string() + " --diff-exr --out " + out.string());
   EXPECT_EQ(forced.code, 0) << forced.out;
   EXPECT_TRUE(fs::is_regular_file(pair / "diff.exr"));
 }
