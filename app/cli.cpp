@@ -279,6 +279,9 @@ int runCli(int argc, char** argv) {
   } catch (const InputError& e) {
     std::cerr << "rastercheck: error: " << oneLineMessage(e.what()) << '\n';
     return kExitInput;
+  } catch (const NotSupportedError& e) {
+    std::cerr << "rastercheck: " << e.what() << '\n';  // "not supported: ..."
+    return kExitBackend;
   } catch (const BackendError& e) {
     std::cerr << "rastercheck: backend error: " << oneLineMessage(e.what()) << '\n';
     return kExitBackend;

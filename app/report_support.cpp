@@ -11,6 +11,7 @@
 #include "compare/pair_images.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
+#include "fixtures/multisample.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -111,12 +112,40 @@ void ReportFolder::commit(const Report& report) {
   folder_.commit();
 }
 
+PairResult failedRenderResult(std::string fixture, std::string expected, std::string actual,
+                              const std::string& message) {
+  if (const std::optional<std::string> reason = notSupportedReason(message))
+    return notSupportedResult(std::move(fixture), std::move(expected), std::move(actual), *reason);
+  return errorResult(std::move(fixture), std::move(expected), std::move(actual), message);
+}
+
+bool needsResample(const Frame& ref, const Frame& gl) {
+  if (!ref.multisampled() || !gl.multisampled()) return false;
+  const std::vector<glm::dvec2> want = samplePositionsFromMeta(gl.meta);
+  return !want.empty() && want != samplePositionsFromMeta(ref.meta);
+}
+
+void resampleReference(Frame& ref, const Frame& gl, const fs::path& scene_file,
+                       ReferenceOptions options) {
+  if (!needsResample(ref, gl)) return;
+  const std::vector<glm::dvec2> want = samplePositionsFromMeta(gl.meta);
+  options.sample_positions = want;
+  Frame again = renderReference(loadScene(scene_file), options);
+  nlohmann::json meta = ref.meta;
+  for (const char* key : {"multisample", "fragments", "triangles_rasterized", "timing_ms"})
+    meta[key] = again.meta[key];
+  meta["multisample"]["positions_from"] = gl.meta.value("backend", std::string("the driver"));
+  again.meta = std::move(meta);
+  ref = std::move(again);
+}
+
 // ---- Summary ----
 
 namespace {
 
 std::string cellText(const PairResult& r) {
   if (r.status == Status::Error) return "ERROR";
+  if (r.status == Status::NotSupported) return "not supported";
   std::string status = toString(r.status);
   if (r.status != Status::Pass)
     std::transform(status.begin(), status.end(), status.begin(),
@@ -185,7 +214,8 @@ std::string summaryTable(const Report& report, std::size_t max_rows) {
         if (const auto it = cells.find({f, backends[k]}); it != cells.end())
           ++n[it->second->status];
       std::string text;
-      for (const Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error})
+      for (const Status st :
+           {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported})
         if (n[st] > 0)
           text += fmt::format("{}{} {}", text.empty() ? "" : ", ", n[st], toString(st));
       line += fmt::format("  {:<{}}", text, widths[k]);
@@ -212,9 +242,10 @@ void printSummary(const Report& report, const fs::path& out_dir, std::ostream& o
       if (f.is_string()) os << "finding: " << spec << ": " << f.get<std::string>() << '\n';
   }
   const ReportSummary s = report.summary();
-  os << fmt::format("{} pairs: {} pass, {} warn, {} fail{}, {} error\n", s.total(), s.pass, s.warn,
-                    s.fail, s.known_fail ? fmt::format(" ({} known)", s.known_fail) : std::string(),
-                    s.error);
+  os << fmt::format(
+      "{} pairs: {} pass, {} warn, {} fail{}, {} error{}\n", s.total(), s.pass, s.warn, s.fail,
+      s.known_fail ? fmt::format(" ({} known)", s.known_fail) : std::string(), s.error,
+      s.not_supported ? fmt::format(", {} not supported", s.not_supported) : std::string());
   os << "report: " << (fs::absolute(out_dir) / "report.html").lexically_normal().string() << '\n';
   os << (s.error                 ? "ERROR"
          : s.fail > s.known_fail ? "FAILURE"

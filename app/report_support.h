@@ -17,6 +17,7 @@
 #include "fixtures/frame.h"
 #include "fixtures/output_folder.h"
 #include "fixtures/scene.h"
+#include "reference/reference_renderer.h"
 
 namespace rc {
 
@@ -44,6 +45,20 @@ PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame&
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, ReportFolder& folder,
                        const PairPictures& pictures = {}, bool diff_exr_when_passing = true);
+
+// A report row for a pair whose render failed with `message`: status not_supported when
+// the message says the backend does not support the fixture, else error.
+PairResult failedRenderResult(std::string fixture, std::string expected, std::string actual,
+                              const std::string& message);
+
+// A multisampled reference frame samples where the driver it is compared with does: when
+// `gl`'s frame.json "multisample" positions differ from `ref`'s, `ref` is rendered again
+// (with `options` and those positions) from the fixture file, keeping its frame.json keys.
+// Nothing happens for single-sample frames or frames without positions.
+void resampleReference(Frame& ref, const Frame& gl, const std::filesystem::path& scene_file,
+                       ReferenceOptions options);
+// Whether resampleReference(ref, gl, ...) would render again (cheap: frame.json only).
+bool needsResample(const Frame& ref, const Frame& gl);
 
 // A frame folder's color.png when it shows `frame` (frame.json's "color_digest", written
 // by `render`, matches the frame that was read), else empty: then the comparator encodes

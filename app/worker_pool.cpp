@@ -133,7 +133,7 @@ WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
   const BackendSpec backend = parseBackendSpec(spec);
   if (backend.kind == BackendSpec::Kind::Gl)
     for (const auto& [name, value] : startupEnvironment(backend.gl))
-      extra.push_back(name + "=" + value);
+      extra.push_back(fmt::format("{}={}", name, value));
   std::vector<std::string> env_text = childEnvironment(extra);
   std::vector<char*> envp;
   envp.reserve(env_text.size() + 1);

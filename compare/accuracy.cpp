@@ -57,6 +57,8 @@ AccuracyPair readPair(const ReportReader& r, const json& j, const std::string& a
   p.actual = r.text(j, "actual", at);
   p.status = r.status(j, "status", at);
   if (j.contains("error") && j["error"].is_string()) p.error = j["error"].get<std::string>();
+  if (j.contains("not_supported") && j["not_supported"].is_string())
+    p.error = j["not_supported"].get<std::string>();
   p.height = static_cast<int>(r.number(j, "height", at));
   p.pixels = r.count(j, "pixels", at);
   if (j.contains("subpixel_bits") && j["subpixel_bits"].is_object()) {
@@ -133,7 +135,7 @@ bool isReference(const std::string& spec) { return spec == "ref" || spec.rfind("
 
 struct Totals {
   std::uint64_t pairs = 0;
-  std::uint64_t by_status[4] = {0, 0, 0, 0};
+  std::uint64_t by_status[5] = {0, 0, 0, 0, 0};  // indexed by Status
   std::uint64_t hard = 0;
   std::uint64_t ambiguous = 0;
   double depth_max = 0.0;
@@ -168,6 +170,7 @@ using Group = std::pair<std::string, std::string>;  // expected, actual
 // "warn: shading 1.25 at (..)" for a cell of the per-fixture table.
 std::string verdictCell(const AccuracyPair& p) {
   if (p.status == Status::Error) return "error: " + cell(p.error);
+  if (p.status == Status::NotSupported) return "not supported: " + cell(p.error);
   if (p.status == Status::Pass) return "pass";
   std::vector<std::string> parts;
   if (p.visibility_status != Status::Pass)
@@ -371,7 +374,7 @@ void perceptualSection(const AccuracyData& data,
   line();
   line("## Perceptual error (LDR-FLIP)");
   line();
-  line("LDR-FLIP (docs/tolerances.md, section 5) of each pair's 8-bit pictures, 0 (identical)");
+  line("LDR-FLIP (docs/tolerances.md, section 6) of each pair's 8-bit pictures, 0 (identical)");
   line("to 1; *mean* averages the pairs' mean errors, *worst pair* is the largest pair mean.");
   line();
   line("| driver | against | pairs | mean | worst pair | largest pixel |");
@@ -538,9 +541,10 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
     }
     line(
         fmt::format("{} fixtures: {} identical, {} differing only in ambiguous pixels, {} "
-                    "with other differences. Verdicts: {} pass, {} warn, {} fail, {} error.",
+                    "with other differences. Verdicts: {} pass, {} warn, {} fail, {} error{}.",
                     t.pairs, identical, edge_only, t.pairs - identical - edge_only, t.by_status[0],
-                    t.by_status[1], t.by_status[2], t.by_status[3]));
+                    t.by_status[1], t.by_status[2], t.by_status[3],
+                    t.by_status[4] ? fmt::format(", {} not supported", t.by_status[4]) : ""));
     for (const auto& [a, b] : bits)
       if (a > 0 && b > 0)
         line(fmt::format("Subpixel bits: `{}` {}, `{}` {}.", g.first, a, g.second, b));

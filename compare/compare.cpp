@@ -19,6 +19,7 @@
 #include "compare/slopes.h"
 #include "fixtures/big_buffer.h"
 #include "fixtures/errors.h"
+#include "fixtures/multisample.h"
 
 namespace rc {
 namespace {
@@ -64,6 +65,7 @@ void checkBuffers(const Frame& f, const char* role, bool need_color) {
       throw InputError(fmt::format("{}: {} does not match its size", frameLabel(f, role),
                                    kUncertaintyChannelInfo[c].name));
   }
+  checkSamplePlanes(f, frameLabel(f, role));
 }
 
 // Four pixels at a time with GCC/Clang vector extensions: portable, and 128-bit so that
@@ -259,10 +261,17 @@ class Comparator {
     shade_slope_band_ = tol.shading_slope_factor * r.depth.band_px;
     texel_band_ = r.depth.band_px;
     shade_relative_units_ = 255.0 * tol.shading_relative;
+    have_sample_uncertainty_ = have_uncertainty_ && u.multisampled() && u.samples == e.samples;
   }
 
   void run(ClassMaps* maps) {
     maps_ = maps;
+    if (e_.multisampled()) {
+      allocateMaps();
+      for (int y = 0; y < e_.height; ++y) runMultisampleRow(y);
+      finish();
+      return;
+    }
     if (maps) {
       const std::size_t n = e_.pixelCount();
       maps->width = e_.width;
@@ -516,6 +525,172 @@ class Comparator {
     if (x < w) runRange<kMaps>(y, x, w);
   }
 
+  // ---- Multisampled frames (docs/tolerances.md "Multisampling") ----
+  // Per pixel: the samples are compared one by one. A sample whose id differs is a
+  // coverage difference; it is ambiguous when the reference's edge_dist at that sample is
+  // within the snap band (or, between two primitives, depth_gap within the depth
+  // tolerance; against the background, clear_gap), else hard. A pixel with any hard
+  // sample is a hard visibility mismatch (its class from the first hard sample's ids) and
+  // nothing else is compared there; a pixel whose differing samples are all ambiguous is
+  // an ambiguous mismatch, and its depth (over the samples both sides give the same
+  // primitive) and resolved colour are still compared, the colour with an allowance of
+  // sample_alt / samples per differing sample. A pixel whose samples all agree and show
+  // a primitive somewhere is a match: depth over its non-background samples, resolved
+  // colour.
+
+  void allocateMaps() {
+    if (!maps_) return;
+    const std::size_t n = e_.pixelCount();
+    maps_->width = e_.width;
+    maps_->height = e_.height;
+    assignBig(maps_->pixel_class, n, PixelClass::Background);
+    assignBig(maps_->depth_steps, n, 0.0f);
+    assignBig(maps_->depth_tolerance, n, 0.0f);
+    assignBig(maps_->shading_abs, n, 0.0f);
+    assignBig(maps_->shading_tolerance, n, 0.0f);
+  }
+
+  // Whether sample s of pixel i may legally belong to another primitive (ids a, b).
+  bool sampleAmbiguous(std::size_t i, int s, std::uint32_t a, std::uint32_t b, bool& by_gap,
+                       double& edge) const {
+    by_gap = false;
+    edge = have_sample_uncertainty_ ? static_cast<double>(u_.sample_edge_dist[u_.sampleIndex(s, i)])
+                                    : kInf;
+    if (edge <= band_) return true;
+    if (!have_uncertainty_) return false;
+    by_gap = a != 0 && b != 0 ? static_cast<double>(u_.depth_gap[i]) <=
+                                    2.0 * (tol_.depth.fail + depth_slope_band_ * u_.gap_slope[i])
+                              : static_cast<double>(u_.clear_gap[i]) <=
+                                    tol_.depth.fail + depth_slope_band_ * u_.clear_slope[i];
+    return by_gap;
+  }
+
+  void runMultisampleRow(int y) {
+    const int samples = e_.samples;
+    for (int x = 0; x < e_.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * e_.width + x;
+      const float* pa = &e_.color[i * 4];
+      const float* pb = &a_.color[i * 4];
+      bool color_finite = true;
+      for (int c = 0; c < 4; ++c)
+        color_finite = color_finite && !isNonFinite(pa[c]) && !isNonFinite(pb[c]);
+      bool depth_finite = true;
+      int differing = 0;
+      int first_hard = -1;
+      int first_diff = -1;
+      bool any_primitive = false;
+      double dz_max = 0.0;
+      bool first_gap = false;
+      bool any_gap = false;  // a differing sample excused by a depth tie, not by an edge
+      double first_edge = kInf;
+      for (int s = 0; s < samples; ++s) {
+        const std::size_t k = e_.sampleIndex(s, i);
+        const std::uint32_t a = e_.sample_id[k];
+        const std::uint32_t b = a_.sample_id[k];
+        if (a != b) {
+          ++differing;
+          bool by_gap = false;
+          double edge = kInf;
+          const bool ambiguous = sampleAmbiguous(i, s, a, b, by_gap, edge);
+          any_gap = any_gap || by_gap;
+          if (first_diff < 0) {
+            first_diff = s;
+            first_gap = by_gap;
+            first_edge = edge;
+          }
+          if (!ambiguous && first_hard < 0) {
+            first_hard = s;
+            first_edge = edge;
+          }
+          continue;
+        }
+        if (a == 0) continue;
+        any_primitive = true;
+        const float za = e_.sample_depth[k];
+        const float zb = a_.sample_depth[k];
+        if (isNonFinite(za) || isNonFinite(zb)) {
+          depth_finite = false;
+          continue;
+        }
+        dz_max = std::max(dz_max, std::fabs(scale_(za) - scale_(zb)));
+      }
+      sample_mismatches_ += static_cast<std::uint64_t>(differing);
+      if (!depth_finite || !color_finite) {
+        for (int c = 0; c < 4; ++c) {
+          tally(pa[c], c, r_.nonfinite_expected);
+          tally(pb[c], c, r_.nonfinite_actual);
+        }
+        tally(e_.depth[i], 4, r_.nonfinite_expected);
+        tally(a_.depth[i], 4, r_.nonfinite_actual);
+      }
+      if (first_hard >= 0) {
+        const std::size_t k = e_.sampleIndex(first_hard, i);
+        const PixelClass cls =
+            record(i, e_.sample_id[k], a_.sample_id[k], false, false, first_edge);
+        if (maps_) maps_->pixel_class[i] = cls;
+        continue;
+      }
+      if (first_diff >= 0) {
+        const std::size_t k = e_.sampleIndex(first_diff, i);
+        const PixelClass cls =
+            record(i, e_.sample_id[k], a_.sample_id[k], true, first_gap, first_edge);
+        if (maps_) maps_->pixel_class[i] = cls;
+      } else if (!any_primitive) {
+        continue;  // background on both sides
+      } else if (maps_) {
+        maps_->pixel_class[i] = PixelClass::Match;
+      }
+      if (!any_primitive) continue;
+      ++vis_match_;
+      if (!depth_finite) {
+        depthNonFinite(i);
+        if (maps_) maps_->depth_steps[i] = std::numeric_limits<float>::quiet_NaN();
+      } else {
+        depth_sum_ += dz_max;
+        r_.depth.histogram.add(dz_max);
+        if (dz_max > depth_max_) {
+          depth_max_ = dz_max;
+          depth_max_at_ = i;
+        }
+        if (dz_max > tol_.depth.warn) depthOverBase(x, y, i, dz_max);
+        if (maps_) maps_->depth_steps[i] = static_cast<float>(dz_max);
+      }
+      // A sample that may legally show another primitive by a depth tie may carry the colour
+      // of a fragment that lost its depth test in the reference: no sample colour the
+      // reference keeps bounds it, so the resolved colour is not compared (as the colour of
+      // a single-sample pixel whose primitive differs is not).
+      if (any_gap) {
+        ++shade_skipped_;
+        continue;
+      }
+      if (!color_finite) {
+        shadingNonFinite(i);
+        if (maps_) maps_->shading_abs[i] = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      float d[4];
+      for (int c = 0; c < 4; ++c) d[c] = colorError(pa[c], pb[c]);
+      const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
+      ++shade_compared_;
+      shade_sum_ += (d[0] + d[1]) + (d[2] + d[3]);
+      shade_sq_ += (d[0] * d[0] + d[1] * d[1]) + (d[2] * d[2] + d[3] * d[3]);
+      for (int c = 0; c < 4; ++c) shade_max_rgba_[c] = std::max(shade_max_rgba_[c], d[c]);
+      r_.shading.histogram.add(e);
+      if (e > shade_max_) {
+        shade_max_ = e;
+        shade_max_at_ = i;
+      }
+      // Each differing (ambiguous) sample may carry the colour of the other primitive: up to
+      // the colour range around the pixel, weighted 1 / samples in the resolve.
+      coverage_allowance_ = differing > 0 && have_sample_uncertainty_
+                                ? static_cast<double>(differing) * u_.sample_alt[i] / samples
+                                : 0.0;
+      if (e > tol_.shading.warn) shadingOver(x, y, i, d);
+      coverage_allowance_ = 0.0;
+      if (maps_) maps_->shading_abs[i] = e;
+    }
+  }
+
   // ---- Depth: slope allowance (docs/tolerances.md) ----
 
   // The depth slope (steps/px) the reference recorded for the fragment whose depth it
@@ -596,7 +771,7 @@ class Comparator {
     for (int c = 0; c < 4; ++c) {
       const double m = std::max(std::fabs(pa[c]), std::fabs(pb[c]));
       out.allowances[c] = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
-                          blends + (c < 3 ? texel + filtering : 0.0);
+                          blends + (c < 3 ? texel + filtering : 0.0) + coverage_allowance_;
     }
     for (int c = 0; c < 4; ++c) {
       const double excess = d[c] - out.allowances[c];
@@ -705,6 +880,8 @@ class Comparator {
     v.mismatched = v.missing + v.extra + v.wrong_primitive;
     v.ambiguous = v.mismatched - v.hard;
     v.uncertainty_available = have_uncertainty_;
+    v.samples = e_.samples;
+    v.mismatched_samples = sample_mismatches_;
     v.status = tol_.visibility.verdict(static_cast<double>(v.hard));
     if (vis_worst_.any) {
       v.worst = pixelAt(vis_worst_.index);
@@ -729,7 +906,8 @@ class Comparator {
     d.status = d.over_fail ? Status::Fail : d.over_tolerance ? Status::Warn : Status::Pass;
 
     ShadingStats& s = r_.shading;
-    s.compared = vis_match_;
+    s.compared = e_.multisampled() ? shade_compared_ + s.nonfinite : vis_match_;
+    s.depth_tied = shade_skipped_;
     const std::uint64_t shade_finite = s.compared - s.nonfinite;
     s.max_abs = shade_max_;
     for (int c = 0; c < 4; ++c) s.max_abs_rgba[c] = shade_max_rgba_[c];
@@ -772,6 +950,12 @@ class Comparator {
   double shade_slope_band_ = 0.0;  // shading_slope_factor * slope band
   double texel_band_ = 0.0;        // the slope band: how far a texture sample may move (px)
   double shade_relative_units_ = 0.0;
+  // Multisampled frames: per-sample edge distances and sample_alt are available.
+  bool have_sample_uncertainty_ = false;
+  std::uint64_t sample_mismatches_ = 0;
+  std::uint64_t shade_skipped_ = 0;   // multisampled: depth-tied pixels (not shading-compared)
+  std::uint64_t shade_compared_ = 0;  // multisampled: pixels shading-compared
+  double coverage_allowance_ = 0.0;   // units, of the pixel being compared (multisampled)
 
   std::uint64_t class_counts_[kPixelClassCount] = {};
   std::uint64_t vis_match_ = 0;
@@ -835,6 +1019,21 @@ PairResult errorResult(std::string fixture, std::string expected, std::string ac
   return r;
 }
 
+PairResult notSupportedResult(std::string fixture, std::string expected, std::string actual,
+                              std::string reason) {
+  PairResult r =
+      errorResult(std::move(fixture), std::move(expected), std::move(actual), std::move(reason));
+  r.status = Status::NotSupported;
+  return r;
+}
+
+std::optional<std::string> notSupportedReason(const std::string& message) {
+  constexpr std::string_view kMarker = "not supported: ";
+  const std::size_t at = message.find(kMarker);
+  if (at == std::string::npos) return std::nullopt;
+  return message.substr(at + kMarker.size());
+}
+
 PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                          const Tolerances& tolerances, ClassMaps* maps) {
   const auto start = std::chrono::steady_clock::now();
@@ -846,6 +1045,10 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
     throw InputError(fmt::format("frames differ in size: {} is {}x{}, {} is {}x{}",
                                  frameLabel(expected, "expected"), expected.width, expected.height,
                                  frameLabel(actual, "actual"), actual.width, actual.height));
+  if (expected.samples != actual.samples)
+    throw InputError(fmt::format("frames differ in samples per pixel: {} has {}, {} has {}",
+                                 frameLabel(expected, "expected"), expected.samples,
+                                 frameLabel(actual, "actual"), actual.samples));
   if (uncertainty.width != expected.width || uncertainty.height != expected.height)
     throw InputError(fmt::format("frames differ in size: {} is {}x{}, {} is {}x{}",
                                  frameLabel(expected, "expected"), expected.width, expected.height,

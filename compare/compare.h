@@ -58,6 +58,8 @@ struct VisibilityStats {
   std::uint64_t ambiguous_by_depth_gap = 0;  // mismatches excused only by depth_gap
   double band_px = 0.0;                      // edge_dist at or below this is ambiguous
   bool uncertainty_available = false;        // false: no edge_dist/depth_gap, all are hard
+  int samples = 1;                           // samples per pixel compared (multisampled frames)
+  std::uint64_t mismatched_samples = 0;      // samples whose ids differ (multisampled frames)
   PixelRef worst;                // the hard mismatch farthest from any edge (first on ties)
   double worst_edge_dist = 0.0;  // its edge_dist (1 = capped; +inf without uncertainty)
 };
@@ -106,6 +108,9 @@ struct ShadingStats {
   // Pixels over their tolerance not counted because the fragments blended under the top
   // one may legally differ (see DepthStats::blend_uncertain).
   std::uint64_t blend_uncertain = 0;
+  // Multisampled pairs: pixels not compared because a sample there may legally show
+  // another primitive by a depth tie (docs/tolerances.md "5. Multisampling").
+  std::uint64_t depth_tied = 0;
   std::array<double, 4> max_abs_rgba{};
   // The pixel furthest over its tolerance when any is over (a non-finite one first), else
   // the largest per-pixel error (first in row order on ties); none when all are equal.
@@ -176,6 +181,13 @@ struct PairResult {
 // A report row for a pair that could not be compared (e.g. the backend did not start).
 PairResult errorResult(std::string fixture, std::string expected, std::string actual,
                        std::string message);
+// A report row for a pair whose backend cannot render the fixture (status NotSupported;
+// `reason` in PairResult::error, without the "not supported: " prefix).
+PairResult notSupportedResult(std::string fixture, std::string expected, std::string actual,
+                              std::string reason);
+// When `message` (a render's last line of output, or an exception text) says the backend
+// does not support the fixture ("not supported: ..." anywhere), the reason after it.
+std::optional<std::string> notSupportedReason(const std::string& message);
 
 // Per-pixel results, for images and diff.exr. Index y * width + x (image coordinates).
 // (The colour deltas diff.exr also holds come straight from the frames.)

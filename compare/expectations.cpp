@@ -17,8 +17,9 @@ using nlohmann::json;
 // The render state keys an entry may name, as the fixture format spells them.
 const std::set<std::string>& stateKeys() {
   static const std::set<std::string> keys = {
-      "shading", "specular_model", "attenuation", "depth_test", "depth_format",   "color_format",
-      "cull",    "front_face",     "blend",       "visibility", "texture_filter", "texture_wrap"};
+      "shading",        "specular_model", "attenuation", "depth_test", "depth_format",
+      "color_format",   "cull",           "front_face",  "blend",      "visibility",
+      "texture_filter", "texture_wrap",   "samples"};
   return keys;
 }
 

@@ -90,7 +90,7 @@ h3{font-size:15px;margin:0 0 6px}
 .summary b{display:block;font-size:20px}
 .badge{display:inline-block;padding:0 6px;border-radius:4px;font-size:12px;font-weight:600;
   text-transform:uppercase;color:#fff}
-.pass{background:#2e7d32}.warn{background:#e6a100}.fail{background:#c62828}.error{background:#6a1b9a}
+.pass{background:#2e7d32}.warn{background:#e6a100}.fail{background:#c62828}.error{background:#6a1b9a}.not_supported{background:#607d8b}
 table{border-collapse:collapse;background:#fff}
 th,td{border:1px solid #ddd;padding:3px 7px;text-align:left;white-space:nowrap}
 td.n{text-align:right;font-variant-numeric:tabular-nums}
@@ -232,7 +232,7 @@ constexpr const char* kScript = R"JS(
     var out = '<details class="pair" id="pair-' + k + '"' + (open ? ' open' : '') + '><summary><h3>' +
         esc(p[0]) + ' &mdash; ' + esc(p[1]) + ' vs ' + esc(p[2]) + ' ' + badge(p[3]) + '</h3></summary>';
     out += '<div class="describe">' + esc(x.d || ('PASS ' + p[0] + ' ' + p[1] + ' vs ' + p[2])) + '</div>';
-    if (p[3] === 'error') return out + '</details>';
+    if (p[3] === 'error' || p[3] === 'not_supported') return out + '</details>';
     var v = x.v;
     var vis = v ? '<div class="legend">' + sw('c1', 'match') + sw('c3', 'missing ' + v[4]) +
         sw('c2', 'missing (ambiguous) ' + (v[3] - v[4])) + sw('c5', 'extra ' + v[6]) +
@@ -308,7 +308,7 @@ constexpr const char* kScript = R"JS(
     td.innerHTML = html;
     return td;
   }
-  var ORDER = {pass: 0, warn: 1, fail: 2, error: 3};
+  var ORDER = {pass: 0, warn: 1, fail: 2, error: 3, not_supported: 4};
   function buildRow(k) {
     var p = P[k], tr = document.createElement('tr');
     tr.className = 'pair-row';
@@ -486,7 +486,7 @@ nlohmann::json sectionData(const PairResult& r, const fs::path& report_dir, bool
     x["img"] = one_dir ? dir : "";
     x["f"] = files;
   }
-  if (r.status == Status::Error) {
+  if (r.status == Status::Error || r.status == Status::NotSupported) {
     x["d"] = describe(r);
     return x;
   }
@@ -672,7 +672,7 @@ std::string backendCounts(const Report& report, const Columns& columns) {
 // at the pair's status (visibility with its largest kind of hard mismatch), or for an
 // error row its message with the fixture name and every number taken out.
 std::string signature(const PairResult& r) {
-  if (r.status == Status::Error) {
+  if (r.status == Status::Error || r.status == Status::NotSupported) {
     std::string m = r.error;
     for (std::size_t at = 0;
          !r.fixture.empty() && (at = m.find(r.fixture, at)) != std::string::npos;)
@@ -803,8 +803,8 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
   out += fmt::format(
       "<div class=\"summary\" id=\"summary\"><div>pairs<b>{}</b></div><div>pass<b>{}</b></div>"
       "<div>warn<b>{}</b></div><div>fail<b>{}</b></div><div>error<b>{}</b></div>"
-      "<div>exit code<b>{}</b></div></div>",
-      sum.total(), sum.pass, sum.warn, sum.fail, sum.error, exitCodeFor(report));
+      "<div>not supported<b>{}</b></div><div>exit code<b>{}</b></div></div>",
+      sum.total(), sum.pass, sum.warn, sum.fail, sum.error, sum.not_supported, exitCodeFor(report));
   out += backendCounts(report, columns);
   // Large reports: the groups of failures come before the (shortened) matrix.
   if (!big) out += matrix(report, columns) + variantsTable(report);
@@ -814,7 +814,8 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
       "placeholder=\"filter: fixture, backend, status...\"><select id=\"status-filter\">"
       "<option value=\"\">all statuses</option><option value=\"not-pass\">not pass</option>"
       "<option value=\"pass\">pass</option><option value=\"warn\">warn</option>"
-      "<option value=\"fail\">fail</option><option value=\"error\">error</option></select>"
+      "<option value=\"fail\">fail</option><option value=\"error\">error</option>"
+      "<option value=\"not_supported\">not supported</option></select>"
       "<select id=\"backend-filter\"><option value=\"\">all backends</option>";
   for (std::size_t b = 0; b < columns.names.size(); ++b)
     out += fmt::format("<option value=\"{}\">{}</option>", b, esc(columns.names[b]));
@@ -861,7 +862,7 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
   for (std::size_t k = 0; k < report.results.size(); ++k) {
     const PairResult& r = report.results[k];
     nlohmann::json classes = nlohmann::json::array();
-    if (r.status != Status::Error) {
+    if (r.status != Status::Error && r.status != Status::NotSupported) {
       if (r.visibility.status != Status::Pass) classes.push_back("visibility");
       if (r.depth.status != Status::Pass) classes.push_back("depth");
       if (r.shading.status != Status::Pass) classes.push_back("shading");
@@ -870,7 +871,7 @@ std::string reportHtml(const Report& report, const fs::path& report_dir) {
     for (const std::string& t : r.tags)
       tag_ids.push_back(std::find(tags.begin(), tags.end(), t) - tags.begin());
     nlohmann::json numbers;
-    if (r.status != Status::Error)
+    if (r.status != Status::Error && r.status != Status::NotSupported)
       numbers = {r.visibility.hard,        r.visibility.ambiguous,       r.visibility.missing,
                  r.visibility.extra,       r.visibility.wrong_primitive, jnum(r.depth.max_steps),
                  jnum(r.depth.p99_steps),  r.depth.over_tolerance,       jnum(r.shading.max_abs),

@@ -60,7 +60,8 @@ std::string junitXml(const Report& report) {
   suite.append_attribute("tests") = static_cast<unsigned long long>(s.total());
   suite.append_attribute("failures") = static_cast<unsigned long long>(s.fail - s.known_fail);
   suite.append_attribute("errors") = static_cast<unsigned long long>(s.error);
-  suite.append_attribute("skipped") = static_cast<unsigned long long>(s.known_fail);
+  suite.append_attribute("skipped") =
+      static_cast<unsigned long long>(s.known_fail + s.not_supported);
   suite.append_attribute("time") = fmt::format("{:.6f}", total_seconds).c_str();
   pugi::xml_node props = suite.append_child("properties");
   pugi::xml_node version = props.append_child("property");
@@ -78,6 +79,12 @@ std::string junitXml(const Report& report) {
     tc.append_attribute("name") = fmt::format("{} vs {}", r.expected, r.actual).c_str();
     tc.append_attribute("time") = fmt::format("{:.6f}", r.seconds).c_str();
     switch (r.status) {
+      case Status::NotSupported: {
+        pugi::xml_node k = tc.append_child("skipped");
+        k.append_attribute("type") = "not supported";
+        k.append_attribute("message") = ("not supported: " + r.error).c_str();
+        break;
+      }
       case Status::Error: {
         pugi::xml_node e = tc.append_child("error");
         e.append_attribute("message") = r.error.c_str();

@@ -131,6 +131,9 @@ ReportSummary Report::summary() const {
       case Status::Error:
         ++s.error;
         break;
+      case Status::NotSupported:
+        ++s.not_supported;
+        break;
     }
   }
   return s;
@@ -158,10 +161,11 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
   }
   if (!r.fixture_file.empty()) j["fixture_file"] = r.fixture_file;
   if (!r.tags.empty()) j["tags"] = r.tags;
-  if (r.status == Status::Error) {
-    // The contract's shape with nothing compared: every class "error", zero counts.
-    const char* e = toString(Status::Error);
-    j["error"] = r.error;
+  if (r.status == Status::Error || r.status == Status::NotSupported) {
+    // The contract's shape with nothing compared: every class "error" (or
+    // "not_supported"), zero counts.
+    const char* e = toString(r.status);
+    j[r.status == Status::Error ? "error" : "not_supported"] = r.error;
     j["visibility"] = {{"status", e},  {"mismatched", 0}, {"ambiguous", 0},      {"hard", 0},
                        {"missing", 0}, {"extra", 0},      {"wrong_primitive", 0}};
     j["depth"] = {{"status", e},    {"compared", 0},       {"max_steps", 0},  {"mean_steps", 0},
@@ -248,6 +252,11 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
                   {"worst_abs", s.worst.valid() ? num(s.worst_abs) : json(nullptr)},
                   {"worst_allowance", s.worst.valid() ? num(s.worst_allowance) : json(nullptr)},
                   {"histogram", histogram(s.histogram, s.max_abs, "8-bit units")}};
+  if (v.samples > 1) {  // multisampled: pixels count as mismatched when any sample differs
+    j["visibility"]["samples"] = v.samples;
+    j["visibility"]["mismatched_samples"] = v.mismatched_samples;
+    j["shading"]["depth_tied"] = s.depth_tied;
+  }
   j["nonfinite"] = {{"expected", nonfinite(r.nonfinite_expected)},
                     {"actual", nonfinite(r.nonfinite_actual)}};
   // Additive blocks kept in their own modules (compare/oit.h, compare/flip.h).
@@ -274,6 +283,7 @@ json toJson(const Report& report, const fs::path& report_dir) {
               {"warn", s.warn},
               {"fail", s.fail},
               {"error", s.error},
+              {"not_supported", s.not_supported},
               {"known_fail", s.known_fail},
               {"total", s.total()}}},
             {"exit_code", exitCodeFor(report)}};
@@ -289,6 +299,7 @@ std::string describe(const PairResult& r) {
   if (!r.known.empty()) status = "KNOWN FAIL";
   std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
   if (r.status == Status::Error) return head + ": " + r.error;
+  if (r.status == Status::NotSupported) return head + ": " + r.error;
   if (!r.known.empty()) {
     std::vector<std::string> ids;
     for (const KnownFailure& k : r.known) ids.push_back(k.id);

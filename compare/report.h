@@ -21,8 +21,9 @@ struct ReportSummary {
   std::uint64_t warn = 0;
   std::uint64_t fail = 0;
   std::uint64_t error = 0;
-  std::uint64_t known_fail = 0;  // of `fail`, those an expectation covers
-  std::uint64_t total() const { return pass + warn + fail + error; }
+  std::uint64_t known_fail = 0;     // of `fail`, those an expectation covers
+  std::uint64_t not_supported = 0;  // the backend cannot render the fixture: no verdict
+  std::uint64_t total() const { return pass + warn + fail + error + not_supported; }
 };
 
 struct Report {

@@ -68,7 +68,7 @@ std::optional<PixelRef> ReportReader::pixel(const json& j, const char* key,
 Status ReportReader::status(const json& j, const char* key, const std::string& path) const {
   if (!j.is_object() || !j.contains(key)) return Status::Pass;
   const std::string s = text(j, key, path);
-  for (Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error})
+  for (Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported})
     if (s == toString(st)) return st;
   fail(path + "." + key, fmt::format("unknown status \"{}\"", s));
 }
@@ -159,10 +159,11 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
                          r.text(known[k], "reason", kat)});
     }
   }
-  if (p.status == Status::Error) {
-    p.error = row.contains("error") && row["error"].is_string() ? row["error"].get<std::string>()
-                                                                : std::string();
-    p.visibility.status = p.depth.status = p.shading.status = Status::Error;
+  if (p.status == Status::Error || p.status == Status::NotSupported) {
+    const char* why = p.status == Status::Error ? "error" : "not_supported";
+    p.error =
+        row.contains(why) && row[why].is_string() ? row[why].get<std::string>() : std::string();
+    p.visibility.status = p.depth.status = p.shading.status = p.status;
     return p;
   }
   p.width = static_cast<int>(r.number(row, "width", at));
@@ -219,6 +220,10 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
   vs.worst = r.pixel(v, "worst", vat).value_or(PixelRef{});
   vs.worst_edge_dist = finiteOr(r, v, "worst_edge_dist", vat, vs.worst.valid(),
                                 std::numeric_limits<double>::infinity());
+  if (v.contains("samples")) {  // multisampled pairs (report.cpp writes them when > 1)
+    vs.samples = static_cast<int>(r.count(v, "samples", vat));
+    vs.mismatched_samples = r.count(v, "mismatched_samples", vat);
+  }
 
   const std::string dat = at + ".depth";
   const json& d = r.member(row, "depth", at);
@@ -255,6 +260,7 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
   ss.nonfinite = r.count(s, "nonfinite", sat);
   ss.texel_choice = r.count(s, "texel_choice", sat);
   ss.blend_uncertain = r.count(s, "blend_uncertain", sat);
+  if (s.contains("depth_tied")) ss.depth_tied = r.count(s, "depth_tied", sat);
   if (s.contains("max_abs_rgba") && s["max_abs_rgba"].is_array() && s["max_abs_rgba"].size() == 4) {
     for (std::size_t c = 0; c < 4; ++c)
       ss.max_abs_rgba[c] =

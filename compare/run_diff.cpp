@@ -198,8 +198,8 @@ std::string runDiffText(const RunDiff& diff) {
   out += "\nPer class, pairs in both runs (verdict transitions; pixels before -> after):\n";
   for (std::size_t c = 0; c < kDiffClasses.size(); ++c) {
     std::vector<std::string> moves;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
+    for (int a = 0; a < kStatusCount; ++a)
+      for (int b = 0; b < kStatusCount; ++b)
         if (a != b && diff.transitions[c][a][b] > 0)
           moves.push_back(fmt::format("{} {} -> {}", diff.transitions[c][a][b],
                                       toString(static_cast<Status>(a)),
@@ -223,8 +223,8 @@ nlohmann::json runDiffJson(const RunDiff& diff) {
   nlohmann::json classes = nlohmann::json::object();
   for (std::size_t c = 0; c < kDiffClasses.size(); ++c) {
     nlohmann::json t = nlohmann::json::object();
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
+    for (int a = 0; a < kStatusCount; ++a)
+      for (int b = 0; b < kStatusCount; ++b)
         if (diff.transitions[c][a][b] > 0)
           t[fmt::format("{}->{}", toString(static_cast<Status>(a)),
                         toString(static_cast<Status>(b)))] = diff.transitions[c][a][b];
@@ -300,8 +300,8 @@ th{background:#f0f0f0}td.n{text-align:right;font-variant-numeric:tabular-nums}
       "runs)</th><th>pixels before</th><th>pixels after</th></tr>";
   for (std::size_t c = 0; c < kDiffClasses.size(); ++c) {
     std::vector<std::string> moves;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
+    for (int a = 0; a < kStatusCount; ++a)
+      for (int b = 0; b < kStatusCount; ++b)
         if (a != b && diff.transitions[c][a][b] > 0)
           moves.push_back(fmt::format("{} {} &rarr; {}", diff.transitions[c][a][b],
                                       badge(static_cast<Status>(a)),

@@ -48,7 +48,7 @@ struct RunDiff {
   std::vector<PairDiff> pairs;  // every pair of either run: the old run's order, then new ones
   std::size_t count(PairDiff::Kind kind) const;
   // Pairs in both runs whose class c went from status a to status b: transitions[c][a][b].
-  std::array<std::array<std::array<std::uint64_t, 4>, 4>, 3> transitions{};
+  std::array<std::array<std::array<std::uint64_t, kStatusCount>, kStatusCount>, 3> transitions{};
   // Pixels of class c summed over the pairs in both runs, before and after.
   std::array<std::array<std::uint64_t, 2>, 3> pixels{};
 };

@@ -21,11 +21,17 @@ const char* toString(Status status) {
       return "fail";
     case Status::Error:
       return "error";
+    case Status::NotSupported:
+      return "not_supported";
   }
   return "?";
 }
 
-Status worse(Status a, Status b) { return static_cast<int>(a) >= static_cast<int>(b) ? a : b; }
+Status worse(Status a, Status b) {
+  if (a == Status::NotSupported) return b;  // never a class's status: no order to keep
+  if (b == Status::NotSupported) return a;
+  return static_cast<int>(a) >= static_cast<int>(b) ? a : b;
+}
 
 Status Thresholds::verdict(double measure) const {
   if (std::isnan(measure) || measure > fail) return Status::Fail;

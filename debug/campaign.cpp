@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "compare/report_text.h"
 #include "fixtures/errors.h"
 
 namespace rc {
@@ -107,29 +108,6 @@ std::uint32_t fnv1a(const std::string& s) {
     h *= 16777619u;
   }
   return h;
-}
-
-std::string html(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
 }
 
 // Markdown table cells: no '|' or newline inside.
@@ -567,23 +545,24 @@ std::string indexHtml(const CampaignSummary& s, const std::vector<CampaignGroup>
     std::string examples;
     for (std::size_t i = 0; i < g.failures.size() && i < 5; ++i) {
       const CampaignFailure& f = *g.failures[i];
-      examples += f.images.empty()
-                      ? html(f.fixture)
-                      : fmt::format("<a href=\"{}\">{}</a>", html(f.images), html(f.fixture));
+      examples += f.images.empty() ? htmlEscape(f.fixture)
+                                   : fmt::format("<a href=\"{}\">{}</a>", htmlEscape(f.images),
+                                                 htmlEscape(f.fixture));
       examples += "<br>";
     }
     page += fmt::format(
         "<tr><td>{}</td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>\n", g.id,
-        html(g.signature), g.failures.size(),
+        htmlEscape(g.signature), g.failures.size(),
         files.reproducer.empty()
             ? std::string("none")
-            : fmt::format("<a href=\"{}\">{}</a><br><code>{}</code>", html(files.reproducer),
-                          html(files.reproducer), html(files.command)),
+            : fmt::format("<a href=\"{}\">{}</a><br><code>{}</code>", htmlEscape(files.reproducer),
+                          htmlEscape(files.reproducer), htmlEscape(files.command)),
         examples);
   }
   page += "</table>\n<h2>Runs</h2>\n<ul>\n";
   for (const std::string& r : s.runs)
-    page += fmt::format("<li><a href=\"{}/report.html\">{}</a></li>\n", html(r), html(r));
+    page +=
+        fmt::format("<li><a href=\"{}/report.html\">{}</a></li>\n", htmlEscape(r), htmlEscape(r));
   page += "</ul>\n</body></html>\n";
   return page;
 }

@@ -88,7 +88,12 @@ namespace rc::gl {
   X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                                   \
   X(PFNGLTEXPARAMETERIPROC, TexParameteri)                                             \
   X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                           \
-  X(PFNGLDRAWARRAYSPROC, DrawArrays)
+  X(PFNGLDRAWARRAYSPROC, DrawArrays)                                                   \
+  X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)                                         \
+  X(PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC, RenderbufferStorageMultisample)           \
+  X(PFNGLTEXIMAGE2DMULTISAMPLEPROC, TexImage2DMultisample)                             \
+  X(PFNGLFRAMEBUFFERTEXTURE2DPROC, FramebufferTexture2D)                               \
+  X(PFNGLGETMULTISAMPLEFVPROC, GetMultisamplefv)
 
 struct Functions {
 #define RC_GL_DECLARE(type, name) type name = nullptr;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -25,6 +26,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "fixtures/errors.h"
+#include "fixtures/multisample.h"
 #include "fixtures/scene_logic.h"
 #include "gl_backend/context.h"
 #include "gl_backend/gl_backend.h"
@@ -170,6 +172,8 @@ struct Session {
   std::vector<std::string> debug_errors;    // KHR_debug error messages since the last check
   Framebuffer framebuffer;
   Scratch scratch;
+  GLuint sample_program = 0;  // reads one sample of the ids / depth (multisampled renders)
+  GLuint empty_vertex_array = 0;
 };
 
 std::mutex g_mutex;
@@ -304,6 +308,8 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
 // before (rgba8 with blending: 5 of 120 random scenes; docs/gl_backend.md).
 void renewContext(Session& s) {
   s.programs.clear();  // their objects go with the old context
+  s.sample_program = 0;
+  s.empty_vertex_array = 0;
   s.framebuffer = Framebuffer{};
   s.debug_errors.clear();
   s.context->renew();
@@ -837,6 +843,188 @@ void readBack(Session& s, const Scene& scene, Frame& frame) {
   if (inverted) gl.PixelStorei(GL_PACK_INVERT_MESA, GL_FALSE);
 }
 
+// ---- multisampling ---------------------------------------------------------------------
+// A multisampled scene draws into `framebuffer` here: colour in a multisample renderbuffer,
+// ids (R32UI) and depth in multisample textures so that a shader can read every sample
+// (glBlitFramebuffer gives one sample of an integer buffer and an implementation-defined
+// mix of the depth samples). The colour resolves into the single-sample FBO by
+// glBlitFramebuffer (the driver's own resolve, what applications get); the ids and depth
+// of each sample are copied, one sample per pass, into the single-sample FBO's R32UI
+// attachment and read back (depth as its stored integer for d16/d24, its bits for d32f).
+
+// The samples this driver can give every attachment a multisampled render uses.
+int maxUsableSamples(const gl::Functions& gl) {
+  return std::min({glInteger(gl, GL_MAX_SAMPLES), glInteger(gl, GL_MAX_COLOR_TEXTURE_SAMPLES),
+                   glInteger(gl, GL_MAX_DEPTH_TEXTURE_SAMPLES),
+                   glInteger(gl, GL_MAX_INTEGER_SAMPLES)});
+}
+
+struct MultisampleTargets {
+  const gl::Functions& gl;
+  GLuint framebuffer = 0;
+  GLuint color = 0;             // renderbuffer
+  GLuint textures[2] = {0, 0};  // ids, depth
+  explicit MultisampleTargets(const gl::Functions& functions) : gl(functions) {}
+  MultisampleTargets(const MultisampleTargets&) = delete;
+  MultisampleTargets& operator=(const MultisampleTargets&) = delete;
+  ~MultisampleTargets() {
+    if (framebuffer != 0) gl.DeleteFramebuffers(1, &framebuffer);
+    if (color != 0) gl.DeleteRenderbuffers(1, &color);
+    gl.DeleteTextures(2, textures);
+    gl.GetError();
+  }
+};
+
+void createMultisampleTargets(Session& s, const Scene& scene, MultisampleTargets& t) {
+  const gl::Functions& gl = s.gl;
+  const int samples = scene.state.samples;
+  gl.GenFramebuffers(1, &t.framebuffer);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+  gl.GenRenderbuffers(1, &t.color);
+  gl.BindRenderbuffer(GL_RENDERBUFFER, t.color);
+  gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples,
+                                    colorFormat(scene.state.color_format).internal, scene.width,
+                                    scene.height);
+  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.color);
+  gl.GenTextures(2, t.textures);
+  const GLenum internal[2] = {GL_R32UI, depthFormat(scene.state.depth_format).internal};
+  const GLenum attachment[2] = {GL_COLOR_ATTACHMENT1, GL_DEPTH_ATTACHMENT};
+  for (int i = 0; i < 2; ++i) {
+    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.textures[i]);
+    gl.TexImage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, samples, internal[i], scene.width,
+                             scene.height, GL_TRUE);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, attachment[i], GL_TEXTURE_2D_MULTISAMPLE, t.textures[i],
+                            0);
+  }
+  gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, 0);
+  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    throw BackendError(fmt::format("multisampled framebuffer incomplete: {} ({} samples)",
+                                   framebufferStatusName(status), samples));
+  const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl.DrawBuffers(2, draw_buffers);
+  checkGl(s, "multisampled framebuffer setup");
+}
+
+// The program that copies sample u_sample of the ids (u_what 0) or of the depth (u_what
+// 1: the stored integer of d16/d24 as round(d * (2^b - 1)), the bits of d32f) to the
+// R32UI attachment. A full-screen triangle from gl_VertexID (no vertex buffer).
+GLuint sampleProgram(Session& s) {
+  if (s.sample_program != 0) return s.sample_program;
+  const gl::Functions& gl = s.gl;
+  const std::string vertex = R"(#version 330 core
+void main() {
+  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+  const std::string fragment = R"(#version 330 core
+uniform usampler2DMS u_ids;
+uniform sampler2DMS u_depth;
+uniform int u_sample;
+uniform int u_what;
+uniform float u_depth_scale;  // 2^b - 1; 0: d32f
+layout(location = 1) out uint o_value;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  if (u_what == 0) {
+    o_value = texelFetch(u_ids, p, u_sample).r;
+  } else {
+    float d = texelFetch(u_depth, p, u_sample).r;
+    o_value = u_depth_scale > 0.0 ? uint(floor(d * u_depth_scale + 0.5)) : floatBitsToUint(d);
+  }
+}
+)";
+  const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, vertex);
+  const GLuint fs = compileShader(gl, GL_FRAGMENT_SHADER, fragment);
+  const GLuint id = gl.CreateProgram();
+  gl.AttachShader(id, vs);
+  gl.AttachShader(id, fs);
+  gl.LinkProgram(id);
+  gl.DeleteShader(vs);
+  gl.DeleteShader(fs);
+  GLint ok = GL_FALSE;
+  gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    gl.DeleteProgram(id);
+    throw BackendError("the sample readback program does not link");
+  }
+  s.sample_program = id;
+  gl.GenVertexArrays(1, &s.empty_vertex_array);
+  return id;
+}
+
+// After the draw into `t`: resolves the colour into the bound single-sample FBO, reads it,
+// then every sample's id and depth, and fills frame's multisample planes and resolve.
+void readBackMultisample(Session& s, const Scene& scene, MultisampleTargets& t, Frame& frame) {
+  const gl::Functions& gl = s.gl;
+  const int w = scene.width;
+  const int h = scene.height;
+  const int samples = scene.state.samples;
+  const GLuint single = s.framebuffer.framebuffer;
+  gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.framebuffer);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, single);
+  const GLenum color_only[2] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+  gl.DrawBuffers(2, color_only);  // a float blit into the R32UI attachment is an error
+  gl.BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  checkGl(s, "multisample resolve");
+  gl.BindFramebuffer(GL_FRAMEBUFFER, single);
+  readBack(s, scene, frame);  // the resolved colour (id and depth are replaced below)
+
+  const GLuint program = sampleProgram(s);
+  const GLenum ids_only[2] = {GL_NONE, GL_COLOR_ATTACHMENT1};
+  gl.DrawBuffers(2, ids_only);
+  gl.Disable(GL_DEPTH_TEST);
+  gl.Disable(GL_MULTISAMPLE);
+  gl.Disablei(GL_BLEND, 0);
+  gl.Disable(GL_CULL_FACE);
+  gl.UseProgram(program);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.textures[0]);
+  gl.ActiveTexture(GL_TEXTURE1);
+  gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.textures[1]);
+  gl.Uniform1i(gl.GetUniformLocation(program, "u_ids"), 0);
+  gl.Uniform1i(gl.GetUniformLocation(program, "u_depth"), 1);
+  const int bits = depthBits(scene.state.depth_format);
+  const double steps = bits == 0 ? 0.0 : std::ldexp(1.0, bits) - 1.0;
+  gl.Uniform1f(gl.GetUniformLocation(program, "u_depth_scale"), static_cast<float>(steps));
+  gl.BindVertexArray(s.empty_vertex_array);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  frame.samples = samples;
+  frame.sample_id.resize(n * samples);
+  frame.sample_depth.resize(n * samples);
+  std::vector<std::uint32_t> raw(n);
+  for (int k = 0; k < samples; ++k) {
+    gl.Uniform1i(gl.GetUniformLocation(program, "u_sample"), k);
+    for (int what = 0; what < 2; ++what) {
+      gl.Uniform1i(gl.GetUniformLocation(program, "u_what"), what);
+      gl.DrawArrays(GL_TRIANGLES, 0, 3);
+      readRows(gl, false, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, raw.data(),
+               static_cast<std::size_t>(w) * 4);
+      const std::size_t at = static_cast<std::size_t>(k) * n;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (what == 0) {
+          frame.sample_id[at + i] = raw[i];
+        } else {
+          frame.sample_depth[at + i] =
+              bits == 0 ? std::bit_cast<float>(raw[i]) : static_cast<float>(raw[i] / steps);
+        }
+      }
+    }
+  }
+  gl.BindVertexArray(0);
+  gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, 0);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, 0);
+  gl.UseProgram(0);
+  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl.DrawBuffers(2, both);
+  resolveSampleOwners(frame);
+}
+
 // Lights cost 5 vec4 slots each in the worst packing; the rest of the uniforms fit in 16.
 constexpr int kSlotsPerLight = 5;
 constexpr int kOtherSlots = 16;
@@ -927,8 +1115,39 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
                     "GL_MAX_VIEWPORT_DIMS {}x{})",
                     scene.width, scene.height, max_rb, max_viewport[0], max_viewport[1]));
   }
+  const int max_samples = glInteger(gl, GL_MAX_SAMPLES);
+  const int samples = scene.state.samples;
+  if (samples > 1) {
+    const int usable = maxUsableSamples(gl);
+    if (usable < samples)
+      throw NotSupportedError(fmt::format(
+          "{} samples per pixel: this driver gives at most {} (GL_MAX_SAMPLES {}; colour, depth "
+          "and integer texture limits included)",
+          samples, usable, max_samples));
+  }
   bindFramebuffer(s, scene);
   checkGl(s, "framebuffer setup");
+  MultisampleTargets ms(gl);
+  nlohmann::json multisample;
+  if (samples > 1) {
+    createMultisampleTargets(s, scene, ms);
+    const int given = glInteger(gl, GL_SAMPLES);
+    if (given != samples)
+      throw NotSupportedError(
+          fmt::format("{} samples per pixel: the driver allocates {} for that request (GL_SAMPLES)",
+                      samples, given));
+    nlohmann::json positions = nlohmann::json::array();
+    for (int k = 0; k < samples; ++k) {
+      GLfloat p[2] = {0.0f, 0.0f};
+      gl.GetMultisamplefv(GL_SAMPLE_POSITION, static_cast<GLuint>(k), p);
+      positions.push_back({static_cast<double>(p[0]), static_cast<double>(p[1])});
+    }
+    checkGl(s, "sample positions");
+    multisample = {{"samples", samples},
+                   {"positions", positions},
+                   {"max_samples", max_samples},
+                   {"usable_samples", maxUsableSamples(gl)}};
+  }
   const double framebuffer_ms = msSince(start);
   const double framebuffer_cpu_ms = threadCpuMs() - cpu_start;
 
@@ -952,6 +1171,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   start = Clock::now();
   setFixedState(gl, scene);
   setFaultedBlend(gl, faults);
+  if (samples > 1) gl.Enable(GL_MULTISAMPLE);  // multisample rasterization into `ms`
   clearFramebuffer(gl, scene);
   drawPassesGl(gl, program, scene, data, textures);
   gl.Finish();
@@ -962,7 +1182,11 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   start = Clock::now();
   cpu_start = threadCpuMs();
   Frame frame;
-  readBack(s, scene, frame);
+  if (samples > 1) {
+    readBackMultisample(s, scene, ms, frame);
+  } else {
+    readBack(s, scene, frame);
+  }
   checkGl(s, "readback");
   const double readback_ms = msSince(start);
   const double readback_cpu_ms = threadCpuMs() - cpu_start;
@@ -984,6 +1208,8 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
     m["vulkan"] = s.vulkan ? gl::toJson(*s.vulkan) : nlohmann::json{{"error", s.vulkan_error}};
     m["vulkan"]["query_ms"] = s.vulkan_query_ms;
   }
+  m["max_samples"] = max_samples;  // GL_MAX_SAMPLES
+  if (samples > 1) m["multisample"] = multisample;
   m["skipped_triangles"] = data.skipped_triangles;
   if (faults.any()) m["fault_injected"] = faults.describe();
   m["timing_ms"] = {
@@ -1002,6 +1228,9 @@ Frame renderGl(const Scene& scene, const GlSpec& spec) {
   try {
     const std::lock_guard lock(g_mutex);
     return renderLocked(scene, spec);
+  } catch (const NotSupportedError& e) {
+    throw NotSupportedError(
+        fmt::format("not supported: {}: {}: {}", name, toString(spec), e.what()));
   } catch (const BackendError& e) {
     throw BackendError(fmt::format("{}: {}: {}", name, toString(spec), e.what()));
   } catch (const std::bad_alloc&) {

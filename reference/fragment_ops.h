@@ -12,6 +12,7 @@
 // (q itself, or the bits of a non-negative float), so the test is one integer compare.
 #pragma once
 
+#include <array>
 #include <bit>
 #include <cstdint>
 
@@ -53,10 +54,20 @@ inline double clampUnit(double c) {
   return c < 1.0 ? c : 1.0;
 }
 
-// The value a colour channel is stored as.
+// float(q / 255.0) for q = 0..255: the stored rgba8 values, so that storing a channel
+// needs no division. The compiler evaluates each entry with the same IEEE operations
+// (one correctly rounded division, one correctly rounded conversion) as the expression
+// it replaces; Determinism.GoldenFrames holds the frames to it.
+inline constexpr auto kStoredUnorm8 = [] {
+  std::array<float, 256> table{};
+  for (int q = 0; q < 256; ++q) table[q] = static_cast<float>(q / 255.0);
+  return table;
+}();
+
+// The value a colour channel is stored as: for rgba8, float(round(clamp(c) * 255) / 255).
 inline float storeColor(double c, ColorFormat format) {
   if (format == ColorFormat::RGBA32F) return static_cast<float>(c);
-  return static_cast<float>(roundHalfEvenNonNegative(clampUnit(c) * 255.0) / 255.0);
+  return kStoredUnorm8[static_cast<int>(roundHalfEvenNonNegative(clampUnit(c) * 255.0))];
 }
 
 // The exact stored value, read back for blending (for rgba8 the float holds q / 255

@@ -34,6 +34,7 @@ class FragmentInterpolator {
     double z = 0.0;
     double inv_w = 0.0;
     double num[3] = {0.0, 0.0, 0.0};
+    double w = 0.0;  // 1 / inv_w: barycentricAt()'s quotient wherever the plane is flat in x
   };
   Row row(double y) const {
     const double dy = y - y0_;
@@ -41,6 +42,7 @@ class FragmentInterpolator {
     r.z = z_.rowPart(dy);
     r.inv_w = inv_w_.rowPart(dy);
     for (int k = 0; k < 3; ++k) r.num[k] = num_[k].rowPart(dy);
+    r.w = 1.0 / r.inv_w;
     return r;
   }
   Row depthRow(double y) const {  // only Row::z
@@ -51,10 +53,17 @@ class FragmentInterpolator {
   double dx(double x) const { return x - x0_; }
   double depthAt(const Row& r, double dx) const { return r.z + z_.ddx * dx; }
   glm::dvec3 barycentricAt(const Row& r, double dx) const {
-    const double inv = 1.0 / (r.inv_w + inv_w_.ddx * dx);
+    // The row's quotient where the denominator equals the row's (always, for an affine
+    // camera: inv_w_.ddx is +-0): the same division of the same operands.
+    const double den = r.inv_w + inv_w_.ddx * dx;
+    const double inv = den == r.inv_w && den != 0.0 ? r.w : 1.0 / den;
     return glm::dvec3((r.num[0] + num_[0].ddx * dx) * inv, (r.num[1] + num_[1].ddx * dx) * inv,
                       (r.num[2] + num_[2].ddx * dx) * inv);
   }
+
+  // Moves the depth plane by (ox, oy) px: depth at (x, y) is then the plane's value at
+  // (x + ox, y + oy) (multisampling: depth at the sample, attributes at the centre).
+  void shiftDepth(double ox, double oy) { z_.at_ref += z_.ddx * ox + z_.ddy * oy; }
 
   // Depth gradient magnitude |grad z| of the plane (window-z units per px).
   double depthSlope() const { return std::hypot(z_.ddx, z_.ddy); }

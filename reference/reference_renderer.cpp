@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "fixtures/errors.h"
+#include "fixtures/multisample.h"
 #include "fixtures/scene_logic.h"
 #include "reference/clipper.h"
 #include "reference/fragment_ops.h"
@@ -122,6 +123,23 @@ struct KeptFragment {
   TexelNote note;
 };
 
+// What the A-buffer's resolve found, per frame (or summed over the samples of a
+// multisampled render, pixels counted once however many of their samples show it).
+struct ABufferTally {
+  static constexpr std::uint8_t kBlended = 1;   // the pixel holds blended fragments
+  static constexpr std::uint8_t kUnsorted = 2;  // ... and the draw order is not depth order
+  struct PairPixel {
+    std::uint32_t near = 0;   // nearer, but drawn first
+    std::uint32_t far = 0;    // farther, but drawn after it
+    std::uint32_t index = 0;  // pixel, framebuffer order
+    auto operator<=>(const PairPixel&) const = default;
+  };
+  std::vector<std::uint8_t> pixel_flags;  // per pixel
+  std::vector<PairPixel> pair_pixels;     // each (pair, pixel) once
+  std::uint64_t kept_fragments = 0;
+};
+nlohmann::json abufferMeta(ABufferTally& tally, const PixelRect& clip, int image_height);
+
 // Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
 // a pixel; transformed vertices: 96 bytes each, Gouraud colours: 48), kept per thread
 // between renders so that rendering many frames does not page-fault fresh memory each
@@ -130,6 +148,7 @@ struct KeptFragment {
 struct Scratch {
   std::vector<std::uint32_t> depth;
   UncertaintyTracker gaps;
+  EdgeDistanceBatch edges;  // the polygons' edge_dist work, applied at the end of the frame
   std::vector<std::vector<TransformedVertex>> vertices;  // per object
   std::vector<std::vector<LitColor>> gouraud;            // per object, Gouraud only
 };
@@ -137,12 +156,25 @@ thread_local Scratch t_scratch;
 constexpr std::size_t kMaxKeptScratchPixels = std::size_t{1} << 22;
 constexpr std::size_t kMaxKeptScratchVertices = std::size_t{1} << 20;
 
+// One sample of a multisampled render: every pixel's coverage and depth are decided at
+// its centre + offset (px) instead of its centre. The snapped vertices move by the
+// offset rounded to the subpixel grid (exact for the standard patterns at >= 4 bits:
+// they are multiples of 1/16), as a rasterizer that snaps once and evaluates its edge
+// functions at the sample does; the depth plane and edge_dist use the exact offset.
+struct SampleShift {
+  bool active = false;
+  glm::dvec2 offset{0.0};  // sample position - (0.5, 0.5), px
+  std::int64_t units_x = 0;
+  std::int64_t units_y = 0;
+};
+
 class Renderer {
  public:
   // Renders into a framebuffer covering `clip` (GL window coordinates): the whole image,
   // or one pixel when trace is non-null.
   Renderer(const Scene& scene, const ReferenceOptions& options, const PixelRect& clip,
-           std::vector<FragmentTrace>* trace, std::vector<SortedFragment>* sorted = nullptr)
+           std::vector<FragmentTrace>* trace, const SampleShift& shift = {},
+           std::vector<SortedFragment>* sorted = nullptr)
       : scene_(scene),
         options_(options),
         clip_(clip),
@@ -162,12 +194,16 @@ class Renderer {
         vertices_(t_scratch.vertices),
         gouraud_(t_scratch.gouraud),
         depth_(t_scratch.depth),
-        gaps_(t_scratch.gaps) {
+        gaps_(t_scratch.gaps),
+        edges_(t_scratch.edges),
+        shift_(shift) {
     shading_.reserve(scene.materials.size());
     for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
   }
 
   Frame run();
+  // ref:abuffer, after run(): what the resolve found (renderMultisample() joins them).
+  ABufferTally& abufferTally() { return abuffer_; }
 
  private:
   void transformVertices();
@@ -175,6 +211,8 @@ class Renderer {
   void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
                    int count);
   void prepareTriangle(TriangleContext& t) const;
+  __attribute__((noinline)) void addSampleEdgeDistances(const WindowVertex* wv, int count,
+                                                        const double* reach);
   void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
                 const FragmentInterpolator& interp);
   template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
@@ -223,11 +261,13 @@ class Renderer {
   Frame frame_;                        // colour, id, edge_dist over the clip rectangle
   std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
   UncertaintyTracker& gaps_;           // scratch
+  EdgeDistanceBatch& edges_;           // scratch
+  const SampleShift shift_;            // multisampling: the sample drawn
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
   std::vector<KeptFragment> kept_;     // A-buffer: blended fragments, in draw order
   std::uint32_t blend_seq_ = 0;        // triangles of blending passes drawn so far
-  nlohmann::json abuffer_meta_;        // frame.json "abuffer"
+  ABufferTally abuffer_;               // A-buffer: what the resolve found
 };
 
 void Renderer::transformVertices() {
@@ -259,6 +299,7 @@ Frame Renderer::run() {
                   static_cast<float>(storedDepth(clear_key, depth_format_)), uncertainty_);
   depth_.assign(frame_.pixelCount(), clear_key);
   if (uncertainty_) gaps_.reset(frame_, depth_format_, clampDepth(scene_.clear_depth));
+  edges_.clear();
 
   transformVertices();
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter)) {
@@ -268,7 +309,10 @@ Frame Renderer::run() {
     }
   }
   if (options_.abuffer) resolveABuffer();
-  if (uncertainty_) gaps_.finish(frame_);
+  if (uncertainty_) {
+    edges_.apply(clip_, fb_width_, fb_height_, frame_.edge_dist.data());
+    gaps_.finish(frame_);
+  }
 
   // Stored depth back to [0, 1] (one simple loop per format, so that it vectorizes).
   const std::size_t n = frame_.pixelCount();
@@ -280,6 +324,7 @@ Frame Renderer::run() {
   }
   if (depth_.capacity() > kMaxKeptScratchPixels) depth_ = {};
   if (gaps_.capacity() > kMaxKeptScratchPixels) gaps_.release();
+  if (edges_.capacity() > kMaxKeptScratchPixels) edges_.release();
   std::size_t kept_vertices = 0;
   for (const auto& v : vertices_) kept_vertices += v.capacity();
   if (kept_vertices > kMaxKeptScratchVertices) {
@@ -294,7 +339,8 @@ Frame Renderer::run() {
                  {"triangles_rasterized", triangles_drawn_},
                  {"fragments", fragments_},
                  {"timing_ms", {{"render", ms}}}};
-  if (options_.abuffer) frame_.meta["abuffer"] = std::move(abuffer_meta_);
+  if (options_.abuffer && !shift_.active)
+    frame_.meta["abuffer"] = abufferMeta(abuffer_, clip_, scene_.height);
   return std::move(frame_);
 }
 
@@ -364,6 +410,10 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     wv[i] = toWindow(poly[i], scene_.width, scene_.height);
     if (!std::isfinite(wv[i].x) || !std::isfinite(wv[i].y) || !std::isfinite(wv[i].z)) return;
     fv[i] = snapVertexScaled(wv[i].x, wv[i].y, snap_scale_);
+    if (shift_.active) {  // the sample position lands on the pixel centre
+      fv[i].x -= shift_.units_x;
+      fv[i].y -= shift_.units_y;
+    }
   }
 
   const bool ccw_is_front = scene_.state.front_face == FrontFace::CCW;
@@ -385,8 +435,13 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     }
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
-    if (rasterized || cullCouldFlip(wv, count, max_reach))
-      addEdgeDistances(wv, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(), reach);
+    if (rasterized || cullCouldFlip(wv, count, max_reach)) {
+      if (shift_.active) {
+        addSampleEdgeDistances(wv, count, reach);
+      } else {
+        edges_.add(wv, count, reach);  // addEdgeDistances(), deferred (EdgeDistanceBatch)
+      }
+    }
   }
 
   TriangleContext t;
@@ -407,6 +462,7 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     FragmentInterpolator interp;
     // A triangle of one stored colour needs no barycentrics (unless traced).
     interp.setup(wv[0], wv[i], wv[i + 1], !t.constant || trace_ != nullptr);
+    if (shift_.active) interp.shiftDepth(shift_.offset.x, shift_.offset.y);
     if (uncertainty_) {
       t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
       t.texel_choice = t.texture != nullptr;
@@ -435,6 +491,18 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     }
     shadeFan(t, coverage, interp);
   }
+}
+
+// Multisampling: edge_dist from the sample position (out of line, so that the
+// single-sample drawPolygon() compiles as it did before multisampling).
+void Renderer::addSampleEdgeDistances(const WindowVertex* wv, int count, const double* reach) {
+  WindowVertex moved[kMaxClipVertices];
+  for (int i = 0; i < count; ++i) {
+    moved[i] = wv[i];
+    moved[i].x -= shift_.offset.x;
+    moved[i].y -= shift_.offset.y;
+  }
+  addEdgeDistances(moved, count, clip_, fb_width_, fb_height_, frame_.edge_dist.data(), reach);
 }
 
 template <Shading kShading>
@@ -783,7 +851,7 @@ void Renderer::traceSpans(const TriangleContext& t, const TriangleCoverage& cove
 // that order through writeColor() (so that where the orders agree the colour is bit for
 // bit the plain reference's), the nearest one as the id. Also the uncertainty channels of
 // that order (UncertaintyTracker::sortedList) and which triangles the draw order blends
-// out of depth order (frame.json "abuffer").
+// out of depth order (abuffer_, for frame.json "abuffer").
 void Renderer::resolveABuffer() {
   defer_blends_ = false;
   std::stable_sort(kept_.begin(), kept_.end(), [](const KeptFragment& a, const KeptFragment& b) {
@@ -791,21 +859,16 @@ void Renderer::resolveABuffer() {
     if (a.z != b.z) return a.z > b.z;
     return a.seq < b.seq;
   });
-  struct PairCount {
-    std::uint64_t pixels = 0;
-    std::uint32_t first = 0;  // pixel index
-  };
-  std::map<std::pair<std::uint32_t, std::uint32_t>, PairCount> pairs;  // (near, far)
-  std::uint64_t blended_pixels = 0;
-  std::uint64_t unsorted_pixels = 0;
+  abuffer_.pixel_flags.assign(frame_.pixelCount(), 0);
+  abuffer_.kept_fragments = kept_.size();
   std::vector<double> z;
   std::vector<float> slope;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> seen;
+  const std::size_t pairs_before = abuffer_.pair_pixels.size();
   for (std::size_t b = 0; b < kept_.size();) {
     std::size_t e = b;
     while (e < kept_.size() && kept_[e].index == kept_[b].index) ++e;
     const std::size_t index = kept_[b].index;
-    ++blended_pixels;
+    abuffer_.pixel_flags[index] |= ABufferTally::kBlended;
     z.clear();
     slope.clear();
     for (std::size_t k = b; k < e; ++k) {
@@ -820,49 +883,235 @@ void Renderer::resolveABuffer() {
     frame_.id[index] = kept_[e - 1].id;
     if (uncertainty_) gaps_.sortedList(index, z.data(), slope.data(), z.size());
     // Inversions: a farther fragment (earlier in the list) drawn after a nearer one.
-    seen.clear();
-    for (std::size_t i = b; i < e; ++i)
-      for (std::size_t j = i + 1; j < e; ++j)
-        if (kept_[i].seq > kept_[j].seq && kept_[i].id != kept_[j].id)
-          seen.emplace_back(kept_[j].id, kept_[i].id);
-    if (!seen.empty()) {
-      ++unsorted_pixels;
-      std::sort(seen.begin(), seen.end());
-      seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
-      for (const auto& p : seen) {
-        PairCount& c = pairs[p];
-        if (c.pixels++ == 0) c.first = static_cast<std::uint32_t>(index);
+    for (std::size_t i = b; i < e; ++i) {
+      for (std::size_t j = i + 1; j < e; ++j) {
+        if (kept_[i].seq > kept_[j].seq && kept_[i].id != kept_[j].id) {
+          abuffer_.pixel_flags[index] |= ABufferTally::kUnsorted;
+          abuffer_.pair_pixels.push_back(
+              {kept_[j].id, kept_[i].id, static_cast<std::uint32_t>(index)});
+        }
       }
     }
     b = e;
   }
-  std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, PairCount>> list(pairs.begin(),
-                                                                                  pairs.end());
+  // Each (pair, pixel) once: pixels come in increasing order, so sorting this frame's
+  // entries keeps them grouped by pair and ordered by pixel within a pair.
+  std::sort(abuffer_.pair_pixels.begin() + static_cast<std::ptrdiff_t>(pairs_before),
+            abuffer_.pair_pixels.end());
+  abuffer_.pair_pixels.erase(
+      std::unique(abuffer_.pair_pixels.begin() + static_cast<std::ptrdiff_t>(pairs_before),
+                  abuffer_.pair_pixels.end()),
+      abuffer_.pair_pixels.end());
+  kept_ = {};
+}
+
+// frame.json "abuffer" from a tally over the framebuffer rectangle `clip` of an image
+// `image_height` rows high: pixel counts, and the out-of-order triangle pairs (most pixels
+// first, ties by ids; each with the first pixel in framebuffer order, image coordinates).
+nlohmann::json abufferMeta(ABufferTally& tally, const PixelRect& clip, int image_height) {
+  std::uint64_t blended_pixels = 0;
+  std::uint64_t unsorted_pixels = 0;
+  for (const std::uint8_t f : tally.pixel_flags) {
+    blended_pixels += (f & ABufferTally::kBlended) != 0 ? 1 : 0;
+    unsorted_pixels += (f & ABufferTally::kUnsorted) != 0 ? 1 : 0;
+  }
+  std::vector<ABufferTally::PairPixel>& pp = tally.pair_pixels;
+  std::sort(pp.begin(), pp.end());
+  pp.erase(std::unique(pp.begin(), pp.end()), pp.end());
+  struct PairCount {
+    std::uint32_t near = 0;
+    std::uint32_t far = 0;
+    std::uint64_t pixels = 0;
+    std::uint32_t first = 0;  // pixel index
+  };
+  std::vector<PairCount> list;
+  for (const ABufferTally::PairPixel& p : pp) {
+    if (list.empty() || list.back().near != p.near || list.back().far != p.far)
+      list.push_back({p.near, p.far, 0, p.index});
+    ++list.back().pixels;
+  }
   std::stable_sort(list.begin(), list.end(),
-                   [](const auto& a, const auto& b) { return a.second.pixels > b.second.pixels; });
+                   [](const PairCount& a, const PairCount& b) { return a.pixels > b.pixels; });
+  const auto width = static_cast<std::uint32_t>(clip.x1 - clip.x0);
   nlohmann::json out = nlohmann::json::array();
   for (std::size_t k = 0; k < list.size() && k < kMaxReportedPairs; ++k) {
-    const std::uint32_t first = list[k].second.first;
-    const int x = clip_.x0 + static_cast<int>(first % static_cast<std::uint32_t>(fb_width_));
-    const int y = (scene_.height - clip_.y1) +
-                  static_cast<int>(first / static_cast<std::uint32_t>(fb_width_));
-    out.push_back({{"near", list[k].first.first},
-                   {"far", list[k].first.second},
-                   {"pixels", list[k].second.pixels},
+    const std::uint32_t first = list[k].first;
+    const int x = clip.x0 + static_cast<int>(first % width);
+    const int y = (image_height - clip.y1) + static_cast<int>(first / width);
+    out.push_back({{"near", list[k].near},
+                   {"far", list[k].far},
+                   {"pixels", list[k].pixels},
                    {"first", {x, y}}});
   }
-  abuffer_meta_ = {{"kept_fragments", kept_.size()},
-                   {"blended_pixels", blended_pixels},
-                   {"unsorted_pixels", unsorted_pixels},
-                   {"out_of_order_pairs", list.size()},
-                   {"out_of_order", std::move(out)}};
-  kept_ = {};
+  return {{"kept_fragments", tally.kept_fragments},
+          {"blended_pixels", blended_pixels},
+          {"unsorted_pixels", unsorted_pixels},
+          {"out_of_order_pairs", list.size()},
+          {"out_of_order", std::move(out)}};
+}
+
+// How each uncertainty channel of a multisampled pixel follows from its samples' (a
+// pixel may differ wherever one of its samples may): the smallest distance or gap, the
+// largest slope, count or colour range.
+constexpr bool kTakeSmallest[kUncertaintyChannels] = {
+    true,   // edge_dist
+    true,   // depth_gap
+    false,  // depth_slope
+    false,  // gap_slope
+    true,   // texel_dist
+    false,  // texel_alt
+    false,  // blend_count
+    true,   // blend_gap
+    false,  // blend_slope
+    true,   // clear_gap
+    false,  // clear_slope
+    false,  // texel_gain
+};
+
+// Multisampling: one render per sample (SampleShift), then the resolve: the colour is the
+// mean of the samples' stored colours (converted to the colour format again), id, depth
+// and coverage by resolveSampleOwners(), the uncertainty channels reduced over the
+// samples (kTakeSmallest), per-sample edge_dist kept, and sample_alt.
+Frame renderMultisample(const Scene& scene, const ReferenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const int samples = scene.state.samples;
+  const bool given = !options.sample_positions.empty();
+  const std::vector<glm::dvec2> positions =
+      given ? options.sample_positions : standardSamplePositions(samples);
+  if (static_cast<int>(positions.size()) != samples)
+    throw InputError(sceneLabel(scene) + ": " + std::to_string(positions.size()) +
+                     " sample positions given for " + std::to_string(samples) + " samples");
+  for (const glm::dvec2& p : positions)
+    if (!(p.x >= 0.0 && p.x <= 1.0 && p.y >= 0.0 && p.y <= 1.0))
+      throw InputError(sceneLabel(scene) + ": sample position outside the pixel [0, 1]^2");
+
+  const double scale = std::ldexp(1.0, options.subpixel_bits);
+  Frame out;
+  std::vector<float> sample_color;  // per sample plane, RGBA
+  std::vector<double> sum;
+  std::uint64_t fragments = 0;
+  std::uint64_t triangles = 0;
+  bool on_grid = true;
+  ABufferTally abuffer;  // ref:abuffer: the samples' resolves joined
+  for (int s = 0; s < samples; ++s) {
+    SampleShift shift;
+    shift.active = true;
+    shift.offset = positions[s] - glm::dvec2(0.5);
+    const double ux = shift.offset.x * scale;
+    const double uy = shift.offset.y * scale;
+    shift.units_x = static_cast<std::int64_t>(roundHalfEven(ux));
+    shift.units_y = static_cast<std::int64_t>(roundHalfEven(uy));
+    on_grid = on_grid && static_cast<double>(shift.units_x) == ux &&
+              static_cast<double>(shift.units_y) == uy;
+    Renderer renderer(scene, options, PixelRect{0, 0, scene.width, scene.height}, nullptr, shift);
+    Frame f = renderer.run();
+    if (options.abuffer) {
+      ABufferTally& t = renderer.abufferTally();
+      if (s == 0) {
+        abuffer = std::move(t);
+      } else {
+        for (std::size_t i = 0; i < t.pixel_flags.size(); ++i)
+          abuffer.pixel_flags[i] |= t.pixel_flags[i];
+        abuffer.pair_pixels.insert(abuffer.pair_pixels.end(), t.pair_pixels.begin(),
+                                   t.pair_pixels.end());
+        abuffer.kept_fragments += t.kept_fragments;
+      }
+    }
+    const std::size_t n = f.pixelCount();
+    fragments += f.meta["fragments"].get<std::uint64_t>();
+    triangles = f.meta["triangles_rasterized"].get<std::uint64_t>();
+    if (s == 0) {
+      out.width = f.width;
+      out.height = f.height;
+      out.samples = samples;
+      out.meta = f.meta;
+      out.sample_id.resize(n * samples);
+      out.sample_depth.resize(n * samples);
+      sample_color.resize(n * 4 * samples);
+      sum.assign(n * 4, 0.0);
+      if (f.hasUncertainty()) {
+        out.sample_edge_dist.resize(n * samples);
+        const auto from = f.uncertainty();
+        const auto to = out.uncertainty();
+        for (int c = 0; c < kUncertaintyChannels; ++c) *to[c] = *from[c];
+      }
+    } else if (f.hasUncertainty()) {
+      const auto from = f.uncertainty();
+      const auto to = out.uncertainty();
+      for (int c = 0; c < kUncertaintyChannels; ++c) {
+        std::vector<float>& dst = *to[c];
+        const std::vector<float>& src = *from[c];
+        for (std::size_t i = 0; i < n; ++i)
+          dst[i] = kTakeSmallest[c] ? std::min(dst[i], src[i]) : std::max(dst[i], src[i]);
+      }
+    }
+    std::copy(f.id.begin(), f.id.end(), out.sample_id.begin() + static_cast<std::ptrdiff_t>(s * n));
+    std::copy(f.depth.begin(), f.depth.end(),
+              out.sample_depth.begin() + static_cast<std::ptrdiff_t>(s * n));
+    std::copy(f.color.begin(), f.color.end(),
+              sample_color.begin() + static_cast<std::ptrdiff_t>(s * n * 4));
+    if (f.hasUncertainty())
+      std::copy(f.edge_dist.begin(), f.edge_dist.end(),
+                out.sample_edge_dist.begin() + static_cast<std::ptrdiff_t>(s * n));
+    for (std::size_t k = 0; k < n * 4; ++k)
+      sum[k] += loadColor(f.color[k], scene.state.color_format);
+  }
+
+  const std::size_t n = out.pixelCount();
+  out.color.resize(n * 4);
+  for (std::size_t k = 0; k < n * 4; ++k)
+    out.color[k] = storeColor(sum[k] / samples, scene.state.color_format);
+  resolveSampleOwners(out);
+  if (out.hasUncertainty()) {
+    // sample_alt: the colour range (8-bit units, any channel) over the samples of the pixel
+    // and its eight neighbours.
+    out.sample_alt.assign(n, 0.0f);
+    const int w = out.width;
+    const int h = out.height;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        float lo[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+        float hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+        for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy) {
+          for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+            const std::size_t j = out.index(xx, yy);
+            for (int s = 0; s < samples; ++s) {
+              const float* c = &sample_color[(static_cast<std::size_t>(s) * n + j) * 4];
+              for (int k = 0; k < 4; ++k) {
+                lo[k] = std::min(lo[k], c[k]);
+                hi[k] = std::max(hi[k], c[k]);
+              }
+            }
+          }
+        }
+        float range = 0.0f;
+        for (int k = 0; k < 4; ++k)
+          if (std::isfinite(hi[k] - lo[k])) range = std::max(range, hi[k] - lo[k]);
+        out.sample_alt[out.index(x, y)] = 255.0f * range;
+      }
+    }
+  }
+  nlohmann::json pos = nlohmann::json::array();
+  for (const glm::dvec2& p : positions) pos.push_back({p.x, p.y});
+  out.meta["fragments"] = fragments;
+  out.meta["triangles_rasterized"] = triangles;
+  out.meta["multisample"] = {{"samples", samples},
+                             {"positions", pos},
+                             {"positions_source", given ? "given" : "standard"},
+                             {"positions_on_grid", on_grid}};
+  if (options.abuffer)
+    out.meta["abuffer"] =
+        abufferMeta(abuffer, PixelRect{0, 0, scene.width, scene.height}, scene.height);
+  out.meta["timing_ms"]["render"] =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
 }
 
 }  // namespace
 
 Frame renderReference(const Scene& scene, const ReferenceOptions& options) {
   validate(scene, options);
+  if (scene.state.samples > 1) return renderMultisample(scene, options);
   Renderer renderer(scene, options, PixelRect{0, 0, scene.width, scene.height}, nullptr);
   return renderer.run();
 }
@@ -892,7 +1141,7 @@ std::vector<SortedFragment> abufferPixel(const Scene& scene, ReferenceOptions op
   const int y = scene.height - 1 - y_image;
   std::vector<FragmentTrace> trace;
   std::vector<SortedFragment> sorted;
-  Renderer renderer(scene, options, PixelRect{x, y, x + 1, y + 1}, &trace, &sorted);
+  Renderer renderer(scene, options, PixelRect{x, y, x + 1, y + 1}, &trace, SampleShift{}, &sorted);
   renderer.run();
   return sorted;
 }

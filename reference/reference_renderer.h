@@ -7,7 +7,12 @@
 // the uncertainty channels (edge_dist, depth_gap) alongside. Single-threaded and
 // bit-identical on every run and build type.
 //
-// It does not: multisample, mipmap, clamp depth, do two-sided lighting, run shaders,
+// Multisampling (scene.state.samples > 1) renders the scene once per sample with the
+// rasterizer and the depth plane moved to that sample position, the colour shaded at
+// the pixel centre (GL without sample shading), and resolves (reference/multisample
+// notes in docs/reference.md "Multisampling").
+//
+// It does not: sample-shade, mipmap, clamp depth, do two-sided lighting, run shaders,
 // or clip against the viewport (the bounding box does that; the guard band only bounds
 // the fixed-point range).
 #pragma once
@@ -27,11 +32,16 @@ struct ReferenceOptions {
   int subpixel_bits = 8;       // vertex snapping grid: 1 / 2^bits px, in [0, 12]
   bool force_painter = false;  // `ref:painter`: draw far-to-near with no depth test
   bool uncertainty = true;     // compute edge_dist and depth_gap
+  // Multisampled scenes: the sample positions (fixtures/multisample.h convention), one per
+  // sample, e.g. a GL frame's frame.json "multisample" positions; empty: the standard
+  // pattern for the scene's sample count. Ignored when the scene has one sample.
+  std::vector<glm::dvec2> sample_positions;
   // `ref:abuffer` (last: positional initialisers keep their meaning): exact order-independent
   // transparency. Every fragment of a blending pass that passes its depth test (against the opaque
   // depth: that pass does not write depth) is kept in its pixel's list; after the last pass each
   // list is sorted far to near (window depth, ties in draw order) and blended in that order, and
-  // the pixel's id is its nearest blended fragment. Opaque passes are unchanged.
+  // the pixel's id is its nearest blended fragment. Opaque passes are unchanged. Multisampled,
+  // each sample keeps its own lists.
   bool abuffer = false;
 };
 
@@ -42,7 +52,10 @@ struct ReferenceOptions {
 // frame.meta: {"renderer", "subpixel_bits", "painter_forced", "triangles_rasterized" (fan
 // triangles, after clipping and culling, that covered a pixel centre's bounding box),
 // "fragments" (covered pixel centres, whether they passed the depth test or not),
-// "timing_ms": {"render"}}; with options.abuffer also "abuffer" (see abufferMeta below).
+// "timing_ms": {"render"}}; multisampled, also "multisample": {"samples", "positions",
+// "positions_source", "positions_on_grid"}, and fragments count covered samples; with
+// options.abuffer also "abuffer" (docs/reference.md section 10; multisampled, its fragment count is
+// over samples and a pixel counts when any of its samples does).
 Frame renderReference(const Scene& scene, const ReferenceOptions& options = {});
 
 // One fragment that reached a pixel, in draw order (`rastercheck explain`).
@@ -69,11 +82,13 @@ struct SortedFragment {
 };
 
 // The sorted list of image pixel (x, y_image) under options.abuffer (forced on), far to
-// near, exactly as renderReference() blends it there. Errors as tracePixel().
+// near, exactly as renderReference() blends it there (a multisampled scene as if it had one
+// sample, as tracePixel()). Errors as tracePixel().
 std::vector<SortedFragment> abufferPixel(const Scene& scene, ReferenceOptions options, int x,
                                          int y_image);
 
-// Every fragment that covers image pixel (x, y_image) (top-left origin, y down), in draw
+// Every fragment that covers image pixel (x, y_image) at its centre (a multisampled scene
+// is traced as if it had one sample) (top-left origin, y down), in draw
 // order, rendered exactly as renderReference() renders it (the same passes and depth
 // buffer history, restricted to that one pixel). Throws InputError when the pixel is
 // outside the image (and for everything renderReference() rejects).

@@ -60,6 +60,12 @@ inline double ceilFast(double x) { return -floorFast(-x); }
   return first < last_excl;
 }
 
+// A segment's end point (the x, y of a WindowVertex).
+struct Point {
+  double x;
+  double y;
+};
+
 // Lowers row[px] to the distance from each listed pixel centre to the segment a-b (in
 // [first, last) of the row at window y = cy), when that is smaller:
 //   t = clamp(((p - a) . d) / |d|^2, 0, 1), distance = hypot(p - (a + t d)).
@@ -68,16 +74,30 @@ inline double ceilFast(double x) { return -floorFast(-x); }
 // so fl(qx^2 + qy^2) >= cur^2 (1 + 2^-40) means hypot(q) > cur and no change (cur is a
 // float, so cur^2 is exact in double). Pixels are visited in any superset of the band
 // within one pixel of the segment: a pixel farther than 1 keeps its value (<= 1).
-void lowerRow(float* row, int first, int last, double cy, const WindowVertex& a,
-              const WindowVertex& b, double reach) {
+void lowerRow(float* row, int first, int last, double cy, const Point& a, const Point& b,
+              double reach) {
   const double dx = b.x - a.x;
   const double dy = b.y - a.y;
   const double len2 = dx * dx + dy * dy;
+  const bool finite_len2 = std::isfinite(len2);
   const double py = cy;
   for (int px = first; px < last; ++px) {
     const double cx = px + 0.5;
     double t = 0.0;
-    if (len2 > 0.0) t = std::clamp(((cx - a.x) * dx + (py - a.y) * dy) / len2, 0.0, 1.0);
+    if (len2 > 0.0) {
+      // t = clamp(num / len2, 0, 1) without the division where the clamp decides: for a
+      // finite len2 > 0, num >= len2 gives a quotient >= 1 (rounding is monotone) and
+      // num <= 0 one <= 0 (t = -0 for num = -0, which moves no end point: a.x + -0 * dx
+      // and a.x + 0 * dx differ at most in the sign of a zero, and cx, py are never 0).
+      const double num = (cx - a.x) * dx + (py - a.y) * dy;
+      if (!finite_len2) {
+        t = std::clamp(num / len2, 0.0, 1.0);
+      } else if (num >= len2) {
+        t = 1.0;
+      } else if (!(num <= 0.0)) {
+        t = num / len2;  // in (0, 1] (the clamp keeps it) or NaN (the clamp returns it)
+      }
+    }
     const double qx = cx - (a.x + t * dx);
     const double qy = py - (a.y + t * dy);
     const double cur = row[px];
@@ -88,8 +108,8 @@ void lowerRow(float* row, int first, int last, double cy, const WindowVertex& a,
   }
 }
 
-void addSegment(const WindowVertex& a, const WindowVertex& b, const PixelRect& clip, int width,
-                int height, float* edge_dist, double reach) {
+void addSegment(const Point& a, const Point& b, const PixelRect& clip, int width, int height,
+                float* edge_dist, double reach) {
   // Centres farther than 1 + reach from the segment keep their value (<= 1).
   const double band = 1.0 + reach;
   int row_first = 0;
@@ -130,8 +150,36 @@ void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& c
   for (int i = 0; i < count; ++i) {
     const int j = (i + 1) % count;
     const double reach = reach_px ? std::max(reach_px[i], reach_px[j]) : 0.0;
-    addSegment(polygon[i], polygon[j], clip, width, height, edge_dist, reach);
+    addSegment(Point{polygon[i].x, polygon[i].y}, Point{polygon[j].x, polygon[j].y}, clip, width,
+               height, edge_dist, reach);
   }
+}
+
+void EdgeDistanceBatch::add(const WindowVertex* polygon, int count, const double* reach_px) {
+  for (int i = 0; i < count; ++i) {
+    const int j = (i + 1) % count;
+    const WindowVertex& a = polygon[i];
+    const WindowVertex& b = polygon[j];
+    // Any key gives the same result; the lower row (clamped, NaN to 0) gives locality.
+    const double low = std::min(a.y, b.y);
+    const double row = low > 0.0 ? std::min(low, 65536.0) : 0.0;
+    segments_.push_back(Segment{a.x, a.y, b.x, b.y, std::max(reach_px[i], reach_px[j]),
+                                static_cast<std::int32_t>(row)});
+  }
+}
+
+void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, float* edge_dist) {
+  // Counting sort by key (keys in [0, 65536]).
+  int max_key = 0;
+  for (const Segment& s : segments_) max_key = std::max(max_key, s.key);
+  starts_.assign(static_cast<std::size_t>(max_key) + 2, 0);
+  for (const Segment& s : segments_) ++starts_[static_cast<std::size_t>(s.key) + 1];
+  for (std::size_t k = 1; k < starts_.size(); ++k) starts_[k] += starts_[k - 1];
+  sorted_.resize(segments_.size());
+  for (const Segment& s : segments_) sorted_[starts_[static_cast<std::size_t>(s.key)]++] = s;
+  for (const Segment& s : sorted_)
+    addSegment(Point{s.ax, s.ay}, Point{s.bx, s.by}, clip, width, height, edge_dist, s.reach);
+  clear();
 }
 
 }  // namespace rc::ref

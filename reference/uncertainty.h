@@ -271,4 +271,37 @@ bool cullCouldFlip(const WindowVertex* polygon, int count, double extra_px = 0.0
 void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& clip, int width,
                       int height, float* edge_dist, const double* reach_px = nullptr);
 
+// addEdgeDistances() for many polygons, deferred and applied in row order. A visit of a
+// pixel by a segment leaves min(cur, float(max(d, 0))) (when d < cur the stored float is
+// <= cur, float conversion being monotone and cur a float; when d >= cur it is >= cur),
+// and whether a pixel is visited does not depend on its value, so edge_dist is the minimum
+// over all visits whatever the polygons' order: applying them sorted by their lowest row
+// gives the same bits, while the band of rows being written stays in cache (polygons drawn
+// in random places otherwise miss it on nearly every row).
+class EdgeDistanceBatch {
+ public:
+  void clear() { segments_.clear(); }
+  // The polygon's vertex positions and per-vertex reach, as addEdgeDistances() takes them.
+  void add(const WindowVertex* polygon, int count, const double* reach_px);
+  // addEdgeDistances() of every added polygon into edge_dist, then clear().
+  void apply(const PixelRect& clip, int width, int height, float* edge_dist);
+  std::size_t capacity() const { return segments_.capacity(); }
+  void release() { *this = {}; }
+
+ private:
+  // One boundary segment with its reach (the larger of its end points'), kept whole so
+  // that the sorted pass reads them in sequence.
+  struct Segment {
+    double ax;
+    double ay;
+    double bx;
+    double by;
+    double reach;
+    std::int32_t key;  // its lower row, clamped to [0, 65536] (the sort key)
+  };
+  std::vector<Segment> segments_;
+  std::vector<Segment> sorted_;
+  std::vector<std::uint32_t> starts_;
+};
+
 }  // namespace rc::ref

@@ -53,7 +53,7 @@ results_section() {
   echo "counts a fault as caught: [campaigns.md](campaigns.md). Latest results:"
   echo
   local any=0 f
-  for f in docs/results/campaign-*.md docs/results/mutations-*.md; do
+  for f in docs/results/findings.md docs/results/campaign-*.md docs/results/mutations-*.md; do
     [[ -f $f ]] || continue
     any=1
     echo "- [${f#docs/}](${f#docs/})"

@@ -35,9 +35,9 @@ using ::testing::HasSubstr;
 
 namespace {
 
-// The backends of the campaign: the two Mesa drivers every machine of the project has.
-// (zink joins when gl:egl:zink is part of the build.)
-const char* const kBackends = "gl:egl:llvmpipe,gl:egl:softpipe";
+// The backends of the campaign: every Mesa driver the project's machines have (zink is
+// GL on Vulkan over lavapipe, installed by scripts/setup.sh).
+const char* const kBackends = "gl:egl:llvmpipe,gl:egl:softpipe,gl:egl:zink";
 
 fs::path scratch(const std::string& name) {
   fs::path p =
@@ -109,15 +109,21 @@ TEST(CampaignGl, ShortCampaignFindsGroupsAndReproducesEveryOne) {
   const std::string args = std::string("--seed 11 --count 50 --backends ") + kBackends +
                            " --max-size 48x36 --reduce-seconds 6 --jobs 2 --out " + dir.string();
   const rc::test::CommandResult first = campaign(args);
-  ASSERT_TRUE(first.code == 0 || first.code == 1) << first.out << first.err;
+  // The target of the campaign issue, in small: no failure on llvmpipe or zink, and on
+  // softpipe only groups an expectations entry covers (exit 0). A group that is not
+  // covered is a false alarm of the harness or a new driver difference: either way a bug
+  // to pin down (summary.md names it and its reproducer).
+  ASSERT_EQ(first.code, 0) << first.out << first.err;
   EXPECT_THAT(first.err, HasSubstr("starting a campaign in"));
   EXPECT_EQ(first.err.find('\r'), std::string::npos) << "no status line when not a terminal";
   EXPECT_THAT(first.out, HasSubstr("summary: " + (dir / "summary.md").string()));
   const json summary = readJson(dir / "summary.json");
   EXPECT_EQ(summary["complete"], true);
   EXPECT_EQ(summary["scenes"]["run"], 50);
-  for (const char* b : {"gl:egl:llvmpipe", "gl:egl:softpipe"})
+  for (const char* b : {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:egl:zink"})
     EXPECT_EQ(summary["backends"][b]["pairs"], 50) << b;
+  for (const char* b : {"gl:egl:llvmpipe", "gl:egl:zink"})
+    EXPECT_EQ(summary["backends"][b]["fail"], 0) << b;
   EXPECT_EQ(summary["exit_code"], first.code);
 
   // The runs' own reports, read independently: every failing class is one failure.

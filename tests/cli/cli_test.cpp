@@ -11,6 +11,8 @@
 
 #include "app/report_support.h"
 #include "fixtures/frame_io.h"
+#include "fixtures/loader.h"
+#include "fixtures/multisample.h"
 #include "tests/support/command.h"
 
 namespace fs = std::filesystem;
@@ -190,8 +192,8 @@ TEST(CliCompare, IdenticalFramesPassWithTheSummaryAndReportPath) {
   // A passing pair gets no diff.exr (75 MB at 1080p) unless asked for.
   EXPECT_FALSE(fs::exists(pair / "diff.exr"));
   EXPECT_EQ(readFile(out / "report.json").find("diff_exr"), std::string::npos);
-  const Result forced = run("compare " + a.string() + " " + b.string() + " --diff-exr --out " +
-                            out.string());
+  const Result forced =
+      run("compare " + a.string() + " " + b.string() + " --diff-exr --out " + out.string());
   EXPECT_EQ(forced.code, 0) << forced.out;
   EXPECT_TRUE(fs::is_regular_file(pair / "diff.exr"));
 }
@@ -435,3 +437,32 @@ TEST(CliCompare, TheFixturesToleranceBlockAppliesAndTheCommandLineWins) {
           " --tolerance visibility.fail=10");
   EXPECT_EQ(r.code, 1) << r.out;
 }
+
+namespace {
+
+// `run` compares a multisampled reference at the positions the driver reports: a GL frame
+// whose frame.json names other positions makes the reference render again there (and
+// keep its frame.json keys); equal positions, or a single-sample frame, change nothing.
+TEST(ResampleReference, RendersAgainAtTheDriversPositions) {
+  const std::filesystem::path fixture =
+      std::filesystem::path(RC_SOURCE_DIR) / "fixtures/scenes/msaa/edge_slopes.json";
+  const rc::Frame original = rc::renderReference(rc::loadScene(fixture));
+  rc::Frame ref = original;
+  ref.meta["backend"] = "ref";
+  rc::Frame gl = original;
+  gl.meta["backend"] = "gl:fake";
+  rc::resampleReference(ref, gl, fixture, {});  // same (standard) positions
+  EXPECT_EQ(ref.sample_id, original.sample_id);
+  EXPECT_EQ(ref.meta["multisample"]["positions_source"], "standard");
+
+  nlohmann::json mirrored = nlohmann::json::array();
+  for (const glm::dvec2& p : rc::standardSamplePositions(4)) mirrored.push_back({p.x, 1.0 - p.y});
+  gl.meta["multisample"]["positions"] = mirrored;
+  rc::resampleReference(ref, gl, fixture, {});
+  EXPECT_NE(ref.sample_id, original.sample_id);
+  EXPECT_EQ(ref.meta["multisample"]["positions"], mirrored);
+  EXPECT_EQ(ref.meta["multisample"]["positions_from"], "gl:fake");
+  EXPECT_EQ(ref.meta["backend"], "ref");
+}
+
+}  // namespace

@@ -52,7 +52,8 @@ const std::vector<std::string> kRequiredTags = {"coverage",
                                                 "texture",
                                                 "transparency",
                                                 "real-mesh",
-                                                "oit"};
+                                                "oit",
+                                                "msaa"};
 
 std::string joinLines(const std::vector<std::string>& lines) {
   std::string out;

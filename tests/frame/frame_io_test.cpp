@@ -333,3 +333,42 @@ TEST(FrameIo, FailedReplacementLeavesTheOldFrame) {
     EXPECT_GT(injected, 0) << (with_other_file ? "per-file" : "swap");
   }
 }
+
+// Multisampled frames: coverage, the per-sample planes (ids as uint32) and, with the
+// uncertainty channels, sample_alt and per-sample edge_dist survive the round trip; a GL
+// frame (no uncertainty) has none of the reference's.
+TEST(FrameIo, RoundTripsMultisampledFrames) {
+  for (bool unc : {false, true}) {
+    const fs::path dir = tempDir(unc ? "ms_unc" : "ms_plain");
+    rc::Frame in = makeFrame(unc);
+    in.samples = 4;
+    const std::size_t n = in.pixelCount();
+    for (std::size_t k = 0; k < 4 * n; ++k) {
+      in.sample_id.push_back(16777217u + static_cast<std::uint32_t>(k));
+      in.sample_depth.push_back(0.001f * static_cast<float>(k));
+      if (unc) in.sample_edge_dist.push_back(0.01f * static_cast<float>(k % 100));
+    }
+    in.coverage.assign(n, 3.0f);
+    if (unc) in.sample_alt.assign(n, 12.5f);
+    rc::writeFrameDir(in, dir);
+    auto spec_in = OIIO::ImageInput::open((dir / "frame.exr").string());
+    ASSERT_TRUE(spec_in);
+    const OIIO::ImageSpec& spec = spec_in->spec();
+    const int id3 = spec.channelindex("s3.id");
+    ASSERT_GE(id3, 0);
+    EXPECT_EQ(spec.channelformat(id3), OIIO::TypeDesc::UINT32);
+    EXPECT_EQ(spec.channelindex("s0.edge_dist") >= 0, unc);
+    spec_in->close();
+    const rc::Frame out = rc::readFrameDir(dir);
+    EXPECT_EQ(out.samples, 4);
+    EXPECT_EQ(out.sample_id, in.sample_id);
+    EXPECT_EQ(out.sample_depth, in.sample_depth);
+    EXPECT_EQ(out.coverage, in.coverage);
+    EXPECT_EQ(out.sample_edge_dist, in.sample_edge_dist);
+    EXPECT_EQ(out.sample_alt, in.sample_alt);
+    fs::remove_all(dir);
+  }
+  rc::Frame bad = makeFrame(false);
+  bad.samples = 4;  // planes missing
+  EXPECT_THROW(rc::writeFrameDir(bad, tempDir("ms_bad")), rc::InputError);
+}

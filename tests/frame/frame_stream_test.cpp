@@ -55,11 +55,37 @@ TEST(FrameStream, RoundTripsEveryBufferBitForBit) {
   }
 }
 
+// Multisampled frames: the per-sample planes and coverage (GL), plus the reference's
+// per-sample edge_dist and sample_alt, come back bit for bit.
+TEST(FrameStream, RoundTripsMultisampledFrames) {
+  for (const bool uncertainty : {false, true}) {
+    Frame in = sample(uncertainty);
+    in.samples = 4;
+    const std::size_t n = in.pixelCount();
+    for (std::size_t k = 0; k < 4 * n; ++k) {
+      in.sample_id.push_back(static_cast<std::uint32_t>(k * 31u));
+      in.sample_depth.push_back(static_cast<float>(k) * 1e-4f);
+      if (uncertainty) in.sample_edge_dist.push_back(static_cast<float>(k % 9) / 8.0f);
+    }
+    in.coverage.assign(n, 3.0f);
+    if (uncertainty) in.sample_alt.assign(n, 7.5f);
+    const Frame out = decodeFrame(encodeFrame(in));
+    EXPECT_EQ(out.samples, 4);
+    EXPECT_EQ(out.sample_id, in.sample_id);
+    EXPECT_TRUE(sameBits(out.sample_depth, in.sample_depth));
+    EXPECT_TRUE(sameBits(out.coverage, in.coverage));
+    EXPECT_TRUE(sameBits(out.sample_edge_dist, in.sample_edge_dist));
+    EXPECT_TRUE(sameBits(out.sample_alt, in.sample_alt));
+    EXPECT_EQ(out.id, in.id);
+  }
+}
+
 TEST(FrameStream, DamagedBytesAreRefused) {
   const std::string good = encodeFrame(sample(true));
   EXPECT_THROW(decodeFrame(good.substr(0, good.size() - 1)), InputError);
   EXPECT_THROW(decodeFrame(good + "x"), InputError);
-  EXPECT_THROW(decodeFrame("RCF1" + good.substr(4)), InputError);  // the older layout
+  EXPECT_THROW(decodeFrame("RCF1" + good.substr(4)), InputError);  // older layouts
+  EXPECT_THROW(decodeFrame("RCF2" + good.substr(4)), InputError);
   EXPECT_THROW(decodeFrame(""), InputError);
   std::string huge = good;
   const std::uint32_t big = 1u << 20;

@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -127,6 +129,44 @@ TEST(GlCli, UnavailablePlatformExitsThreeNamingTheFixture) {
     EXPECT_NE(r.out.find(errorPrefix(spec, "")), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out));
   }
+}
+
+// softpipe has one sample: `render` of a 4-sample fixture exits 3 with one "not supported"
+// line and writes nothing; `run` records a not_supported row (neither pass nor failure:
+// exit 0, junit skipped) next to llvmpipe's pass.
+TEST(GlCli, TooFewSamplesIsNotSupported) {
+  const std::string fixture = std::string(RC_SOURCE_DIR) + "/fixtures/scenes/msaa/edge_slopes.json";
+  const fs::path dir = scratch("msaa");
+  const Result r =
+      run("render " + fixture + " --backend gl:egl:softpipe --out " + (dir / "frame").string());
+  if (r.code == 3 && r.out.find("not supported") == std::string::npos) {
+    if (requireGl()) FAIL() << "RASTERCHECK_REQUIRE_GL=1 but softpipe: " << r.out;
+    GTEST_SKIP() << "softpipe does not start here: " << r.out;
+  }
+  EXPECT_EQ(r.code, 3) << r.out;
+  ASSERT_EQ(lines(r.out).size(), 1u) << r.out;
+  EXPECT_EQ(
+      r.out.rfind("rastercheck: not supported: msaa/edge_slopes: gl:egl:softpipe: 4 samples", 0),
+      0u)
+      << r.out;
+  EXPECT_FALSE(fs::exists(dir / "frame"));
+
+  const Result ran =
+      run("run " + fixture + " --backends gl:egl:llvmpipe,gl:egl:softpipe --no-variants --out " +
+          (dir / "report").string());
+  EXPECT_EQ(ran.code, 0) << ran.out;
+  EXPECT_NE(ran.out.find("1 not supported"), std::string::npos) << ran.out;
+  std::ifstream in(dir / "report" / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  std::map<std::string, std::string> status;
+  for (const nlohmann::json& row : report["results"]) status[row["actual"]] = row["status"];
+  EXPECT_EQ(status["gl:egl:llvmpipe"], "pass");
+  EXPECT_EQ(status["gl:egl:softpipe"], "not_supported");
+  EXPECT_EQ(report["summary"]["not_supported"], 1);
+  std::ifstream junit(dir / "report" / "junit.xml");
+  const std::string xml((std::istreambuf_iterator<char>(junit)), std::istreambuf_iterator<char>());
+  EXPECT_NE(xml.find("<skipped type=\"not supported\""), std::string::npos);
+  fs::remove_all(dir);
 }
 
 TEST(GlCli, UnknownFaultExitsTwoBeforeWriting) {

@@ -5,12 +5,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 
+#include <fmt/format.h>
+
+#include "fixtures/random_scene.h"
 #include "reference/reference_renderer.h"
 #include "tests/reference/corpus.h"
 #include "tests/reference/test_scenes.h"
@@ -69,6 +74,85 @@ TEST(Determinism, IdenticalAcrossOptimisationLevels) {
   EXPECT_EQ(o0, o2) << "-O0 and -O2 builds differ first at: " << firstDifference(o0, o2);
   EXPECT_EQ(o0, here) << "the test's build differs from -O0 first at: "
                       << firstDifference(o0, here);
+}
+
+// The golden listing (tests/reference/data/golden_frames.txt): one hash over every buffer
+// of the frame (colour, depth, id and all 12 uncertainty channels, frameBytes()) per
+// catalog fixture, random scene (`generate --seed 1 --count 10` under four profiles; their
+// files are pinned by RandomScenes.GoldenHash) and benchmark scene, each under the four
+// option sets of renderCorpus(). It was recorded before the reference's speed work of
+// issue 13 (docs/performance.md) so that this test proves that work changed no bit.
+// An intended change of the reference's output re-records it:
+//   RC_UPDATE_GOLDEN=1 build/release/tests/reference/test_reference (with
+//   --gtest_filter=Determinism.GoldenFrames)
+// Fixtures added after the recording are listed (not failed) until it is re-recorded.
+std::string goldenListing() {
+  namespace fs = std::filesystem;
+  const fs::path source(RC_SOURCE_DIR);
+  const fs::path random = fs::path(RC_BINARY_DIR) / "tests" / "reference" / "golden_random";
+  std::vector<fs::path> files = corpusFixtures();
+  const std::size_t catalog = files.size();
+  fs::remove_all(random);
+  for (const RandomProfile profile :
+       {RandomProfile::All, RandomProfile::Textures, RandomProfile::Blend, RandomProfile::Soups}) {
+    RandomSceneOptions o;
+    o.seed = 1;
+    o.count = 10;
+    o.profile = profile;
+    fs::create_directories(random / toString(profile));
+    writeRandomFixtures(o, random / toString(profile));
+  }
+  for (const fs::path& f : test::fixtureFiles(random))
+    if (f.filename() != "generate.json") files.push_back(f);
+  EXPECT_GE(files.size(), catalog + 40);
+  std::string out;
+  test::renderCorpus(files, true, [&](const std::string& name, const Frame& frame) {
+    std::string label = name;
+    for (const fs::path& base : {random.parent_path(), source}) {
+      const std::string prefix = base.string() + "/";
+      if (label.starts_with(prefix)) label = label.substr(prefix.size());
+    }
+    out += fmt::format("{:016x} {}\n", test::frameHash(frame), label);
+  });
+  fs::remove_all(random);
+  return out;
+}
+
+std::map<std::string, std::string> parseListing(const std::string& text) {
+  std::map<std::string, std::string> hashes;  // name -> hash
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.size() > 17) hashes[line.substr(17)] = line.substr(0, 16);
+  return hashes;
+}
+
+TEST(Determinism, GoldenFrames) {
+  const std::filesystem::path golden =
+      std::filesystem::path(RC_SOURCE_DIR) / "tests" / "reference" / "data" / "golden_frames.txt";
+  const std::string now = goldenListing();
+  if (std::getenv("RC_UPDATE_GOLDEN") != nullptr) {
+    std::ofstream(golden, std::ios::binary) << now;
+    GTEST_SKIP() << "recorded " << golden;
+  }
+  std::ifstream in(golden, std::ios::binary);
+  ASSERT_TRUE(in) << golden;
+  const auto expected = parseListing(std::string(std::istreambuf_iterator<char>(in), {}));
+  const auto actual = parseListing(now);
+  ASSERT_GE(expected.size(), 4u * 90u);
+  std::size_t compared = 0;
+  for (const auto& [name, hash] : actual) {
+    const auto it = expected.find(name);
+    if (it == expected.end()) {
+      std::printf("not in the golden listing yet: %s\n", name.c_str());
+      continue;
+    }
+    ++compared;
+    EXPECT_EQ(hash, it->second) << name << ": the reference's frame changed";
+  }
+  for (const auto& [name, hash] : expected)
+    EXPECT_TRUE(actual.contains(name)) << name << " is in the golden listing but was not rendered";
+  EXPECT_GE(compared, expected.size());
 }
 
 TEST(Determinism, TheCorpusIsSensitiveToOneUlp) {
