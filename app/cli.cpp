@@ -95,8 +95,12 @@ int runCli(int argc, char** argv) {
                           "warn|fail, depth.slope_factor); repeatable");
   compare_cmd->add_flag("--diff-exr", compare.diff_exr,
                         "Write diff.exr also when the pair passes (by default only when not)");
+  compare_cmd->add_flag("--flip", compare.flip,
+                        "Also compute the LDR-FLIP perceptual error (report.json flip, "
+                        "flip_heat.png); off by default: it costs more than the comparison");
   compare_cmd->add_option("--flip-threshold", compare.flip_threshold,
-                          "Fail the pair when its mean LDR-FLIP error (0..1) exceeds this");
+                          "Fail the pair when its mean LDR-FLIP error (0..1) exceeds this "
+                          "(implies --flip)");
 
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand(
@@ -109,8 +113,9 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_option("--out,-o", run.out, "Report folder")->required();
   run_cmd->add_option("--tolerance,-t", run.tolerance, "As for compare; repeatable");
+  run_cmd->add_flag("--flip", run.flip, "As for compare: also compute LDR-FLIP for every pair");
   run_cmd->add_option("--flip-threshold", run.flip_threshold,
-                      "Fail a pair whose mean LDR-FLIP error (0..1) exceeds this");
+                      "Fail a pair whose mean LDR-FLIP error (0..1) exceeds this (implies --flip)");
   run_cmd->add_option("--jobs,-j", run.jobs, "Renders at a time (default: one per core)");
   run_cmd->add_option("--expectations", run.expectations,
                       "Known driver differences to mark as known failures: a file, or 'none' "

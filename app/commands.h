@@ -53,8 +53,10 @@ struct CompareArgs {
   std::filesystem::path uncertainty;  // empty: the expected (or actual) frame's channels
   std::filesystem::path out;
   std::vector<std::string> tolerance;
-  bool diff_exr = false;                 // write diff.exr also when the pair passes
-  std::optional<double> flip_threshold;  // a pair whose mean LDR-FLIP exceeds it fails
+  bool diff_exr = false;  // write diff.exr also when the pair passes
+  bool flip = false;      // compute LDR-FLIP (report.json "flip", flip_heat.png)
+  std::optional<double>
+      flip_threshold;  // a pair whose mean LDR-FLIP exceeds it fails (implies flip)
 };
 int compareCommand(const CompareArgs& args);
 
@@ -64,6 +66,7 @@ struct RunArgs {
   std::string against = "ref";
   std::filesystem::path out;
   std::vector<std::string> tolerance;
+  bool flip = false;                     // as for compare
   std::optional<double> flip_threshold;  // as for compare
   int jobs = 0;                          // 0: one per core
   bool variants = true;                  // probe each GL backend's variants (app/variants.h)

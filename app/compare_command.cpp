@@ -70,8 +70,8 @@ int compareCommand(const CompareArgs& args) {
   report.tool_version = kVersion;
   report.command = "compare";
   const PairPictures pictures{expected_read.picture, actual_read.picture};
-  report.results.push_back(
-      comparePair(expected, actual, *uncertainty, tolerances, folder, pictures, args.diff_exr));
+  report.results.push_back(comparePair(expected, actual, *uncertainty, tolerances, folder, pictures,
+                                       args.diff_exr, args.flip));
   folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);

@@ -41,10 +41,11 @@ PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame&
 
 // Compares and writes the pair's images into the report folder (a folder of its own for
 // every pair: ReportFolder::pairDirectory); diff.exr only when the pair does not pass,
-// unless diff_exr_when_passing.
+// unless diff_exr_when_passing; LDR-FLIP and flip_heat.png when flip (or a FLIP threshold).
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, ReportFolder& folder,
-                       const PairPictures& pictures = {}, bool diff_exr_when_passing = true);
+                       const PairPictures& pictures = {}, bool diff_exr_when_passing = true,
+                       bool flip = false);
 
 // A report row for a pair whose render failed with `message`: status not_supported when
 // the message says the backend does not support the fixture, else error.

@@ -383,6 +383,7 @@ int runCommand(const RunArgs& args) {
             // changed under us) ends the run with exit 2 and no report.
             const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
             ClassMaps maps;
+            maps.want_flip = args.flip;  // --flip-threshold asks through tol as well
             r = compareNamed(expected, actual, *uncertainty, tol, &maps);
             if (args.keep_frames || r.status != Status::Pass) {
               const fs::path da = keepFrame(against.text);

@@ -97,6 +97,10 @@ AccuracyPair readPair(const ReportReader& r, const json& j, const std::string& a
     p.flip_mean = r.number(j["flip"], "mean", at + ".flip");
     p.flip_max = r.number(j["flip"], "max", at + ".flip");
   }
+  if (j.contains("ciede2000") && j["ciede2000"].is_object()) {
+    p.ciede2000_mean = r.number(j["ciede2000"], "mean", at + ".ciede2000");
+    p.ciede2000_max = r.number(j["ciede2000"], "max", at + ".ciede2000");
+  }
   if (j.contains("oit") && j["oit"].is_object()) {
     const json& o = j["oit"];
     const std::string oat = at + ".oit";
@@ -363,20 +367,11 @@ AccuracyData readAccuracyRuns(const std::vector<fs::path>& runs,
   return data;
 }
 
-// LDR-FLIP per driver pair (report.json "flip"): how large the differences look.
-template <class Line>
-void perceptualSection(const AccuracyData& data,
-                       const std::map<Group, std::vector<const AccuracyPair*>>& groups,
-                       Line& line) {
-  if (std::none_of(data.pairs.begin(), data.pairs.end(),
-                   [](const AccuracyPair& p) { return p.flip_mean.has_value(); }))
-    return;
-  line();
-  line("## Perceptual error (LDR-FLIP)");
-  line();
-  line("LDR-FLIP (docs/tolerances.md, section 6) of each pair's 8-bit pictures, 0 (identical)");
-  line("to 1; *mean* averages the pairs' mean errors, *worst pair* is the largest pair mean.");
-  line();
+// One perceptual measure per driver pair: the pairs' means averaged, the worst pair mean,
+// the largest pixel. `mean` and `max` read the measure of a pair (no mean: not measured).
+template <class Line, class Mean, class Max>
+void perceptualTable(const std::map<Group, std::vector<const AccuracyPair*>>& groups, Mean mean,
+                     Max max_of, Line& line) {
   line("| driver | against | pairs | mean | worst pair | largest pixel |");
   line("|---|---|---|---|---|---|");
   for (const auto& [g, list] : groups) {
@@ -384,18 +379,54 @@ void perceptualSection(const AccuracyData& data,
     double sum = 0.0, worst = 0.0, max = 0.0;
     std::string worst_fixture;
     for (const AccuracyPair* p : list) {
-      if (!p->flip_mean) continue;
+      const std::optional<double> m = mean(*p);
+      if (!m) continue;
       ++n;
-      sum += *p->flip_mean;
-      max = std::max(max, p->flip_max);
-      if (*p->flip_mean > worst || worst_fixture.empty()) {
-        worst = *p->flip_mean;
+      sum += *m;
+      max = std::max(max, max_of(*p));
+      if (*m > worst || worst_fixture.empty()) {
+        worst = *m;
         worst_fixture = p->fixture;
       }
     }
     if (n == 0) continue;
     line(fmt::format("| `{}` | `{}` | {} | {} | {} (`{}`) | {} |", g.second, g.first, n,
                      num(sum / static_cast<double>(n)), num(worst), worst_fixture, num(max)));
+  }
+}
+
+// LDR-FLIP (report.json "flip", runs with --flip) and CIEDE2000 ("ciede2000") per driver
+// pair: how large the differences look.
+template <class Line>
+void perceptualSection(const AccuracyData& data,
+                       const std::map<Group, std::vector<const AccuracyPair*>>& groups,
+                       Line& line) {
+  const bool flip = std::any_of(data.pairs.begin(), data.pairs.end(),
+                                [](const AccuracyPair& p) { return p.flip_mean.has_value(); });
+  const bool de = std::any_of(data.pairs.begin(), data.pairs.end(),
+                              [](const AccuracyPair& p) { return p.ciede2000_mean.has_value(); });
+  if (flip) {
+    line();
+    line("## Perceptual error (LDR-FLIP)");
+    line();
+    line("LDR-FLIP (docs/tolerances.md, section 6) of each pair's 8-bit pictures, 0 (identical)");
+    line("to 1; *mean* averages the pairs' mean errors, *worst pair* is the largest pair mean.");
+    line();
+    perceptualTable(
+        groups, [](const AccuracyPair& p) { return p.flip_mean; },
+        [](const AccuracyPair& p) { return p.flip_max; }, line);
+  }
+  if (de) {
+    line();
+    line("## Colour difference (CIEDE2000)");
+    line();
+    line("CIEDE2000 (docs/tolerances.md, section 7) of each pair's 8-bit pictures, per pixel;");
+    line("*mean* averages the pairs' means over all their pixels, *worst pair* is the largest");
+    line("pair mean.");
+    line();
+    perceptualTable(
+        groups, [](const AccuracyPair& p) { return p.ciede2000_mean; },
+        [](const AccuracyPair& p) { return p.ciede2000_max; }, line);
   }
 }
 

@@ -59,6 +59,9 @@ struct AccuracyPair {
   // perceptual error (report.json "flip"), when the report has it
   std::optional<double> flip_mean;
   double flip_max = 0.0;
+  // CIEDE2000 (report.json "ciede2000"), when the report has it
+  std::optional<double> ciede2000_mean;
+  double ciede2000_max = 0.0;
   // against ref:abuffer (report.json "oit"), when the report has it
   bool oit = false;
   std::uint64_t oit_blended = 0;

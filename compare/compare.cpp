@@ -1089,6 +1089,7 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
   r.shading.histogram = ErrorHistogram(int_color ? 1.0 : 1.0 / 4096.0, int_color);
   Comparator(expected, actual, uncertainty, tolerances, r).run(maps);
   r.oit = compareOit(expected, actual, tolerances);
+  r.ciede2000 = deltaE2000Frames(expected, actual);  // cheap: only differing pixels
   if ((maps && maps->want_flip) || tolerances.flip_mean_fail) {
     r.flip = flipFrames(expected, actual, tolerances, maps ? &maps->flip : nullptr);
     r.status = worse(r.status, r.flip->status);

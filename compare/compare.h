@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "compare/ciede2000.h"
 #include "compare/flip.h"
 #include "compare/histogram.h"
 #include "compare/oit.h"
@@ -167,9 +168,11 @@ struct PairResult {
   NonFiniteCounts nonfinite_actual;
   // Against an A-buffer frame (ref:abuffer): the distance from exact transparency.
   std::optional<OitStats> oit;
-  // The perceptual error (LDR-FLIP): computed when maps are asked for or a FLIP threshold
-  // is set; its verdict joins the pair's status.
+  // The perceptual error (LDR-FLIP): computed only when asked for (ClassMaps::want_flip,
+  // `--flip`) or when a FLIP threshold is set; its verdict joins the pair's status.
   std::optional<FlipStats> flip;
+  // CIEDE2000 per pixel, pooled: every compared pair (a measurement, no verdict).
+  std::optional<DeltaE2000Stats> ciede2000;
   // Files written by writePairImages, by kind: expected, actual, visibility, depth_heat,
   // shading_heat, diff_exr. Reports print them relative to the report folder.
   std::map<std::string, std::filesystem::path> images;
@@ -202,16 +205,18 @@ struct ClassMaps {
   // channel error - that pixel's largest channel excess over its allowance), else 0.
   std::vector<float> shading_tolerance;
   std::vector<float> flip;  // LDR-FLIP per pixel (every pixel), empty when not computed
-  bool want_flip = true;    // false: compareFrames skips FLIP (unless a threshold is set)
+  // Compute LDR-FLIP (`--flip`): it costs ~2000 instructions a pixel near differences,
+  // more than the rest of the comparison, so it is opt-in (a threshold also asks for it).
+  bool want_flip = false;
 };
 
 // Compares `actual` with `expected`. `uncertainty` is the reference frame whose
 // edge_dist/depth_gap and Z classify the pair: usually `expected` itself (pass the same
 // object), or the reference render of the same fixture when both sides are GL drivers.
 // Without uncertainty channels every mismatch is hard. FLIP (result.flip) is computed when
-// `maps` is given or tolerances.flip_mean_fail is set. Subpixel bits come from each
-// frame's meta["subpixel_bits"] (8 when absent). Throws InputError when sizes differ or
-// a frame's buffers do not match its size.
+// maps->want_flip or tolerances.flip_mean_fail is set; CIEDE2000 (result.ciede2000) always.
+// Subpixel bits come from each frame's meta["subpixel_bits"] (8 when absent). Throws InputError
+// when sizes differ or a frame's buffers do not match its size.
 PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                          const Tolerances& tolerances, ClassMaps* maps = nullptr);
 

@@ -279,8 +279,13 @@ constexpr const char* kScript = R"JS(
       ['format', x.fmt[1]], ['thresholds warn / fail', num(t[5]) + ' / ' + num(t[6]) + ' + allowance'],
       ['allowance', x.a], ['worst', at(s[13], s[14], h)],
       ['worst error / allowance', num(s[15]) + ' / ' + num(s[16])]]);
-    // The additive blocks: perceptual error (flip) and, against ref:abuffer, exact
-    // transparency (oit).
+    // The additive blocks: perceptual error (flip, ciede2000) and, against ref:abuffer,
+    // exact transparency (oit).
+    if (x.de)
+      out += table2('CIEDE2000 (per pixel, 8-bit sRGB)', 'pass', [
+        ['mean', num(x.de[0])], ['weighted median', num(x.de[1])],
+        ['weighted quartiles', num(x.de[2]) + ' / ' + num(x.de[3])], ['max', num(x.de[4])],
+        ['pixels that differ', x.de[5]], ['worst', at(x.de[6], x.de[7], h)]]);
     if (x.fl)
       out += table2('flip (LDR-FLIP)', x.fl[6], [
         ['mean', num(x.fl[0])], ['weighted median', num(x.fl[1])],
@@ -547,6 +552,13 @@ nlohmann::json sectionData(const PairResult& r, const fs::path& report_dir, bool
                jnum(f.weighted_q1), jnum(f.weighted_q3),
                jnum(f.max),         jnum(f.ppd),
                toString(f.status),  f.threshold ? jnum(*f.threshold) : json(nullptr)};
+  }
+  if (r.ciede2000) {
+    const DeltaE2000Stats& e = *r.ciede2000;
+    x["de"] = {jnum(e.mean),        jnum(e.weighted_median),
+               jnum(e.weighted_q1), jnum(e.weighted_q3),
+               jnum(e.max),         e.differing,
+               e.worst_x,           e.worst_y};
   }
   if (r.oit) {
     const OitStats& o = *r.oit;

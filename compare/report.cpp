@@ -259,9 +259,11 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
   }
   j["nonfinite"] = {{"expected", nonfinite(r.nonfinite_expected)},
                     {"actual", nonfinite(r.nonfinite_actual)}};
-  // Additive blocks kept in their own modules (compare/oit.h, compare/flip.h).
+  // Additive blocks kept in their own modules (compare/oit.h, compare/flip.h,
+  // compare/ciede2000.h).
   if (r.oit) j["oit"] = oitJson(*r.oit, r.height);
   if (r.flip) j["flip"] = flipJson(*r.flip);
+  if (r.ciede2000) j["ciede2000"] = deltaE2000Json(*r.ciede2000, r.height);
   json images = json::object();
   for (const auto& [kind, file] : r.images) images[kind] = relativePath(file, report_dir);
   j["images"] = images;

@@ -289,7 +289,8 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
     p.depth_heat_scale = r.number(row["heat_scales"], "depth_steps", at + ".heat_scales");
     p.shading_heat_scale = r.number(row["heat_scales"], "shading_abs", at + ".heat_scales");
   }
-  // The additive blocks (compare/flip.h, compare/oit.h), so that merged shards keep them.
+  // The additive blocks (compare/flip.h, compare/ciede2000.h, compare/oit.h), so that merged
+  // shards keep them.
   if (row.contains("flip") && row["flip"].is_object()) {
     const json& f = row["flip"];
     const std::string fat = at + ".flip";
@@ -304,6 +305,22 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
     fs.threshold = r.optionalNumber(f, "threshold", fat);
     fs.ppd = r.number(f, "pixels_per_degree", fat);
     p.flip = fs;
+  }
+  if (row.contains("ciede2000") && row["ciede2000"].is_object()) {
+    const json& c = row["ciede2000"];
+    const std::string cat = at + ".ciede2000";
+    DeltaE2000Stats cs;
+    cs.mean = r.number(c, "mean", cat);
+    cs.weighted_median = r.number(c, "weighted_median", cat);
+    cs.weighted_q1 = r.number(c, "weighted_q1", cat);
+    cs.weighted_q3 = r.number(c, "weighted_q3", cat);
+    cs.min = r.number(c, "min", cat);
+    cs.max = r.number(c, "max", cat);
+    cs.differing = r.count(c, "differing", cat);
+    const PixelRef worst = r.pixel(c, "worst", cat).value_or(PixelRef{});
+    cs.worst_x = worst.x;
+    cs.worst_y = worst.y;
+    p.ciede2000 = cs;
   }
   if (row.contains("oit") && row["oit"].is_object()) {
     const json& o = row["oit"];

@@ -34,13 +34,13 @@ run() {
 
 cd "$root"
 rm -rf "$work/catalog" "$work/drivers" "$work/oit"
-run fixtures/scenes --backends "$backends" --out "$work/catalog"
-run fixtures/scenes --backends "$drivers" --against gl:egl:llvmpipe --out "$work/drivers"
+run fixtures/scenes --backends "$backends" --flip --out "$work/catalog"
+run fixtures/scenes --backends "$drivers" --against gl:egl:llvmpipe --flip --out "$work/drivers"
 run fixtures/scenes/transparency/oit_*.json --backends "ref,$backends" --against ref:abuffer \
   --no-variants --out "$work/oit"
 "$exe" accuracy "$work/catalog" "$work/drivers" "$work/oit" \
   --expectations fixtures/expectations.json \
-  --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends\`, \`rastercheck run fixtures/scenes --backends $drivers --against gl:egl:llvmpipe\` and \`rastercheck run fixtures/scenes/transparency/oit_*.json --backends ref,$backends --against ref:abuffer\`, then \`rastercheck accuracy\` on the three run folders)" \
+  --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends --flip\`, \`rastercheck run fixtures/scenes --backends $drivers --against gl:egl:llvmpipe --flip\` and \`rastercheck run fixtures/scenes/transparency/oit_*.json --backends ref,$backends --against ref:abuffer\`, then \`rastercheck accuracy\` on the three run folders)" \
   --out docs/accuracy.md
 
 # The random-scene campaigns and mutation studies (scripts/campaign.sh, scripts/mutations.sh)

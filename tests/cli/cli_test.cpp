@@ -8,6 +8,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/report_support.h"
 #include "fixtures/frame_io.h"
@@ -213,6 +214,39 @@ TEST(CliCompare, AFailingPairExitsOne) {
   expectReportFiles(dir / "report");
 }
 
+// LDR-FLIP is opt-in (its cost is over issue 13's budget of compare <= idiff): a plain
+// compare has no flip block and no flip_heat.png, --flip adds both, --flip-threshold
+// implies it; CIEDE2000 is in every compared pair.
+TEST(CliCompare, FlipIsOptInAndCiede2000AlwaysThere) {
+  const fs::path dir = scratch("cmp_flip");
+  const std::string fixture = crafted("interpenetrating.json");
+  const fs::path a = renderTo(dir, "z", fixture, "ref");
+  const fs::path b = renderTo(dir, "p", fixture, "ref:painter");
+  auto compare = [&](const std::string& extra) {
+    const fs::path out = dir / "report";
+    const Result r =
+        run("compare " + a.string() + " " + b.string() + " --out " + out.string() + extra);
+    EXPECT_EQ(r.code, 1) << r.out;
+    bool heat = false;
+    for (const auto& e : fs::recursive_directory_iterator(out))
+      heat = heat || e.path().filename() == "flip_heat.png";
+    const nlohmann::json row =
+        nlohmann::json::parse(readFile(out / "report.json")).at("results").at(0);
+    EXPECT_EQ(row.contains("flip"), heat) << extra;
+    EXPECT_TRUE(row.contains("ciede2000")) << extra;
+    EXPECT_GT(row.at("ciede2000").at("differing"), 0) << extra;
+    return row;
+  };
+  EXPECT_FALSE(compare("").contains("flip"));
+  const nlohmann::json asked = compare(" --flip");
+  ASSERT_TRUE(asked.contains("flip"));
+  EXPECT_GT(asked.at("flip").at("mean"), 0.0);
+  EXPECT_TRUE(asked.at("flip").at("threshold").is_null());
+  const nlohmann::json threshold = compare(" --flip-threshold 0.5");
+  ASSERT_TRUE(threshold.contains("flip"));
+  EXPECT_EQ(threshold.at("flip").at("threshold"), 0.5);
+}
+
 TEST(CliCompare, BadInputExitsTwoWithOneLineAndWritesNothing) {
   const fs::path dir = scratch("cmp_bad");
   const std::string fixture = catalog("coverage/triangle_fan.json");
@@ -269,6 +303,15 @@ TEST(CliRun, ExitCodesZeroOneTwoThree) {
           (dir / "fail").string());
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("FAIL compare-tests/interpenetrating"), std::string::npos) << r.out;
+  // FLIP only with --flip (CliCompare.FlipIsOptInAndCiede2000AlwaysThere); CIEDE2000 always.
+  const nlohmann::json plain = nlohmann::json::parse(readFile(dir / "fail" / "report.json"));
+  EXPECT_FALSE(plain.at("results").at(0).contains("flip"));
+  EXPECT_TRUE(plain.at("results").at(0).contains("ciede2000"));
+  r = run("run " + crafted("interpenetrating.json") + " --backends ref:painter --flip --out " +
+          (dir / "fail").string());
+  EXPECT_EQ(r.code, 1) << r.out;
+  const nlohmann::json flip = nlohmann::json::parse(readFile(dir / "fail" / "report.json"));
+  EXPECT_GT(flip.at("results").at(0).at("flip").at("mean"), 0.0);
 
   // 3: a backend that cannot start; the report is still written, one error row, and the
   // reason names the backend once.

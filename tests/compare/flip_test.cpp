@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "compare/compare.h"
 #include "compare/flip.h"
 
 namespace rc {
@@ -344,6 +345,33 @@ TEST(Flip, ThresholdFailsAPairWhoseMeanExceedsIt) {
   EXPECT_EQ(img.rgb[1], 0.0f);
   EXPECT_EQ(img.rgb[2], 101.0f / 255.0f);
   EXPECT_EQ(img.rgb[3], std::round(0.30f * 255.0f) / 255.0f);
+}
+
+// FLIP is opt-in (`--flip`, issue 13's time budget): compareFrames computes it only when
+// the maps ask for it or a threshold is set; CIEDE2000 comes with every comparison.
+TEST(Flip, OnlyComputedWhenAskedFor) {
+  Frame e, a;
+  const float clear[4] = {0.2f, 0.2f, 0.2f, 1.0f};
+  e.allocate(16, 16, clear, 1.0f, false);
+  a.allocate(16, 16, clear, 1.0f, false);
+  for (std::size_t i = 0; i < 16; ++i) a.color[4 * i] = 0.9f;
+  Tolerances t;
+  ClassMaps maps;
+  maps.flip.assign(3, 0.5f);  // a stale map from an earlier pair
+  PairResult r = compareFrames(e, a, e, t, &maps);
+  EXPECT_FALSE(r.flip.has_value());
+  EXPECT_TRUE(maps.flip.empty());
+  ASSERT_TRUE(r.ciede2000.has_value());
+  EXPECT_EQ(r.ciede2000->differing, 16u);
+  maps.want_flip = true;
+  r = compareFrames(e, a, e, t, &maps);
+  ASSERT_TRUE(r.flip.has_value());
+  EXPECT_GT(r.flip->mean, 0.0);
+  EXPECT_EQ(maps.flip.size(), 256u);
+  t.flip_mean_fail = 1.0;  // a threshold alone asks for it too
+  r = compareFrames(e, a, e, t);
+  ASSERT_TRUE(r.flip.has_value());
+  EXPECT_EQ(r.flip->threshold, 1.0);
 }
 
 }  // namespace

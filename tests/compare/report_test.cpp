@@ -68,6 +68,7 @@ class ReportTest : public ::testing::Test {
       Frame expected = ref;
       expected.meta["fixture"] = fixture;
       ClassMaps maps;
+      maps.want_flip = true;  // FLIP is opt-in (`--flip`): these pairs ask for it
       PairResult r = compareFrames(expected, actual, expected, tol, &maps);
       writePairImages(expected, actual, maps, pairDirectory(*out_, r), r);
       report_->results.push_back(r);
@@ -157,6 +158,17 @@ TEST_F(ReportTest, JsonHoldsTheContractFields) {
   EXPECT_EQ(error.at("depth").at("compared"), 0);
   EXPECT_EQ(error.at("shading").at("compared"), 0);
   EXPECT_TRUE(error.at("images").is_object() && error.at("images").empty());
+  // The additive perceptual blocks: flip where asked for, ciede2000 on every compared pair
+  // (identical colours: all zero), neither on an error row.
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_TRUE(j.at("results").at(k).contains("flip")) << k;
+    EXPECT_TRUE(j.at("results").at(k).contains("ciede2000")) << k;
+  }
+  EXPECT_EQ(j.at("results").at(0).at("ciede2000").at("differing"), 0);
+  EXPECT_EQ(j.at("results").at(0).at("ciede2000").at("max"), 0.0);
+  EXPECT_TRUE(j.at("results").at(0).at("ciede2000").at("worst").is_null());
+  EXPECT_FALSE(error.contains("flip"));
+  EXPECT_FALSE(error.contains("ciede2000"));
   // Image paths are relative to the report and resolve there.
   for (const auto& [kind, rel] : fail.at("images").items()) {
     EXPECT_FALSE(fs::path(rel.get<std::string>()).is_absolute()) << kind;

@@ -75,6 +75,8 @@ Synthetic makeRun(const fs::path& root) {
       {"status", "pass"}, {"compared", 50}, {"max_steps", 3}, {"p99_steps", 2}, {"worst", {5, 6}}};
   a["flip"] = {{"mean", 0.25}, {"max", 0.9}};
   b["flip"] = {{"mean", 0.5}, {"max", 0.75}};
+  a["ciede2000"] = {{"mean", 1.5}, {"max", 12.0}};
+  b["ciede2000"] = {{"mean", 0.25}, {"max", 20.0}};
   json e = pair("t/a", "ref:abuffer", "gl:x:y", "fail");
   e["oit"] = {{"blended_pixels", 40}, {"unsorted_pixels", 7}, {"pixels", 6},
               {"max_abs", 44.5},      {"mean_abs", 3.25},     {"out_of_order_pairs", 2}};
@@ -127,6 +129,8 @@ TEST(Accuracy, TablesShowTheReportsNumbers) {
   EXPECT_TRUE(hasLine(md, "- Hard visibility differences: none.")) << md;
   // The perceptual and exact-transparency sections, from the reports' flip and oit blocks.
   EXPECT_TRUE(hasLine(md, "| `gl:x:y` | `ref` | 2 | 0.375 | 0.5 (`t/b`) | 0.9 |")) << md;
+  EXPECT_TRUE(hasLine(md, "## Colour difference (CIEDE2000)")) << md;
+  EXPECT_TRUE(hasLine(md, "| `gl:x:y` | `ref` | 2 | 0.875 | 1.5 (`t/a`) | 20 |")) << md;
   EXPECT_TRUE(hasLine(md, "| `t/a` | `gl:x:y` | 40 | 7 | 6 | 44.5 | 3.25 | 2 |")) << md;
   EXPECT_TRUE(
       hasLine(md, "| bar | `t/b` | `gl:*:y` | any | any | visibility | a reason \\| with a bar |"))

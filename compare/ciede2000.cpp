@@ -1,0 +1,208 @@
+// CIEDE2000 per pixel and pooled: see ciede2000.h. The formula's steps are numbered as in
+// Sharma, Wu and Dalal (2005), equations (1) to (17); angles are in degrees there and in
+// radians here.
+#include "compare/ciede2000.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace rc {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+constexpr double kPow25To7 = 6103515625.0;  // 25^7
+
+// C^7 / (C^7 + 25^7), the chroma weight of (4) and (17); its square root is taken there.
+double chromaWeight(double c) {
+  const double c7 = std::pow(c, 7.0);
+  return c7 / (c7 + kPow25To7);
+}
+
+// The hue angle in [0, 2 pi) of (a', b) (5); 0 for a neutral colour (a' = b = 0).
+double hueAngle(double b, double a_prime) {
+  if (a_prime == 0.0 && b == 0.0) return 0.0;
+  const double h = std::atan2(b, a_prime);
+  return h >= 0.0 ? h : h + 2.0 * kPi;
+}
+
+// sRGB primaries and D65 white (IEC 61966-2-1): linear RGB to CIE XYZ, the same matrix
+// compare/flip.cpp uses.
+constexpr double kRgbToXyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
+                                    {0.2126729, 0.7151522, 0.0721750},
+                                    {0.0193339, 0.1191920, 0.9503041}};
+
+double srgbDecode(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+// CIELAB's f(t): the cube root above (6/29)^3, its tangent line below.
+double labF(double t) {
+  constexpr double d = 6.0 / 29.0;
+  return t > d * d * d ? std::cbrt(t) : t / (3.0 * d * d) + 4.0 / 29.0;
+}
+
+Lab linearToLab(const double rgb[3]) {
+  double xyz[3];
+  double white[3];
+  for (int i = 0; i < 3; ++i) {
+    xyz[i] = kRgbToXyz[i][0] * rgb[0] + kRgbToXyz[i][1] * rgb[1] + kRgbToXyz[i][2] * rgb[2];
+    white[i] = kRgbToXyz[i][0] + kRgbToXyz[i][1] + kRgbToXyz[i][2];
+  }
+  const double fx = labF(xyz[0] / white[0]);
+  const double fy = labF(xyz[1] / white[1]);
+  const double fz = labF(xyz[2] / white[2]);
+  return {116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)};
+}
+
+// color.png's byte of a frame channel (DESIGN.md: clamp to [0, 1], NaN as 0, round to
+// nearest, halves up), as fixtures/frame_io.cpp writes it and compare/flip.cpp reads it.
+std::uint8_t unorm8(float v) {
+  v = v > 0.0f ? v : 0.0f;
+  v = v < 1.0f ? v : 1.0f;
+  const float x = v * 255.0f;
+  const auto q = static_cast<int>(x);
+  return static_cast<std::uint8_t>(q + (x - static_cast<float>(q) >= 0.5f ? 1 : 0));
+}
+
+// The linear value of each 8-bit sRGB code (frames are read as 8-bit pictures).
+const std::array<double, 256>& decodeTable() {
+  static const std::array<double, 256> table = [] {
+    std::array<double, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = srgbDecode(i / 255.0);
+    return t;
+  }();
+  return table;
+}
+
+Lab pixelLab(const float* rgba) {
+  const std::array<double, 256>& decode = decodeTable();
+  const double rgb[3] = {decode[unorm8(rgba[0])], decode[unorm8(rgba[1])], decode[unorm8(rgba[2])]};
+  return linearToLab(rgb);
+}
+
+}  // namespace
+
+double ciede2000(const Lab& x, const Lab& y) {
+  // (2)-(4): a' scaled up by G, which grows as the mean chroma falls (near-neutral blues).
+  const double c_mean = 0.5 * (std::hypot(x.a, x.b) + std::hypot(y.a, y.b));
+  const double g = 0.5 * (1.0 - std::sqrt(chromaWeight(c_mean)));
+  const double a1 = (1.0 + g) * x.a;
+  const double a2 = (1.0 + g) * y.a;
+  // (5)-(6)
+  const double c1 = std::hypot(a1, x.b);
+  const double c2 = std::hypot(a2, y.b);
+  const double h1 = hueAngle(x.b, a1);
+  const double h2 = hueAngle(y.b, a2);
+  const double c_product = c1 * c2;
+  // (8)-(10): the hue difference the short way round the circle; none when either colour
+  // is neutral.
+  const double d_l = y.l - x.l;
+  const double d_c = c2 - c1;
+  double d_h = 0.0;
+  if (c_product != 0.0) {
+    d_h = h2 - h1;
+    if (d_h > kPi) {
+      d_h -= 2.0 * kPi;
+    } else if (d_h < -kPi) {
+      d_h += 2.0 * kPi;
+    }
+  }
+  const double d_big_h = 2.0 * std::sqrt(c_product) * std::sin(0.5 * d_h);
+  // (12)-(14): means; the mean hue is taken across 0 when the two hues are more than half
+  // a turn apart, and is their sum when either colour is neutral.
+  const double l_mean = 0.5 * (x.l + y.l);
+  const double c_prime_mean = 0.5 * (c1 + c2);
+  double h_mean = h1 + h2;
+  if (c_product != 0.0) {
+    if (std::fabs(h1 - h2) <= kPi) {
+      h_mean = 0.5 * (h1 + h2);
+    } else if (h1 + h2 < 2.0 * kPi) {
+      h_mean = 0.5 * (h1 + h2 + 2.0 * kPi);
+    } else {
+      h_mean = 0.5 * (h1 + h2 - 2.0 * kPi);
+    }
+  }
+  // (15)-(17)
+  const double t = 1.0 - 0.17 * std::cos(h_mean - 30.0 * kDeg) + 0.24 * std::cos(2.0 * h_mean) +
+                   0.32 * std::cos(3.0 * h_mean + 6.0 * kDeg) -
+                   0.20 * std::cos(4.0 * h_mean - 63.0 * kDeg);
+  const double hue_offset = (h_mean / kDeg - 275.0) / 25.0;
+  const double d_theta = 30.0 * kDeg * std::exp(-hue_offset * hue_offset);
+  const double r_c = 2.0 * std::sqrt(chromaWeight(c_prime_mean));
+  const double l50 = (l_mean - 50.0) * (l_mean - 50.0);
+  const double s_l = 1.0 + 0.015 * l50 / std::sqrt(20.0 + l50);
+  const double s_c = 1.0 + 0.045 * c_prime_mean;
+  const double s_h = 1.0 + 0.015 * c_prime_mean * t;
+  const double r_t = -std::sin(2.0 * d_theta) * r_c;
+  const double l_term = d_l / s_l;
+  const double c_term = d_c / s_c;
+  const double h_term = d_big_h / s_h;
+  const double sum = l_term * l_term + c_term * c_term + h_term * h_term + r_t * c_term * h_term;
+  return std::sqrt(std::max(sum, 0.0));
+}
+
+Lab srgbToLab(double r, double g, double b) {
+  const double rgb[3] = {srgbDecode(r), srgbDecode(g), srgbDecode(b)};
+  return linearToLab(rgb);
+}
+
+DeltaE2000Stats deltaE2000Frames(const Frame& expected, const Frame& actual) {
+  DeltaE2000Stats s;
+  const std::size_t n = std::min(expected.pixelCount(), actual.pixelCount());
+  if (n == 0) return s;
+  std::vector<double> values;  // the non-zero differences: zeros move no weighted percentile
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* e = &expected.color[4 * i];
+    const float* a = &actual.color[4 * i];
+    if (unorm8(e[0]) == unorm8(a[0]) && unorm8(e[1]) == unorm8(a[1]) &&
+        unorm8(e[2]) == unorm8(a[2]))
+      continue;
+    const double d = ciede2000(pixelLab(e), pixelLab(a));
+    values.push_back(d);
+    total += d;
+    if (d > s.max) {
+      s.max = d;
+      s.worst_x = static_cast<int>(i % static_cast<std::size_t>(expected.width));
+      s.worst_y = static_cast<int>(i / static_cast<std::size_t>(expected.width));
+    }
+  }
+  s.differing = values.size();
+  s.mean = total / static_cast<double>(n);
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  s.min = values.size() == n ? values.front() : 0.0;
+  if (total <= 0.0) return s;
+  const double fractions[3] = {0.25, 0.5, 0.75};
+  double* targets[3] = {&s.weighted_q1, &s.weighted_median, &s.weighted_q3};
+  double cum = 0.0;
+  int next = 0;
+  for (const double v : values) {
+    cum += v;
+    while (next < 3 && cum >= fractions[next] * total) *targets[next++] = v;
+    if (next == 3) break;
+  }
+  while (next < 3) *targets[next++] = s.max;  // rounding of the running sum
+  return s;
+}
+
+nlohmann::json deltaE2000Json(const DeltaE2000Stats& s, int height) {
+  const bool worst = s.worst_x >= 0;
+  return {
+      {"mean", s.mean},
+      {"weighted_median", s.weighted_median},
+      {"weighted_q1", s.weighted_q1},
+      {"weighted_q3", s.weighted_q3},
+      {"min", s.min},
+      {"max", s.max},
+      {"differing", s.differing},
+      {"worst", worst ? nlohmann::json::array({s.worst_x, s.worst_y}) : nlohmann::json(nullptr)},
+      {"worst_window", worst ? nlohmann::json::array({s.worst_x, height - 1 - s.worst_y})
+                             : nlohmann::json(nullptr)}};
+}
+
+}  // namespace rc
