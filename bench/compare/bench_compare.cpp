@@ -101,7 +101,7 @@ void BM_Compare1080pNoisy(benchmark::State& state) {
 BENCHMARK(BM_Compare1080pNoisy)->Unit(benchmark::kMillisecond);
 
 // LDR-FLIP (compare/flip.h) alone, on the colour of the pair above: the cost `run` and
-// `compare` add per pair (they compute it whenever they write the pair's images).
+// `compare` add per pair with --flip.
 void BM_Flip1080p(benchmark::State& state) {
   const Pair& p = pair1080p();
   const rc::Tolerances tol = rc::tolerancesForFrames(p.ref, p.gl);
@@ -113,6 +113,39 @@ void BM_Flip1080p(benchmark::State& state) {
   countPixels(state, p);
 }
 BENCHMARK(BM_Flip1080p)->Unit(benchmark::kMillisecond);
+
+// CIEDE2000 (compare/ciede2000.h) alone, which every comparison includes: on the pair
+// above (only the blocks and the few noisy pixels whose 8-bit colour changes are computed)
+// and on its worst case, a copy one 8-bit step brighter in R, G and B at every pixel.
+void BM_Ciede2000_1080p(benchmark::State& state) {
+  const Pair& p = pair1080p();
+  for (auto _ : state) {
+    rc::DeltaE2000Stats s = rc::deltaE2000Frames(p.ref, p.gl);
+    benchmark::DoNotOptimize(s);
+  }
+  countPixels(state, p);
+}
+BENCHMARK(BM_Ciede2000_1080p)->Unit(benchmark::kMillisecond);
+
+void BM_Ciede2000_1080pEveryPixel(benchmark::State& state) {
+  static const Pair p = [] {
+    Pair q;
+    q.ref = rc::testing::renderRects(1920, 1080, rc::testing::defaultRects(1920, 1080));
+    q.gl = q.ref;
+    for (std::size_t i = 0; i < q.gl.pixelCount(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        float& v = q.gl.color[4 * i + c];
+        v = v < 0.5f ? v + 1.0f / 255.0f : v - 1.0f / 255.0f;
+      }
+    return q;
+  }();
+  for (auto _ : state) {
+    rc::DeltaE2000Stats s = rc::deltaE2000Frames(p.ref, p.gl);
+    benchmark::DoNotOptimize(s);
+  }
+  countPixels(state, p);
+}
+BENCHMARK(BM_Ciede2000_1080pEveryPixel)->Unit(benchmark::kMillisecond);
 
 // The catalog's usual size.
 void BM_Flip256(benchmark::State& state) {

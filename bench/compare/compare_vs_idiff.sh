@@ -6,6 +6,8 @@
 #
 #   bench/compare/compare_vs_idiff.sh [BUILD_DIR] [ROUNDS]     (default build/release, 7)
 #
+# RC_COMPARE_ARGS adds arguments to every `rastercheck compare`, e.g. "--flip" to time it
+# with LDR-FLIP (opt-in since issue 14).
 # RC_EXR_COMPRESSION=LIST re-encodes the two frame.exr files with oiiotool before timing,
 # one measurement per entry ("asis" keeps what `render` wrote), e.g. "asis zip none".
 # Rounds alternate the two commands so that both see the same machine load; the medians
@@ -15,6 +17,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build=${1:-$root/build/release}
 rounds=${2:-7}
 compressions=${RC_EXR_COMPRESSION:-asis}
+read -r -a compare_args <<<"${RC_COMPARE_ARGS:-}"
 exe=$build/app/rastercheck
 [[ -x $exe ]] || { echo "no $exe: build first (scripts/build.sh)" >&2; exit 2; }
 command -v idiff >/dev/null || { echo "idiff not found (openimageio-tools)" >&2; exit 2; }
@@ -63,10 +66,10 @@ for comp in $compressions; do
   compare_times=()
   idiff_times=()
   for ((i = 0; i < rounds; ++i)); do
-    compare_times+=("$(seconds "$exe" compare "$dir/ref" "$dir/gl" --out "$work/report-$comp")")
+    compare_times+=("$(seconds "$exe" compare "$dir/ref" "$dir/gl" --out "$work/report-$comp" "${compare_args[@]}")")
     idiff_times+=("$(seconds idiff "$dir/ref/color.png" "$dir/gl/color.png")")
   done
   echo "frame.exr $comp (${exr_size} KiB), $rounds rounds:"
-  echo "  rastercheck compare: $(stats "${compare_times[@]}")"
+  echo "  rastercheck compare ${RC_COMPARE_ARGS:-}: $(stats "${compare_times[@]}")"
   echo "  idiff (PNGs only):   $(stats "${idiff_times[@]}")"
 done

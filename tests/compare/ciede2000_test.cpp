@@ -97,8 +97,10 @@ TEST(Ciede2000, HueDiscontinuityIsWhereThePaperPutsIt) {
   const double below = ciede2000({50, 2.49, -0.001}, {50, -2.49, 0.0010});
   const double above = ciede2000({50, 2.49, -0.001}, {50, -2.49, 0.0011});
   EXPECT_GT(above - below, 0.03);
-  // Lightness only, at L = 50 (S_L = 1): the difference is |dL|.
-  EXPECT_NEAR(ciede2000({50, 0, 0}, {51, 0, 0}), 1.0, 1e-12);
+  // Lightness only, mean lightness 50 (S_L = 1): the difference is |dL|; at mean 50.5,
+  // S_L = 1 + 0.015 * 0.25 / sqrt(20.25) shrinks it.
+  EXPECT_NEAR(ciede2000({49.5, 0, 0}, {50.5, 0, 0}), 1.0, 1e-12);
+  EXPECT_NEAR(ciede2000({50, 0, 0}, {51, 0, 0}), 1.0 / (1.0 + 0.015 * 0.25 / 4.5), 1e-12);
 }
 
 // sRGB primaries in CIELAB under D65 (Bruce Lindbloom's colour calculator, reproduced in

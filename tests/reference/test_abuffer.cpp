@@ -8,6 +8,7 @@
 #include <set>
 #include <vector>
 
+#include "fixtures/multisample.h"
 #include "reference/reference_renderer.h"
 #include "tests/reference/test_scenes.h"
 
@@ -70,9 +71,9 @@ struct Oracle {
   glm::dvec3 color{0.0};
 };
 
-Oracle oracleAt(const std::vector<Tri>& tris, int px, int gl_y) {
+// The fragment list at window point c (a pixel centre, or a sample position).
+Oracle oracleAtPoint(const std::vector<Tri>& tris, const glm::dvec2& c) {
   Oracle o;
-  const glm::dvec2 c(px + 0.5, gl_y + 0.5);
   std::vector<std::pair<double, int>> frags;
   for (int k = 0; k < static_cast<int>(tris.size()); ++k) {
     const Tri& t = tris[k];
@@ -112,13 +113,13 @@ Oracle oracleAt(const std::vector<Tri>& tris, int px, int gl_y) {
   return o;
 }
 
-TEST(ABuffer, MatchesBruteForceFragmentLists) {
-  const std::vector<Tri> tris = triangles();
-  const Scene scene = abufferScene(tris);
-  ReferenceOptions opts;
-  opts.abuffer = true;
-  const Frame f = renderReference(scene, opts);
-  // The far-to-near order of the triangle pass, by mean view depth (1 - z here).
+Oracle oracleAt(const std::vector<Tri>& tris, int px, int gl_y) {
+  return oracleAtPoint(tris, glm::dvec2(px + 0.5, gl_y + 0.5));
+}
+
+// Whether the sorted pass draws triangle `far` after the nearer `near`: the mean view
+// depth order of the pass (1 - z here), ties in file order.
+std::vector<int> drawPositions(const std::vector<Tri>& tris) {
   std::vector<int> draw(tris.size());
   for (std::size_t k = 0; k < tris.size(); ++k) draw[k] = static_cast<int>(k);
   auto mean_depth = [&](int k) {
@@ -126,8 +127,19 @@ TEST(ABuffer, MatchesBruteForceFragmentLists) {
   };
   std::stable_sort(draw.begin(), draw.end(),
                    [&](int a, int b) { return mean_depth(a) > mean_depth(b); });
-  std::vector<int> draw_pos(tris.size());
-  for (std::size_t k = 0; k < draw.size(); ++k) draw_pos[draw[k]] = static_cast<int>(k);
+  std::vector<int> pos(tris.size());
+  for (std::size_t k = 0; k < draw.size(); ++k) pos[draw[k]] = static_cast<int>(k);
+  return pos;
+}
+
+TEST(ABuffer, MatchesBruteForceFragmentLists) {
+  const std::vector<Tri> tris = triangles();
+  const Scene scene = abufferScene(tris);
+  ReferenceOptions opts;
+  opts.abuffer = true;
+  const Frame f = renderReference(scene, opts);
+  // The far-to-near order of the triangle pass, by mean view depth (1 - z here).
+  const std::vector<int> draw_pos = drawPositions(tris);
 
   int checked = 0, multi = 0;
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> oracle_pairs;  // (near, far) ids
@@ -226,6 +238,92 @@ TEST(ABuffer, DeterministicAndTracedListMatchesTheFrame) {
       for (int c = 0; c < 4; ++c)
         EXPECT_EQ(static_cast<float>(list.back().color_after[c]), a.color[4 * i + c]);
     }
+}
+
+// Multisampled (4x, standard positions): every sample keeps and blends its own lists, the
+// resolve averages them, and frame.json "abuffer" joins the samples: a pixel counts as
+// blended / unsorted (and towards a pair) when any of its samples does, kept_fragments
+// sums the samples. Checked against the brute-force lists at each sample position.
+TEST(ABuffer, MultisampledListsAreJoinedOverTheSamples) {
+  const std::vector<Tri> tris = triangles();
+  Scene scene = abufferScene(tris);
+  scene.state.samples = 4;
+  ReferenceOptions opts;
+  opts.abuffer = true;
+  const Frame f = renderReference(scene, opts);
+  ASSERT_EQ(f.samples, 4);
+  ASSERT_TRUE(f.meta.contains("abuffer"));
+  const nlohmann::json& meta = f.meta["abuffer"];
+  const std::vector<glm::dvec2> pos = standardSamplePositions(4);
+  const std::vector<int> draw_pos = drawPositions(tris);
+
+  std::uint64_t blended = 0, unsorted = 0, kept = 0, unsure = 0, mixed = 0, partly_unsorted = 0;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint64_t> oracle_pairs;
+  for (int gl_y = 0; gl_y < kSize; ++gl_y) {
+    for (int x = 0; x < kSize; ++x) {
+      bool skip = false, any_blended = false, any_unsorted = false;
+      int samples_unsorted = 0;
+      std::set<std::vector<int>> lists;
+      glm::dvec3 mean(0.0);
+      std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+      for (const glm::dvec2& p : pos) {
+        const Oracle o = oracleAtPoint(tris, glm::dvec2(x, gl_y) + p);
+        skip = skip || o.skip;
+        mean += o.color / 4.0;
+        kept += o.order.size();
+        any_blended = any_blended || !o.order.empty();
+        lists.insert(o.order);
+        bool sample_unsorted = false;
+        for (std::size_t a = 0; a < o.order.size(); ++a)
+          for (std::size_t b = a + 1; b < o.order.size(); ++b)
+            if (draw_pos[o.order[a]] > draw_pos[o.order[b]]) {
+              sample_unsorted = true;
+              pairs.insert({3u + o.order[b], 3u + o.order[a]});
+            }
+        any_unsorted = any_unsorted || sample_unsorted;
+        samples_unsorted += sample_unsorted;
+      }
+      if (skip) {
+        ++unsure;
+        continue;
+      }
+      blended += any_blended;
+      unsorted += any_unsorted;
+      mixed += lists.size() > 1;
+      partly_unsorted += samples_unsorted > 0 && samples_unsorted < 4;
+      for (const auto& q : pairs) ++oracle_pairs[q];
+      const std::size_t i = f.index(x, kSize - 1 - gl_y);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(f.color[4 * i + c], mean[c], 4e-6) << "pixel " << x << "," << gl_y;
+    }
+  }
+  // Pixels whose samples lie on an edge or a depth tie may go either way.
+  EXPECT_LT(unsure, static_cast<std::uint64_t>(kSize * kSize / 8));
+  // Pixels whose samples hold different lists, and pixels only some samples of which are
+  // out of order: where joining the samples matters.
+  EXPECT_GT(mixed, 10u);
+  EXPECT_GT(partly_unsorted, 0u);
+  const auto got_blended = meta["blended_pixels"].get<std::uint64_t>();
+  const auto got_unsorted = meta["unsorted_pixels"].get<std::uint64_t>();
+  EXPECT_GE(got_blended, blended);
+  EXPECT_LE(got_blended, blended + unsure);
+  EXPECT_GT(unsorted, 0u);
+  EXPECT_GE(got_unsorted, unsorted);
+  EXPECT_LE(got_unsorted, unsorted + unsure);
+  // Fragments: every sample's, give or take the unsure pixels' (at most 4 x 4 each).
+  const auto got_kept = meta["kept_fragments"].get<std::uint64_t>();
+  EXPECT_NEAR(static_cast<double>(got_kept), static_cast<double>(kept),
+              16.0 * static_cast<double>(unsure));
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint64_t> reported;
+  for (const auto& p : meta["out_of_order"])
+    reported[{p["near"].get<std::uint32_t>(), p["far"].get<std::uint32_t>()}] =
+        p["pixels"].get<std::uint64_t>();
+  EXPECT_EQ(meta["out_of_order_pairs"].get<std::size_t>(), reported.size());
+  for (const auto& [pair, n] : oracle_pairs) {
+    ASSERT_TRUE(reported.count(pair)) << pair.first << " over " << pair.second;
+    EXPECT_GE(reported[pair], n);
+    EXPECT_LE(reported[pair], n + unsure);
+  }
 }
 
 }  // namespace
