@@ -16,6 +16,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <fmt/format.h>
 
+#include "compare/cube_root.h"
 #include "fixtures/errors.h"
 
 namespace rc {
@@ -117,20 +118,6 @@ Vec3 xyzToYcc(const Vec3& xyz, const Vec3& w) {
 Vec3 yccToXyz(const Vec3& ycc, const Vec3& w) {
   const double y = (ycc[0] + 16.0) / 116.0;
   return {{(ycc[1] / 500.0 + y) * w[0], y * w[1], (y - ycc[2] / 200.0) * w[2]}};
-}
-
-// The cube root of t > 0 without libm's (a third of FLIP's time went to std::cbrt): fdlibm's
-// 5-bit first guess from the high word, then three Halley steps, each tripling the correct
-// bits (5, 15, 45, then double's 53): within an ulp or two of std::cbrt.
-double cubeRoot(double t) {
-  const auto bits = std::bit_cast<std::uint64_t>(t);
-  const auto hi = static_cast<std::uint32_t>(bits >> 32) / 3u + 715094163u;
-  double y = std::bit_cast<double>(static_cast<std::uint64_t>(hi) << 32);
-  for (int k = 0; k < 3; ++k) {
-    const double y3 = y * y * y;
-    y = y * (y3 + 2.0 * t) / (2.0 * y3 + t);
-  }
-  return y;
 }
 
 // CIELAB, then the Hunt adjustment of the chroma by lightness: a' = 0.01 L a, b' = 0.01 L b.

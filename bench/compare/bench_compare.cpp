@@ -115,8 +115,9 @@ void BM_Flip1080p(benchmark::State& state) {
 BENCHMARK(BM_Flip1080p)->Unit(benchmark::kMillisecond);
 
 // CIEDE2000 (compare/ciede2000.h) alone, which every comparison includes: on the pair
-// above (only the blocks and the few noisy pixels whose 8-bit colour changes are computed)
-// and on its worst case, a copy one 8-bit step brighter in R, G and B at every pixel.
+// above (only the blocks and the noisy pixels whose 8-bit colour changes are computed) and
+// on its worst case: random 8-bit colours at every pixel against a copy one step off in R,
+// G and B, so that no pixel repeats its neighbour's pair of colours.
 void BM_Ciede2000_1080p(benchmark::State& state) {
   const Pair& p = pair1080p();
   for (auto _ : state) {
@@ -132,10 +133,13 @@ void BM_Ciede2000_1080pEveryPixel(benchmark::State& state) {
     Pair q;
     q.ref = rc::testing::renderRects(1920, 1080, rc::testing::defaultRects(1920, 1080));
     q.gl = q.ref;
+    std::mt19937 rng(2);
+    std::uniform_int_distribution<int> byte(0, 254);
     for (std::size_t i = 0; i < q.gl.pixelCount(); ++i)
       for (int c = 0; c < 3; ++c) {
-        float& v = q.gl.color[4 * i + c];
-        v = v < 0.5f ? v + 1.0f / 255.0f : v - 1.0f / 255.0f;
+        const int v = byte(rng);
+        q.ref.color[4 * i + c] = static_cast<float>(v) / 255.0f;
+        q.gl.color[4 * i + c] = static_cast<float>(v + 1) / 255.0f;
       }
     return q;
   }();

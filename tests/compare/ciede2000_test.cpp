@@ -4,7 +4,9 @@
 // hand-computed lists.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "compare/ciede2000.h"
@@ -182,6 +184,54 @@ TEST(Ciede2000, FramesAreReadAsTheirEightBitPictures) {
   EXPECT_EQ(same.max, 0.0);
   EXPECT_EQ(same.worst_x, -1);
   EXPECT_TRUE(deltaE2000Json(same, 1)["worst"].is_null());
+}
+
+// A frame large enough to be split over two threads (512 x 512), random colours, against
+// the statistics computed here pixel by pixel in one pass with a plain sort; the largest
+// difference placed twice, once in each half: the worst pixel is the first in row order.
+TEST(Ciede2000, LargeFramesGiveTheOnePassAnswer) {
+  constexpr int kSide = 512;
+  Frame e = flatFrame(kSide, kSide, 0.0f, 0.0f, 0.0f);
+  Frame a = flatFrame(kSide, kSide, 0.0f, 0.0f, 0.0f);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::uniform_int_distribution<int> step(-3, 3);
+  for (std::size_t i = 0; i < e.pixelCount(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const int v = byte(rng);
+      e.color[4 * i + c] = static_cast<float>(v) / 255.0f;
+      a.color[4 * i + c] = static_cast<float>(std::clamp(v + step(rng), 0, 255)) / 255.0f;
+    }
+  for (const std::size_t i : {std::size_t{1000}, e.pixelCount() - 1000}) {  // black vs white
+    for (int c = 0; c < 3; ++c) {
+      e.color[4 * i + c] = 0.0f;
+      a.color[4 * i + c] = 1.0f;
+    }
+  }
+  std::vector<double> d;
+  double total = 0.0;
+  for (std::size_t i = 0; i < e.pixelCount(); ++i) {
+    auto byteOf = [](float v) { return std::lround(v * 255.0f) / 255.0; };
+    const double x = ciede2000(
+        srgbToLab(byteOf(e.color[4 * i]), byteOf(e.color[4 * i + 1]), byteOf(e.color[4 * i + 2])),
+        srgbToLab(byteOf(a.color[4 * i]), byteOf(a.color[4 * i + 1]), byteOf(a.color[4 * i + 2])));
+    total += x;
+    if (x > 0.0) d.push_back(x);
+  }
+  std::sort(d.begin(), d.end());
+  double cum = 0.0, median = 0.0;
+  for (const double x : d)
+    if ((cum += x) >= 0.5 * total) {
+      median = x;
+      break;
+    }
+  const DeltaE2000Stats s = deltaE2000Frames(e, a);
+  EXPECT_EQ(s.differing, d.size());
+  EXPECT_NEAR(s.mean, total / static_cast<double>(e.pixelCount()), 1e-9);
+  EXPECT_NEAR(s.max, d.back(), 1e-9);
+  EXPECT_NEAR(s.weighted_median, median, 1e-9);
+  EXPECT_EQ(s.worst_x, 1000 % kSide);
+  EXPECT_EQ(s.worst_y, 1000 / kSide);
 }
 
 }  // namespace
