@@ -7,7 +7,8 @@
 #   bench/compare/compare_vs_idiff.sh [BUILD_DIR] [ROUNDS]     (default build/release, 7)
 #
 # RC_COMPARE_ARGS adds arguments to every `rastercheck compare`, e.g. "--flip" to time it
-# with LDR-FLIP (opt-in since issue 14).
+# with LDR-FLIP (opt-in since issue 14). RC_BASELINE=EXE times another build's `compare`
+# (e.g. main's) in the same rounds. Each command's CPU time (user + sys) is printed too.
 # RC_EXR_COMPRESSION=LIST re-encodes the two frame.exr files with oiiotool before timing,
 # one measurement per entry ("asis" keeps what `render` wrote), e.g. "asis zip none".
 # Rounds alternate the two commands so that both see the same machine load; the medians
@@ -42,15 +43,15 @@ PY
 "$exe" render "$work/teapot_1080p.json" --backend ref --out "$work/asis/ref" >/dev/null
 "$exe" render "$work/teapot_1080p.json" --backend gl:egl:llvmpipe --out "$work/asis/gl" >/dev/null
 
-seconds() {  # wall time of a command, output discarded, exit status ignored
-  local start end
-  start=$(date +%s.%N)
-  "$@" >/dev/null 2>&1 || true
-  end=$(date +%s.%N)
-  echo "$end - $start" | bc -l
+seconds() {  # "wall cpu" seconds of a command, output discarded, exit status ignored
+  /usr/bin/time -o "$work/time.txt" -f "%e %U %S" "$@" >/dev/null 2>&1 || true
+  tail -1 "$work/time.txt" | awk '{printf "%s %.3f\n", $1, $2 + $3}'
 }
-stats() {  # median and minimum of the arguments
-  printf '%s\n' "$@" | sort -g | awk '{v[NR]=$1} END {printf "median %.3f s, min %.3f s", v[int((NR+1)/2)], v[1]}'
+stats() {  # median and minimum wall time, median CPU time of "wall cpu" arguments
+  printf '%s\n' "$@" | awk '{print $1}' | sort -g |
+    awk '{v[NR]=$1} END {printf "median %.3f s, min %.3f s", v[int((NR+1)/2)], v[1]}'
+  printf '%s\n' "$@" | awk '{print $2}' | sort -g |
+    awk '{v[NR]=$1} END {printf ", CPU median %.3f s", v[int((NR+1)/2)]}'
 }
 
 for comp in $compressions; do
@@ -64,12 +65,17 @@ for comp in $compressions; do
   fi
   exr_size=$(du -k "$dir/ref/frame.exr" | cut -f1)
   compare_times=()
+  baseline_times=()
   idiff_times=()
   for ((i = 0; i < rounds; ++i)); do
     compare_times+=("$(seconds "$exe" compare "$dir/ref" "$dir/gl" --out "$work/report-$comp" "${compare_args[@]}")")
+    if [[ -n ${RC_BASELINE:-} ]]; then
+      baseline_times+=("$(seconds "$RC_BASELINE" compare "$dir/ref" "$dir/gl" --out "$work/baseline-$comp")")
+    fi
     idiff_times+=("$(seconds idiff "$dir/ref/color.png" "$dir/gl/color.png")")
   done
   echo "frame.exr $comp (${exr_size} KiB), $rounds rounds:"
   echo "  rastercheck compare ${RC_COMPARE_ARGS:-}: $(stats "${compare_times[@]}")"
+  [[ -z ${RC_BASELINE:-} ]] || echo "  $RC_BASELINE compare: $(stats "${baseline_times[@]}")"
   echo "  idiff (PNGs only):   $(stats "${idiff_times[@]}")"
 done
