@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <tuple>
 #include <type_traits>
 
 #include "fixtures/errors.h"
@@ -132,7 +133,13 @@ struct ABufferTally {
     std::uint32_t near = 0;   // nearer, but drawn first
     std::uint32_t far = 0;    // farther, but drawn after it
     std::uint32_t index = 0;  // pixel, framebuffer order
-    auto operator<=>(const PairPixel&) const = default;
+    // Ordered by pair, then pixel (written out: clang-tidy misreads a defaulted <=>).
+    bool operator<(const PairPixel& o) const {
+      return std::tie(near, far, index) < std::tie(o.near, o.far, o.index);
+    }
+    bool operator==(const PairPixel& o) const {
+      return near == o.near && far == o.far && index == o.index;
+    }
   };
   std::vector<std::uint8_t> pixel_flags;  // per pixel
   std::vector<PairPixel> pair_pixels;     // each (pair, pixel) once

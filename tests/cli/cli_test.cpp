@@ -230,8 +230,7 @@ TEST(CliCompare, FlipIsOptInAndCiede2000AlwaysThere) {
     bool heat = false;
     for (const auto& e : fs::recursive_directory_iterator(out))
       heat = heat || e.path().filename() == "flip_heat.png";
-    const nlohmann::json row =
-        nlohmann::json::parse(readFile(out / "report.json")).at("results").at(0);
+    nlohmann::json row = nlohmann::json::parse(readFile(out / "report.json")).at("results").at(0);
     EXPECT_EQ(row.contains("flip"), heat) << extra;
     EXPECT_TRUE(row.contains("ciede2000")) << extra;
     EXPECT_GT(row.at("ciede2000").at("differing"), 0) << extra;

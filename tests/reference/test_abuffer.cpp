@@ -89,7 +89,7 @@ Oracle oracleAtPoint(const std::vector<Tri>& tris, const glm::dvec2& c) {
     const double l1 = ((c.x - a.x) * (d.y - a.y) - (d.x - a.x) * (c.y - a.y)) / area;
     const double l2 = ((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y)) / area;
     const double world_z = (1 - l1 - l2) * t.p[0].z + l1 * t.p[1].z + l2 * t.p[2].z;
-    frags.push_back({1.0 - world_z, k});
+    frags.emplace_back(1.0 - world_z, k);
   }
   std::sort(frags.begin(), frags.end(), [](auto& x, auto& y) { return x.first > y.first; });
   for (std::size_t i = 0; i + 1 < frags.size(); ++i)
