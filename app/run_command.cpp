@@ -175,12 +175,7 @@ void writeText(const fs::path& file, const std::string& text) {
 int runCommand(const RunArgs& args) {
   CommandLineTolerances cli;
   parseToleranceArgs(args.tolerance, cli);
-  Expectations known;
-  if (args.expectations != "none") {
-    const fs::path file =
-        args.expectations.empty() ? defaultExpectationsFile() : fs::path(args.expectations);
-    if (!args.expectations.empty() || fs::exists(file)) known = readExpectations(file);
-  }
+  const Expectations known = expectationsFromArgument(args.expectations);
   if (args.backends.empty()) throw InputError("run: --backends needs at least one SPEC");
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 #include "fixtures/errors.h"
 #include "fixtures/multisample.h"
@@ -95,8 +97,10 @@ struct TriangleContext {
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
   float depth_slope = 0.0f;   // |grad z| in depth-format steps per px
+  float depth_reach = 0.0f;   // steps: its vertices' float32 window-depth reach (the largest)
   bool texel_choice = false;  // textured: record the texel channels
   glm::dvec2 uq_max{0.0};     // largest |u / w|, |v / w| over its three vertices
+  glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
 };
 
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
@@ -104,6 +108,7 @@ struct TexelNote {
   float dist = 1.0f;  // px
   float alt = 0.0f;   // 8-bit units, weighted as the fragment's colour is in the pixel
   float gain = 0.0f;  // units per texel unit, weighted alike
+  float reach = 0.0f;  // linear filtering: texels (s + t) the sample may move
 };
 
 // Working buffers that are not part of the Frame (depth keys and depth_gap state: 12 bytes
@@ -223,7 +228,17 @@ class Renderer {
   const SampleShift shift_;            // multisampling: the sample drawn
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
+  // textureRange() of each texture met so far (linear filtering with uncertainty).
+  std::vector<std::pair<const Texture*, glm::dvec4>> texture_ranges_;
+  const glm::dvec4& textureRangeOf(const Texture* texture);
 };
+
+const glm::dvec4& Renderer::textureRangeOf(const Texture* texture) {
+  for (const auto& [t, range] : texture_ranges_)
+    if (t == texture) return range;
+  texture_ranges_.emplace_back(texture, textureRange(*texture));
+  return texture_ranges_.back().second;
+}
 
 void Renderer::transformVertices() {
   vertices_.resize(scene_.objects.size());
@@ -371,16 +386,24 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     return (cull == Cull::Back && !front) || (cull == Cull::Front && front);
   };
 
+  float depth_reach = 0.0f;
   if (uncertainty_) {
     // How far a float32 implementation may put each vertex beyond snapping (its clip
-    // coordinates' error through the divide and the viewport): its edges' reach.
+    // coordinates' error through the divide and the viewport): its edges' reach, and the
+    // same error in window depth, which the driver interpolates between the vertices (a
+    // convex combination: the largest vertex's bounds it).
     double reach[kMaxClipVertices];
     double max_reach = 0.0;
+    double max_depth_reach = 0.0;
     for (int i = 0; i < count; ++i) {
       reach[i] = windowErrorPx(poly[i], scene_.width, scene_.height);
       if (!(reach[i] < kMaxVertexReachPx)) reach[i] = kMaxVertexReachPx;  // NaN too
       max_reach = std::max(max_reach, reach[i]);
+      const double dz = windowDepthError(poly[i]);
+      max_depth_reach = dz >= max_depth_reach ? dz : max_depth_reach;
+      if (std::isnan(dz)) max_depth_reach = std::numeric_limits<double>::infinity();
     }
+    depth_reach = static_cast<float>(max_depth_reach * depth_steps_);
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
     if (rasterized || cullCouldFlip(wv, count, max_reach)) {
@@ -413,7 +436,10 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     if (shift_.active) interp.shiftDepth(shift_.offset.x, shift_.offset.y);
     if (uncertainty_) {
       t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
+      t.depth_reach = depth_reach;
       t.texel_choice = t.texture != nullptr;
+      if (t.texel_choice && scene_.state.texture_filter == TextureFilter::Linear)
+        t.texture_range = textureRangeOf(t.texture);
       if (t.texel_choice) {
         t.uq_max = glm::dvec2(0.0);
         for (const WindowVertex* w : {&wv[0], &wv[i], &wv[i + 1]}) {
@@ -492,8 +518,9 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
 // The texel channels of a textured fragment (docs/tolerances.md (c), (d), (e)), in 8-bit
 // units weighted by alpha when the fragment is blended: the gain (how much a texel unit
 // moves the colour: the ambient and diffuse light on the texture); with linear filtering
-// the colour range of the footprint; with nearest filtering how far (px) the sample is from
-// a texel boundary beyond float rounding and how much the colour would change with the
+// how far float rounding may move the sample (texels) and the colour range of every
+// footprint within that reach; with nearest filtering how far (px) the sample is from a
+// texel boundary beyond float rounding and how much the colour would change with the
 // texel(s) across it.
 TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                               const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
@@ -502,13 +529,6 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
   TexelNote note;
   note.gain = static_cast<float>(
       weight * std::max({ambient_diffuse.x, ambient_diffuse.y, ambient_diffuse.z, 0.0}));
-  if (scene_.state.texture_filter == TextureFilter::Linear) {
-    const glm::dvec4 range = linearFootprintRange(*t.texture, uv, scene_.state.texture_wrap);
-    double alt = 0.0;
-    for (int c = 0; c < 3; ++c) alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
-    note.alt = static_cast<float>(255.0 * alt * weight);
-    return note;
-  }
   glm::dvec3 db[2];
   interp.barycentricGradient(row, dx, b, db);
   const glm::dvec3 u(t.v[0]->uv.x, t.v[1]->uv.x, t.v[2]->uv.x);
@@ -527,6 +547,19 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
   tt.gradient = h * std::hypot(glm::dot(db[0], v), glm::dot(db[1], v));
   tt.reach = kTexelCoordinateReach *
              (h * std::max(std::fabs(uv.y), t.uq_max.y / std::fabs(q)) + tt.gradient * image);
+  if (scene_.state.texture_filter == TextureFilter::Linear) {
+    // Where float32 interpolation may move the sample (reach, texels), the filter may
+    // read any footprint within it: the colour range over all of them.
+    const glm::dvec4 range = linearReachRange(*t.texture, uv, scene_.state.texture_wrap, s.reach,
+                                              tt.reach, t.texture_range);
+    double alt = 0.0;
+    for (int c = 0; c < 3; ++c) alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
+    note.alt = static_cast<float>(255.0 * alt * weight);
+    const double reach = s.reach + tt.reach;
+    note.reach = std::isnan(reach) ? std::numeric_limits<float>::infinity()
+                                   : static_cast<float>(reach);
+    return note;
+  }
   const TexelChoice choice = nearestTexelChoice(*t.texture, s, tt, scene_.state.texture_wrap, 1.0);
   note.dist = static_cast<float>(choice.dist_px);
   double alt = 0.0;
@@ -584,6 +617,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
   const bool depth_write = t.pass->depth_write;
   const bool blend = t.pass->blend;
   const float slope = t.depth_slope;
+  const float reach = t.depth_reach;
   const auto alpha = static_cast<float>(std::clamp(t.material->opacity, 0.0, 1.0));
   const std::uint32_t id = t.prim->id;
   std::uint32_t* const depth = depth_.data();
@@ -603,16 +637,17 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       const bool pass = always || key < depth[index];
       if constexpr (kGaps) {
         if (pass) {
-          gaps_.passed(index, z, slope, !always, depth_write, blend);
+          gaps_.passed(index, z, slope, reach, !always, depth_write, blend);
         } else {
-          gaps_.failed(index, z, slope, blend);
+          gaps_.failed(index, z, slope, reach, blend);
         }
       }
       if (!pass) continue;
       if (depth_write) depth[index] = key;
       ids[index] = id;
       const TexelNote note = shade(index, row, dx);
-      if constexpr (kGaps) gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain);
+      if constexpr (kGaps)
+        gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain, note.reach);
     }
   });
 }
@@ -794,6 +829,8 @@ constexpr bool kTakeSmallest[kUncertaintyChannels] = {
     true,   // clear_gap
     false,  // clear_slope
     false,  // texel_gain
+    false,  // depth_reach
+    false,  // texel_reach
 };
 
 // Multisampling: one render per sample (SampleShift), then the resolve: the colour is the
