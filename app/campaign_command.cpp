@@ -270,7 +270,8 @@ class Campaign {
     for (const CampaignFailure& f : failures_) {
       const fs::path record = failureDir(f) / "failure.json";
       if (!fs::exists(record, ec)) continue;
-      CampaignFailure& done = done_[f.id] = campaignFailureFromJson(readJson(record), record.string());
+      CampaignFailure& done = done_[f.id] =
+          campaignFailureFromJson(readJson(record), record.string());
       done.known = f.known;  // the expectations file as it is now, not as it was then
     }
   }

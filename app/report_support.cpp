@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "compare/pair_images.h"
 #include "app/paths.h"
+#include "compare/pair_images.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
 #include "fixtures/multisample.h"

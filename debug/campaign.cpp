@@ -228,16 +228,16 @@ std::vector<CampaignFailure> failuresOfReport(
       pair.actual = base.actual;
       pair.status = Status::Fail;
       if (row.contains("state") && row["state"].is_object()) pair.state = row["state"];
-      const json* stack = row.contains("stacks") && row["stacks"].is_object() &&
-                                  row["stacks"].contains("actual")
-                              ? &row["stacks"]["actual"]
-                              : nullptr;
+      const json* stack =
+          row.contains("stacks") && row["stacks"].is_object() && row["stacks"].contains("actual")
+              ? &row["stacks"]["actual"]
+              : nullptr;
       if (stack && stack->is_object() && stack->contains("gl_version") &&
           (*stack)["gl_version"].is_string())
         pair.actual_driver = (*stack)["gl_version"].get<std::string>();
-      for (auto [cls, status_of] : {std::pair{"visibility", &pair.visibility.status},
-                                    std::pair{"depth", &pair.depth.status},
-                                    std::pair{"shading", &pair.shading.status}}) {
+      for (auto [cls, status_of] :
+           {std::pair{"visibility", &pair.visibility.status},
+            std::pair{"depth", &pair.depth.status}, std::pair{"shading", &pair.shading.status}}) {
         const bool failed =
             row.contains(cls) && row[cls].is_object() && row[cls].value("status", "") == "fail";
         *status_of = failed ? Status::Fail : Status::Pass;

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -96,18 +96,18 @@ struct TriangleContext {
   bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
-  float depth_slope = 0.0f;   // |grad z| in depth-format steps per px
-  float depth_reach = 0.0f;   // steps: its vertices' float32 window-depth reach (the largest)
-  bool texel_choice = false;  // textured: record the texel channels
-  glm::dvec2 uq_max{0.0};     // largest |u / w|, |v / w| over its three vertices
+  float depth_slope = 0.0f;       // |grad z| in depth-format steps per px
+  float depth_reach = 0.0f;       // steps: its vertices' float32 window-depth reach (the largest)
+  bool texel_choice = false;      // textured: record the texel channels
+  glm::dvec2 uq_max{0.0};         // largest |u / w|, |v / w| over its three vertices
   glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
 };
 
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
 struct TexelNote {
-  float dist = 1.0f;  // px
-  float alt = 0.0f;   // 8-bit units, weighted as the fragment's colour is in the pixel
-  float gain = 0.0f;  // units per texel unit, weighted alike
+  float dist = 1.0f;   // px
+  float alt = 0.0f;    // 8-bit units, weighted as the fragment's colour is in the pixel
+  float gain = 0.0f;   // units per texel unit, weighted alike
   float reach = 0.0f;  // linear filtering: texels (s + t) the sample may move
 };
 
@@ -556,8 +556,8 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
     for (int c = 0; c < 3; ++c) alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
     note.alt = static_cast<float>(255.0 * alt * weight);
     const double reach = s.reach + tt.reach;
-    note.reach = std::isnan(reach) ? std::numeric_limits<float>::infinity()
-                                   : static_cast<float>(reach);
+    note.reach =
+        std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
     return note;
   }
   const TexelChoice choice = nearestTexelChoice(*t.texture, s, tt, scene_.state.texture_wrap, 1.0);

@@ -108,11 +108,16 @@ glm::dvec4 linearFootprintRange(const Texture& texture, const glm::dvec2& uv, Te
 
 namespace {
 
-// The texel indices [first, last] (before wrapping) of one axis that footprints within
-// `reach` texels of coordinate `coord` (u * size) read; nullopt when they span the axis.
-std::optional<std::pair<double, double>> reachSpan(double coord, double reach, int size) {
-  const double first = std::floor(coord - 0.5 - reach);
-  const double last = std::floor(coord - 0.5 + reach) + 1.0;
+// The texel indices [first, last] of one axis that footprints within `reach` texels of
+// coordinate `coord` (u * size) read: under repeat before wrapping (nullopt when they span
+// the axis), under clamp already clamped into [0, size - 1].
+std::optional<std::pair<double, double>> reachSpan(double coord, double reach, int size,
+                                                   TextureWrap wrap) {
+  double first = std::floor(coord - 0.5 - reach);
+  double last = std::floor(coord - 0.5 + reach) + 1.0;
+  if (std::isnan(first) || std::isnan(last)) return std::nullopt;
+  if (wrap == TextureWrap::Clamp)
+    return std::pair{std::clamp(first, 0.0, size - 1.0), std::clamp(last, 0.0, size - 1.0)};
   if (!std::isfinite(first) || !std::isfinite(last) || last - first + 1.0 >= size)
     return std::nullopt;
   return std::pair{first, last};
@@ -122,8 +127,8 @@ std::optional<std::pair<double, double>> reachSpan(double coord, double reach, i
 
 glm::dvec4 linearReachRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap,
                             double reach_s, double reach_t, const glm::dvec4& whole) {
-  const auto cols = reachSpan(uv.x * texture.width, reach_s, texture.width);
-  const auto rows = reachSpan(uv.y * texture.height, reach_t, texture.height);
+  const auto cols = reachSpan(uv.x * texture.width, reach_s, texture.width, wrap);
+  const auto rows = reachSpan(uv.y * texture.height, reach_t, texture.height, wrap);
   const double ncols = cols ? cols->second - cols->first + 1.0 : texture.width;
   const double nrows = rows ? rows->second - rows->first + 1.0 : texture.height;
   if (ncols * nrows > static_cast<double>(kMaxReachTexels)) return whole;

@@ -50,7 +50,8 @@ glm::dvec4 linearFootprintRange(const Texture& texture, const glm::dvec2& uv, Te
 
 // The same over every footprint the filter may read when the sample moves by up to
 // reach_s, reach_t texels: columns floor(u W - 0.5 - reach_s) to floor(u W - 0.5 + reach_s) + 1,
-// rows alike (every one once they span the texture). `whole` (the range of the whole
+// rows alike, wrapped (every one once they span the texture) or clamped as `wrap` says.
+// `whole` (the range of the whole
 // texture) answers when more than kMaxReachTexels texels would be visited.
 inline constexpr long kMaxReachTexels = 256;
 glm::dvec4 linearReachRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap,

@@ -84,9 +84,9 @@ TEST(CampaignFailures, OneFailurePerFailingClassAndOneForAnError) {
 // pair is known only when all its failing classes are.
 TEST(CampaignFailures, ExpectationsAreAppliedAsTheyAreNowNotAsTheRunMarkedThem) {
   const Expectations x = parseExpectations(json::parse(R"({"expectations": [
-      {"id": "sp-d16-depth", "backend": "gl:*:softpipe", "driver_version": "*Mesa 22.*",
+      {"id": "sp-d16-depth", "fixture": "*", "backend": "gl:*:softpipe", "driver_version": "*Mesa 22.*",
        "state": {"depth_format": "d16"}, "class": "depth", "reason": "r"},
-      {"id": "sp-d16-vis", "backend": "gl:*:softpipe", "state": {"depth_format": "d16"},
+      {"id": "sp-d16-vis", "fixture": "*", "backend": "gl:*:softpipe", "state": {"depth_format": "d16"},
        "class": "visibility", "reason": "r"}]})"),
                                            "test");
   auto pair = [](const std::string& fixture, const std::string& version, const std::string& depth,
@@ -114,7 +114,9 @@ TEST(CampaignFailures, ExpectationsAreAppliedAsTheyAreNowNotAsTheRunMarkedThem) 
   EXPECT_EQ(known["e/shading"], "");
   // Without the file, what the run wrote.
   for (const CampaignFailure& f : read(r))
-    if (f.cls == "depth") EXPECT_EQ(f.known, "stale") << f.fixture;
+    if (f.cls == "depth") {
+      EXPECT_EQ(f.known, "stale") << f.fixture;
+    }
 }
 
 TEST(CampaignFailures, MalformedReportsNameTheFileAndPath) {

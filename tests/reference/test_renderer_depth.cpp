@@ -491,7 +491,9 @@ TEST(DepthReach, FollowsTheMagnitudeOfTheWorldCoordinates) {
     if (far.id[i] != 0) ++drawn;
     far_max = std::max(far_max, far.depth_reach[i]);
     near_max = std::max(near_max, near.depth_reach[i]);
-    if (far.id[i] == 0) EXPECT_EQ(far.depth_reach[i], 0.0f) << "nothing tested there";
+    if (far.id[i] == 0) {
+      EXPECT_EQ(far.depth_reach[i], 0.0f) << "nothing tested there";
+    }
   }
   EXPECT_GT(drawn, 100);
   EXPECT_GT(far_max, 1477.0f);  // what the drivers measured must be inside it
