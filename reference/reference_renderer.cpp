@@ -82,6 +82,44 @@ bool isFinite(const glm::dvec4& v) {
 // ---- the renderer -----------------------------------------------------------------------
 
 // What the fragment loop needs about the original triangle being drawn.
+// A per-vertex error bound interpolated over a fan triangle in screen space: GL interpolates
+// window z with the triangle's screen-space barycentrics (non-negative, summing to 1 at a
+// covered pixel), so a fragment's depth error is at most the same combination of its
+// vertices' errors. Clamped to the vertices' range (snapping may cover a centre just
+// outside the exact triangle); a degenerate or non-finite setup gives the largest.
+struct ReachPlane {
+  double x0 = 0.0;
+  double y0 = 0.0;
+  double at0 = 0.0;
+  double ddx = 0.0;
+  double ddy = 0.0;
+  double lo = 0.0;
+  double hi = 0.0;
+
+  void setup(const WindowVertex& a, const WindowVertex& b, const WindowVertex& c, double ra,
+             double rb, double rc) {
+    x0 = a.x;
+    y0 = a.y;
+    at0 = ra;
+    lo = std::min({ra, rb, rc});
+    hi = std::max({ra, rb, rc});
+    ddx = ddy = 0.0;
+    const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    const double gx = ((rb - ra) * (c.y - a.y) - (rc - ra) * (b.y - a.y)) / det;
+    const double gy = ((b.x - a.x) * (rc - ra) - (c.x - a.x) * (rb - ra)) / det;
+    if (det != 0.0 && std::isfinite(gx) && std::isfinite(gy)) {
+      ddx = gx;
+      ddy = gy;
+    } else {
+      at0 = lo = hi;
+    }
+  }
+  float at(double x, double y) const {
+    const double r = at0 + ddx * (x - x0) + ddy * (y - y0);
+    return static_cast<float>(std::clamp(r, lo, hi));
+  }
+};
+
 struct TriangleContext {
   const PrimitiveRef* prim = nullptr;
   const DrawPass* pass = nullptr;
@@ -97,7 +135,7 @@ struct TriangleContext {
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
   float depth_slope = 0.0f;       // |grad z| in depth-format steps per px
-  float depth_reach = 0.0f;       // steps: its vertices' float32 window-depth reach (the largest)
+  ReachPlane depth_reach;         // steps: its vertices' float32 window-depth reach, interpolated
   bool texel_choice = false;      // textured: record the texel channels
   glm::dvec2 uq_max{0.0};         // largest |u / w|, |v / w| over its three vertices
   glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
@@ -386,7 +424,7 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     return (cull == Cull::Back && !front) || (cull == Cull::Front && front);
   };
 
-  float depth_reach = 0.0f;
+  double depth_reach[kMaxClipVertices] = {};  // steps, per vertex
   if (uncertainty_) {
     // How far a float32 implementation may put each vertex beyond snapping (its clip
     // coordinates' error through the divide and the viewport): its edges' reach, and the
@@ -394,16 +432,13 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     // convex combination: the largest vertex's bounds it).
     double reach[kMaxClipVertices];
     double max_reach = 0.0;
-    double max_depth_reach = 0.0;
     for (int i = 0; i < count; ++i) {
       reach[i] = windowErrorPx(poly[i], scene_.width, scene_.height);
       if (!(reach[i] < kMaxVertexReachPx)) reach[i] = kMaxVertexReachPx;  // NaN too
       max_reach = std::max(max_reach, reach[i]);
-      const double dz = windowDepthError(poly[i]);
-      max_depth_reach = dz >= max_depth_reach ? dz : max_depth_reach;
-      if (std::isnan(dz)) max_depth_reach = std::numeric_limits<double>::infinity();
+      const double dz = windowDepthError(poly[i]) * depth_steps_;
+      depth_reach[i] = std::isnan(dz) ? std::numeric_limits<double>::infinity() : dz;
     }
-    depth_reach = static_cast<float>(max_depth_reach * depth_steps_);
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
     if (rasterized || cullCouldFlip(wv, count, max_reach)) {
@@ -436,7 +471,8 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     if (shift_.active) interp.shiftDepth(shift_.offset.x, shift_.offset.y);
     if (uncertainty_) {
       t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
-      t.depth_reach = depth_reach;
+      t.depth_reach.setup(wv[0], wv[i], wv[i + 1], depth_reach[0], depth_reach[i],
+                          depth_reach[i + 1]);
       t.texel_choice = t.texture != nullptr;
       if (t.texel_choice && scene_.state.texture_filter == TextureFilter::Linear)
         t.texture_range = textureRangeOf(t.texture);
@@ -617,7 +653,6 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
   const bool depth_write = t.pass->depth_write;
   const bool blend = t.pass->blend;
   const float slope = t.depth_slope;
-  const float reach = t.depth_reach;
   const auto alpha = static_cast<float>(std::clamp(t.material->opacity, 0.0, 1.0));
   const std::uint32_t id = t.prim->id;
   std::uint32_t* const depth = depth_.data();
@@ -636,6 +671,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       const std::uint32_t key = depthKey(z, kFormat);  // kFormat constant: the switch folds
       const bool pass = always || key < depth[index];
       if constexpr (kGaps) {
+        const float reach = t.depth_reach.at(px + 0.5, cy);
         if (pass) {
           gaps_.passed(index, z, slope, reach, !always, depth_write, blend);
         } else {
