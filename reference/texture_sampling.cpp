@@ -89,32 +89,13 @@ AxisChoice axisChoice(const TexelAxis& a, int size, TextureWrap wrap, double cap
   return out;
 }
 
-}  // namespace
-
-glm::dvec4 linearFootprintRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap) {
-  const double fs = std::floor(uv.x * texture.width - 0.5);
-  const double ft = std::floor(uv.y * texture.height - 0.5);
-  const int i0 = wrapIndex(fs, texture.width, wrap);
-  const int i1 = wrapIndex(fs + 1.0, texture.width, wrap);
-  const int j0 = wrapIndex(ft, texture.height, wrap);
-  const int j1 = wrapIndex(ft + 1.0, texture.height, wrap);
-  const glm::dvec4 t00 = texel(texture, i0, j0);
-  const glm::dvec4 t10 = texel(texture, i1, j0);
-  const glm::dvec4 t01 = texel(texture, i0, j1);
-  const glm::dvec4 t11 = texel(texture, i1, j1);
-  return glm::max(glm::max(t00, t10), glm::max(t01, t11)) -
-         glm::min(glm::min(t00, t10), glm::min(t01, t11));
-}
-
-namespace {
-
 // The texel indices [first, last] of one axis that footprints within `reach` texels of
 // coordinate `coord` (u * size) read: under repeat before wrapping (nullopt when they span
 // the axis), under clamp already clamped into [0, size - 1].
 std::optional<std::pair<double, double>> reachSpan(double coord, double reach, int size,
                                                    TextureWrap wrap) {
-  double first = std::floor(coord - 0.5 - reach);
-  double last = std::floor(coord - 0.5 + reach) + 1.0;
+  const double first = std::floor(coord - 0.5 - reach);
+  const double last = std::floor(coord - 0.5 + reach) + 1.0;
   if (std::isnan(first) || std::isnan(last)) return std::nullopt;
   if (wrap == TextureWrap::Clamp)
     return std::pair{std::clamp(first, 0.0, size - 1.0), std::clamp(last, 0.0, size - 1.0)};
