@@ -22,6 +22,7 @@
 #include "app/campaign_support.h"
 #include "app/commands.h"
 #include "app/paths.h"
+#include "app/report_support.h"
 #include "app/subprocess.h"
 #include "compare/atomic_file.h"
 #include "compare/tolerances.h"
@@ -73,7 +74,8 @@ class Campaign {
         jobs_(args.jobs > 0 ? args.jobs
                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))),
         folder_(fs::absolute(args.out).lexically_normal(), identity(), args.command_line),
-        exe_(selfExecutable().string()) {}
+        exe_(selfExecutable().string()),
+        expectations_(expectationsFromArgument(args.expectations)) {}
 
   int run() {
     const auto start = Clock::now();
@@ -176,7 +178,7 @@ class Campaign {
                           ? FixtureInfo{}
                           : FixtureInfo{it->second->file.string(), it->second->tags};
              },
-             (dir / "report.json").string()))
+             (dir / "report.json").string(), &expectations_))
       failures_.push_back(std::move(f));
     finished_runs_.push_back(range);
     run_names_.push_back(rel);
@@ -267,8 +269,10 @@ class Campaign {
     std::error_code ec;
     for (const CampaignFailure& f : failures_) {
       const fs::path record = failureDir(f) / "failure.json";
-      if (fs::exists(record, ec))
-        done_[f.id] = campaignFailureFromJson(readJson(record), record.string());
+      if (!fs::exists(record, ec)) continue;
+      CampaignFailure& done = done_[f.id] =
+          campaignFailureFromJson(readJson(record), record.string());
+      done.known = f.known;  // the expectations file as it is now, not as it was then
     }
   }
 
@@ -634,9 +638,9 @@ class Campaign {
     return code;
   }
 
-  // A group is covered when every one of its failures was marked known by the `run` that
-  // found it (run applies the expectations file: compare/expectations.h); the entry ids
-  // are named. A group with any unmarked failure is not covered.
+  // A group is covered when every one of its failures is known: the expectations file as
+  // it is now, applied to the report of the run that found it (failuresOfReport); the
+  // entry ids are named. A group with any unmarked failure is not covered.
   static ExpectationVerdict expectationFor(const CampaignGroup& g) {
     ExpectationVerdict v;
     v.checked = true;
@@ -655,6 +659,9 @@ class Campaign {
   InterruptGuard interrupt_;
   CampaignFolder folder_;
   const std::string exe_;
+  // The known differences, re-applied to every run's report when it is read (a resumed
+  // campaign picks up entries added since its runs were made).
+  const Expectations expectations_;
   StatusLine status_;
   std::vector<CampaignScene> scenes_;
   std::map<std::string, const CampaignScene*> scene_of_;

@@ -442,8 +442,9 @@ std::string story(const Json& doc) {
                                  : "",
                    doc["depth_gap"].is_null() ? std::string("none (fewer than two fragments)")
                                               : fmtNum(doc["depth_gap"]) + " steps");
-  s += fmt::format("  depth_slope {} steps/px, gap_slope {} steps/px\n", fmtNum(doc["depth_slope"]),
-                   fmtNum(doc["gap_slope"]));
+  s +=
+      fmt::format("  depth_slope {} steps/px, gap_slope {} steps/px, depth_reach {} steps\n",
+                  fmtNum(doc["depth_slope"]), fmtNum(doc["gap_slope"]), fmtNum(doc["depth_reach"]));
   if (doc["clear_gap"].is_number())
     s += fmt::format(
         "  clear_gap {} steps (slope {}): how close the pixel came to the other side of "

@@ -8,12 +8,21 @@
 
 #include <fmt/format.h>
 
+#include "app/paths.h"
 #include "compare/pair_images.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
 #include "fixtures/multisample.h"
 
 namespace rc {
+
+Expectations expectationsFromArgument(const std::string& arg) {
+  if (arg == "none") return {};
+  const std::filesystem::path file =
+      arg.empty() ? defaultExpectationsFile() : std::filesystem::path(arg);
+  if (!arg.empty() || std::filesystem::exists(file)) return readExpectations(file);
+  return {};
+}
 namespace fs = std::filesystem;
 
 ToleranceOverrides fixtureTolerance(const Frame& expected, const Frame& actual) {

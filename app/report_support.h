@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "compare/compare.h"
+#include "compare/expectations.h"
 #include "compare/pair_images.h"
 #include "compare/report.h"
 #include "compare/tolerances.h"
@@ -20,6 +21,11 @@
 #include "reference/reference_renderer.h"
 
 namespace rc {
+
+// The known differences `run --expectations ARG` applies: ARG a file, "none" (no entries),
+// or empty for defaultExpectationsFile() when it exists. `campaign` re-applies the same
+// file to its runs' reports. Throws InputError for a file that cannot be read or is invalid.
+Expectations expectationsFromArgument(const std::string& arg);
 
 // The fixture's own tolerance block for a pair: frame.json "tolerance" (recorded by
 // `render`; the expected side's, else the actual side's), else the fixture file named by

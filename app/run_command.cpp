@@ -180,12 +180,7 @@ int runCommand(const RunArgs& args) {
     Tolerances check;  // a bad threshold is refused before anything renders
     applyOverrides(check, cli);
   }
-  Expectations known;
-  if (args.expectations != "none") {
-    const fs::path file =
-        args.expectations.empty() ? defaultExpectationsFile() : fs::path(args.expectations);
-    if (!args.expectations.empty() || fs::exists(file)) known = readExpectations(file);
-  }
+  const Expectations known = expectationsFromArgument(args.expectations);
   if (args.backends.empty()) throw InputError("run: --backends needs at least one SPEC");
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));

@@ -558,10 +558,7 @@ class Comparator {
                                     : kInf;
     if (edge <= band_) return true;
     if (!have_uncertainty_) return false;
-    by_gap = a != 0 && b != 0 ? static_cast<double>(u_.depth_gap[i]) <=
-                                    2.0 * (tol_.depth.fail + depth_slope_band_ * u_.gap_slope[i])
-                              : static_cast<double>(u_.clear_gap[i]) <=
-                                    tol_.depth.fail + depth_slope_band_ * u_.clear_slope[i];
+    by_gap = ambiguousByDepth(i, a, b);
     return by_gap;
   }
 
@@ -700,6 +697,34 @@ class Comparator {
     return std::isnan(s) ? 0.0 : s;
   }
 
+  // How far float32 vertex transforms may move the window depth of pixel i's fragments
+  // (steps, the reference's depth_reach); 0 without uncertainty channels, NaN excuses nothing.
+  double depthReach(std::size_t i) const {
+    const double r = have_uncertainty_ ? static_cast<double>(u_.depth_reach[i]) : 0.0;
+    return std::isnan(r) ? 0.0 : r;
+  }
+
+  // The depth allowance of pixel i on top of the warn or fail threshold, for a fragment of
+  // depth gradient `slope` (steps/px): where snapping moves its plane, plus its vertices'
+  // float32 reach (docs/tolerances.md section 2).
+  double depthAllowance(std::size_t i, double slope) const {
+    return depth_slope_band_ * slope + depthReach(i);
+  }
+
+  // Whether the reference's depth comparisons at pixel i could legally go the other way,
+  // so that the driver shows id b where the reference shows a. Each fragment's stored
+  // depth may be off by its tolerance (fail + allowance) in either direction; two
+  // fragments closer than the sum may swap. The slope is the steeper fragment's of the
+  // comparisons that decided the pixel (gap_slope). Against the clear depth (missing,
+  // extra: primitive or background), only the fragment's own tolerance: the clear value
+  // is exact on both sides.
+  bool ambiguousByDepth(std::size_t i, std::uint32_t a, std::uint32_t b) const {
+    return a != 0 && b != 0 ? static_cast<double>(u_.depth_gap[i]) <=
+                                  2.0 * (tol_.depth.fail + depthAllowance(i, u_.gap_slope[i]))
+                            : static_cast<double>(u_.clear_gap[i]) <=
+                                  tol_.depth.fail + depthAllowance(i, u_.clear_slope[i]);
+  }
+
   // Whether the fragments blended under the top one at pixel i may legally differ: a
   // blended pixel near a polygon edge (another fragment may or may not cover it) or with
   // a blended fragment's depth test within the tolerance of flipping. Its depth and colour
@@ -708,14 +733,14 @@ class Comparator {
     if (!have_uncertainty_ || !(u_.blend_count[i] > 0.0f)) return false;
     return static_cast<double>(u_.edge_dist[i]) <= band_ ||
            static_cast<double>(u_.blend_gap[i]) <=
-               2.0 * (tol_.depth.fail + depth_slope_band_ * u_.blend_slope[i]);
+               2.0 * (tol_.depth.fail + depthAllowance(i, u_.blend_slope[i]));
   }
 
   // dz is over warn: check it against the pixel's slope allowance.
   __attribute__((noinline)) void depthOverBase(int, int, std::size_t i, double dz) {
     DepthStats& d = r_.depth;
     const double slope = depthSlope(i);  // NaN excuses nothing
-    const double allow = depth_slope_band_ * slope;
+    const double allow = depthAllowance(i, slope);
     if (maps_) maps_->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allow);
     d.max_slope = std::max(d.max_slope, slope);
     const double excess = dz - (tol_.depth.warn + allow);
@@ -762,9 +787,12 @@ class Comparator {
     if (have_uncertainty_) {
       if (tol_.texel_choice > 0.0 && static_cast<double>(u_.texel_dist[i]) <= texel_band_)
         texel = tol_.texel_choice * u_.texel_alt[i];
-      // Linear filtering: quantised weights move the value by a fraction of the footprint's
-      // colour range (texel_alt), the 8-bit filtered texel by a unit times its light.
-      filtering = tol_.texture_weight_error * u_.texel_alt[i] +
+      // Linear filtering: quantised weights, and a sample moved by float32 interpolation
+      // (texel_reach, texels), move the value by a fraction of the colour range of the
+      // footprints it may read (texel_alt); the 8-bit filtered texel by a unit times its
+      // light. (NaN reach: excuses nothing.)
+      const double reach = std::isnan(u_.texel_reach[i]) ? 0.0 : u_.texel_reach[i];
+      filtering = (tol_.texture_weight_error + std::min(1.0, reach)) * u_.texel_alt[i] +
                   tol_.texture_rounding_units * u_.texel_gain[i];
       blends = tol_.blend_rounding_units * u_.blend_count[i];
     }
@@ -830,15 +858,7 @@ class Comparator {
     bool ambiguous = edge <= band_;  // false for NaN
     bool by_gap = false;
     if (!ambiguous && have_uncertainty_) {
-      // Each fragment's stored depth may be off by its tolerance, fail + slope allowance,
-      // in either direction; two fragments closer than the sum may swap. The slope is the
-      // steeper fragment's of the comparisons that decided the pixel (gap_slope). Against
-      // the clear depth (missing, extra: primitive or background), only the fragment's
-      // own tolerance: the clear value is exact on both sides.
-      by_gap = a != 0 && b != 0 ? static_cast<double>(u_.depth_gap[i]) <=
-                                      2.0 * (tol_.depth.fail + depth_slope_band_ * u_.gap_slope[i])
-                                : static_cast<double>(u_.clear_gap[i]) <=
-                                      tol_.depth.fail + depth_slope_band_ * u_.clear_slope[i];
+      by_gap = ambiguousByDepth(i, a, b);
       ambiguous = by_gap;
     }
     return record(i, a, b, ambiguous, by_gap, edge);
@@ -901,7 +921,7 @@ class Comparator {
     } else if (depth_max_ > 0.0) {  // all equal: no worst pixel
       d.worst = pixelAt(depth_max_at_);
       d.worst_steps = depth_max_;
-      d.worst_allowance = depth_slope_band_ * depthSlope(depth_max_at_);
+      d.worst_allowance = depthAllowance(depth_max_at_, depthSlope(depth_max_at_));
     }
     d.status = d.over_fail ? Status::Fail : d.over_tolerance ? Status::Warn : Status::Pass;
 

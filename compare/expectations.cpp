@@ -179,27 +179,24 @@ std::vector<const Expectation*> expectationsFor(const Expectations& x, const Pai
   return out;
 }
 
-void applyExpectations(const Expectations& x, Report& report) {
-  for (PairResult& r : report.results) {
-    r.known.clear();
-    if (r.status != Status::Fail) continue;
-    const PairContext pair = contextOf(r);
-    std::vector<KnownFailure> known;
-    bool all = true;
-    const std::pair<const char*, Status> classes[] = {{"visibility", r.visibility.status},
-                                                      {"depth", r.depth.status},
-                                                      {"shading", r.shading.status}};
-    for (const auto& [cls, status] : classes) {
-      if (status != Status::Fail) continue;
-      const auto entries = expectationsFor(x, pair, cls);
-      if (entries.empty()) {
-        all = false;
-        break;
-      }
-      for (const Expectation* e : entries) known.push_back({e->id, e->cls, e->reason});
-    }
-    if (all) r.known = std::move(known);
+std::vector<KnownFailure> knownFailuresOf(const Expectations& x, const PairResult& r) {
+  if (r.status != Status::Fail) return {};
+  const PairContext pair = contextOf(r);
+  std::vector<KnownFailure> known;
+  const std::pair<const char*, Status> classes[] = {{"visibility", r.visibility.status},
+                                                    {"depth", r.depth.status},
+                                                    {"shading", r.shading.status}};
+  for (const auto& [cls, status] : classes) {
+    if (status != Status::Fail) continue;
+    const auto entries = expectationsFor(x, pair, cls);
+    if (entries.empty()) return {};
+    for (const Expectation* e : entries) known.push_back({e->id, e->cls, e->reason});
   }
+  return known;
+}
+
+void applyExpectations(const Expectations& x, Report& report) {
+  for (PairResult& r : report.results) r.known = knownFailuresOf(x, r);
 }
 
 }  // namespace rc

@@ -64,6 +64,10 @@ bool covers(const Expectation& e, const PairContext& pair);
 std::vector<const Expectation*> expectationsFor(const Expectations& x, const PairContext& pair,
                                                 const std::string& cls);
 
+// The known failures of one pair: for each failing class the entries that cover it, or
+// none at all unless every failing class is covered (a pair is known as a whole).
+std::vector<KnownFailure> knownFailuresOf(const Expectations& x, const PairResult& r);
+
 // Marks every failed pair whose failing classes are all covered as known (PairResult::known:
 // the ids and reasons), so reports can tell expected failures from new ones.
 void applyExpectations(const Expectations& x, Report& report);

@@ -666,17 +666,20 @@ std::string matrix(const Report& report, const Columns& columns) {
 // Verdict counts per backend column.
 std::string backendCounts(const Report& report, const Columns& columns) {
   if (columns.names.size() < 2 && report.results.size() < 2) return "";
-  std::vector<std::array<std::uint64_t, 4>> n(columns.names.size(), {0, 0, 0, 0});
+  // One count per Status (kStatusCount): a not_supported row (MSAA) indexed past a table
+  // of four overflowed it (heap-buffer-overflow found by the asan-ubsan build).
+  std::vector<std::array<std::uint64_t, kStatusCount>> n(columns.names.size(),
+                                                         std::array<std::uint64_t, kStatusCount>{});
   for (std::size_t k = 0; k < report.results.size(); ++k)
     ++n[columns.of[k]][static_cast<std::size_t>(report.results[k].status)];
   std::string out =
       "<h2>Backends</h2><table id=\"backends\"><tr><th>backend</th><th>pass</th><th>warn</th>"
-      "<th>fail</th><th>error</th></tr>";
+      "<th>fail</th><th>error</th><th>not supported</th></tr>";
   for (std::size_t b = 0; b < columns.names.size(); ++b)
     out += fmt::format(
         "<tr><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>"
-        "<td class=\"n\">{}</td></tr>",
-        esc(columns.names[b]), n[b][0], n[b][1], n[b][2], n[b][3]);
+        "<td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
+        esc(columns.names[b]), n[b][0], n[b][1], n[b][2], n[b][3], n[b][4]);
   return out + "</table>";
 }
 

@@ -178,6 +178,10 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
     if (stacks.contains("expected")) p.expected_stack = stacks["expected"];
     if (stacks.contains("actual")) p.actual_stack = stacks["actual"];
   }
+  // The actual side's GL version, which expectations entries may be scoped to.
+  if (p.actual_stack.is_object() && p.actual_stack.contains("gl_version") &&
+      p.actual_stack["gl_version"].is_string())
+    p.actual_driver = p.actual_stack["gl_version"].get<std::string>();
 
   const std::string tat = at + ".tolerances";
   const json& t = r.member(row, "tolerances", at);

@@ -46,8 +46,10 @@ struct Tolerances {
   //   255 * shading_relative * M              float32 evaluation of the lighting
   //   + shading_slope_factor * G * band       attribute planes of snapped vertices
   // and from the reference's channels at the pixel:
-  //   + texture_weight_error * texel_alt      linear filtering: quantised bilinear weights
-  //                                           (texel_alt: the footprint's colour range)
+  //   + (texture_weight_error + min(1, texel_reach)) * texel_alt
+  //                                           linear filtering: quantised bilinear weights
+  //                                           and the sample's float32 reach (texel_alt:
+  //                                           the colour range of the footprints within it)
   //   + texture_rounding_units * texel_gain   linear filtering: the 8-bit filtered texel
   // (these two are 0 unless a textured material is filtered linearly),
   //   + texel_choice * texel_alt   nearest filtering, where texel_dist <= the slope band:

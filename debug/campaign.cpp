@@ -191,7 +191,8 @@ CampaignFailure campaignFailureFromJson(const json& j, const std::string& source
 
 std::vector<CampaignFailure> failuresOfReport(
     const json& report, const std::string& run_rel,
-    const std::function<FixtureInfo(const std::string&)>& fixture_info, const std::string& source) {
+    const std::function<FixtureInfo(const std::string&)>& fixture_info, const std::string& source,
+    const Expectations* expectations) {
   if (!report.is_object() || !report.contains("results") || !report["results"].is_array())
     throw InputError(fmt::format("{}: results: missing or not an array", source));
   std::vector<CampaignFailure> out;
@@ -217,6 +218,32 @@ std::vector<CampaignFailure> failuresOfReport(
         break;
       }
     }
+    // What the expectations say of the row now, from the same facts `run` matched them
+    // against: fixture, actual backend, its GL version, the render state and the failing
+    // classes.
+    std::vector<KnownFailure> known_now;
+    if (expectations && status == "fail") {
+      PairResult pair;
+      pair.fixture = base.fixture;
+      pair.actual = base.actual;
+      pair.status = Status::Fail;
+      if (row.contains("state") && row["state"].is_object()) pair.state = row["state"];
+      const json* stack =
+          row.contains("stacks") && row["stacks"].is_object() && row["stacks"].contains("actual")
+              ? &row["stacks"]["actual"]
+              : nullptr;
+      if (stack && stack->is_object() && stack->contains("gl_version") &&
+          (*stack)["gl_version"].is_string())
+        pair.actual_driver = (*stack)["gl_version"].get<std::string>();
+      for (auto [cls, status_of] :
+           {std::pair{"visibility", &pair.visibility.status},
+            std::pair{"depth", &pair.depth.status}, std::pair{"shading", &pair.shading.status}}) {
+        const bool failed =
+            row.contains(cls) && row[cls].is_object() && row[cls].value("status", "") == "fail";
+        *status_of = failed ? Status::Fail : Status::Pass;
+      }
+      known_now = knownFailuresOf(*expectations, pair);
+    }
     auto add = [&](const std::string& cls) {
       CampaignFailure f = base;
       f.cls = cls;
@@ -228,9 +255,13 @@ std::vector<CampaignFailure> failuresOfReport(
       } else {
         f.message = classMessage(row, cls);
         if (cls == "visibility") f.kind = visibilityKind(row[cls]);
-        if (row.contains("known") && row["known"].is_array())
+        if (expectations) {
+          for (const KnownFailure& k : known_now)
+            if (k.cls == cls) f.known = k.id;
+        } else if (row.contains("known") && row["known"].is_array()) {
           for (const json& k : row["known"])
             if (k.is_object() && k.value("class", "") == cls) f.known = k.value("id", "");
+        }
       }
       out.push_back(std::move(f));
     };

@@ -15,6 +15,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "compare/expectations.h"
+
 namespace rc {
 
 inline constexpr const char* kCampaignFormat = "rastercheck-campaign/1";
@@ -54,7 +56,9 @@ CampaignFailure campaignFailureFromJson(const nlohmann::json& j, const std::stri
 
 // The failures of one run's report.json (`run_rel`: the run folder relative to the
 // campaign folder; `fixture_file(name)` gives a fixture's file and tags). Rows that pass
-// or warn give none. Throws InputError for a malformed report.
+// or warn give none. CampaignFailure::known: with `expectations`, what they say of the
+// row now (an entry added after the run counts; one removed no longer does), else what
+// the run marked. Throws InputError for a malformed report.
 struct FixtureInfo {
   std::string file;
   std::vector<std::string> tags;
@@ -62,7 +66,7 @@ struct FixtureInfo {
 std::vector<CampaignFailure> failuresOfReport(
     const nlohmann::json& report, const std::string& run_rel,
     const std::function<FixtureInfo(const std::string& fixture)>& fixture_info,
-    const std::string& source);
+    const std::string& source, const Expectations* expectations = nullptr);
 
 // The signature that groups failures: actual backend (and the expected SPEC when it is not
 // `ref`), class (visibility with its kind), and what the probes found involved; "not

@@ -6,10 +6,11 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <map>
+#include <limits>
 #include <string>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 
 #include "fixtures/errors.h"
 #include "fixtures/multisample.h"
@@ -85,6 +86,44 @@ bool isFinite(const glm::dvec4& v) {
 // ---- the renderer -----------------------------------------------------------------------
 
 // What the fragment loop needs about the original triangle being drawn.
+// A per-vertex error bound interpolated over a fan triangle in screen space: GL interpolates
+// window z with the triangle's screen-space barycentrics (non-negative, summing to 1 at a
+// covered pixel), so a fragment's depth error is at most the same combination of its
+// vertices' errors. Clamped to the vertices' range (snapping may cover a centre just
+// outside the exact triangle); a degenerate or non-finite setup gives the largest.
+struct ReachPlane {
+  double x0 = 0.0;
+  double y0 = 0.0;
+  double at0 = 0.0;
+  double ddx = 0.0;
+  double ddy = 0.0;
+  double lo = 0.0;
+  double hi = 0.0;
+
+  void setup(const WindowVertex& a, const WindowVertex& b, const WindowVertex& c, double ra,
+             double rb, double rc) {
+    x0 = a.x;
+    y0 = a.y;
+    at0 = ra;
+    lo = std::min({ra, rb, rc});
+    hi = std::max({ra, rb, rc});
+    ddx = ddy = 0.0;
+    const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    const double gx = ((rb - ra) * (c.y - a.y) - (rc - ra) * (b.y - a.y)) / det;
+    const double gy = ((b.x - a.x) * (rc - ra) - (c.x - a.x) * (rb - ra)) / det;
+    if (det != 0.0 && std::isfinite(gx) && std::isfinite(gy)) {
+      ddx = gx;
+      ddy = gy;
+    } else {
+      at0 = lo = hi;
+    }
+  }
+  float at(double x, double y) const {
+    const double r = at0 + ddx * (x - x0) + ddy * (y - y0);
+    return static_cast<float>(std::clamp(r, lo, hi));
+  }
+};
+
 struct TriangleContext {
   const PrimitiveRef* prim = nullptr;
   const DrawPass* pass = nullptr;
@@ -99,16 +138,19 @@ struct TriangleContext {
   bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
-  float depth_slope = 0.0f;   // |grad z| in depth-format steps per px
-  bool texel_choice = false;  // textured: record the texel channels
-  glm::dvec2 uq_max{0.0};     // largest |u / w|, |v / w| over its three vertices
+  float depth_slope = 0.0f;       // |grad z| in depth-format steps per px
+  ReachPlane depth_reach;         // steps: its vertices' float32 window-depth reach, interpolated
+  bool texel_choice = false;      // textured: record the texel channels
+  glm::dvec2 uq_max{0.0};         // largest |u / w|, |v / w| over its three vertices
+  glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
 };
 
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
 struct TexelNote {
-  float dist = 1.0f;  // px
-  float alt = 0.0f;   // 8-bit units, weighted as the fragment's colour is in the pixel
-  float gain = 0.0f;  // units per texel unit, weighted alike
+  float dist = 1.0f;   // px
+  float alt = 0.0f;    // 8-bit units, weighted as the fragment's colour is in the pixel
+  float gain = 0.0f;   // units per texel unit, weighted alike
+  float reach = 0.0f;  // linear filtering: texels (s + t) the sample may move
 };
 
 // A blended fragment the A-buffer keeps (ReferenceOptions::abuffer) until its pixel's list
@@ -275,7 +317,17 @@ class Renderer {
   std::vector<KeptFragment> kept_;     // A-buffer: blended fragments, in draw order
   std::uint32_t blend_seq_ = 0;        // triangles of blending passes drawn so far
   ABufferTally abuffer_;               // A-buffer: what the resolve found
+  // textureRange() of each texture met so far (linear filtering with uncertainty).
+  std::vector<std::pair<const Texture*, glm::dvec4>> texture_ranges_;
+  const glm::dvec4& textureRangeOf(const Texture* texture);
 };
+
+const glm::dvec4& Renderer::textureRangeOf(const Texture* texture) {
+  for (const auto& [t, range] : texture_ranges_)
+    if (t == texture) return range;
+  texture_ranges_.emplace_back(texture, textureRange(*texture));
+  return texture_ranges_.back().second;
+}
 
 void Renderer::transformVertices() {
   vertices_.resize(scene_.objects.size());
@@ -430,15 +482,20 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     return (cull == Cull::Back && !front) || (cull == Cull::Front && front);
   };
 
+  double depth_reach[kMaxClipVertices] = {};  // steps, per vertex
   if (uncertainty_) {
     // How far a float32 implementation may put each vertex beyond snapping (its clip
-    // coordinates' error through the divide and the viewport): its edges' reach.
+    // coordinates' error through the divide and the viewport): its edges' reach, and the
+    // same error in window depth, which the driver interpolates between the vertices (a
+    // convex combination: the largest vertex's bounds it).
     double reach[kMaxClipVertices];
     double max_reach = 0.0;
     for (int i = 0; i < count; ++i) {
       reach[i] = windowErrorPx(poly[i], scene_.width, scene_.height);
       if (!(reach[i] < kMaxVertexReachPx)) reach[i] = kMaxVertexReachPx;  // NaN too
       max_reach = std::max(max_reach, reach[i]);
+      const double dz = windowDepthError(poly[i]) * depth_steps_;
+      depth_reach[i] = std::isnan(dz) ? std::numeric_limits<double>::infinity() : dz;
     }
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
@@ -472,7 +529,11 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     if (shift_.active) interp.shiftDepth(shift_.offset.x, shift_.offset.y);
     if (uncertainty_) {
       t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
+      t.depth_reach.setup(wv[0], wv[i], wv[i + 1], depth_reach[0], depth_reach[i],
+                          depth_reach[i + 1]);
       t.texel_choice = t.texture != nullptr;
+      if (t.texel_choice && scene_.state.texture_filter == TextureFilter::Linear)
+        t.texture_range = textureRangeOf(t.texture);
       if (t.texel_choice) {
         t.uq_max = glm::dvec2(0.0);
         for (const WindowVertex* w : {&wv[0], &wv[i], &wv[i + 1]}) {
@@ -551,8 +612,9 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
 // The texel channels of a textured fragment (docs/tolerances.md (c), (d), (e)), in 8-bit
 // units weighted by alpha when the fragment is blended: the gain (how much a texel unit
 // moves the colour: the ambient and diffuse light on the texture); with linear filtering
-// the colour range of the footprint; with nearest filtering how far (px) the sample is from
-// a texel boundary beyond float rounding and how much the colour would change with the
+// how far float rounding may move the sample (texels) and the colour range of every
+// footprint within that reach; with nearest filtering how far (px) the sample is from a
+// texel boundary beyond float rounding and how much the colour would change with the
 // texel(s) across it.
 TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                               const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
@@ -561,13 +623,6 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
   TexelNote note;
   note.gain = static_cast<float>(
       weight * std::max({ambient_diffuse.x, ambient_diffuse.y, ambient_diffuse.z, 0.0}));
-  if (scene_.state.texture_filter == TextureFilter::Linear) {
-    const glm::dvec4 range = linearFootprintRange(*t.texture, uv, scene_.state.texture_wrap);
-    double alt = 0.0;
-    for (int c = 0; c < 3; ++c) alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
-    note.alt = static_cast<float>(255.0 * alt * weight);
-    return note;
-  }
   glm::dvec3 db[2];
   interp.barycentricGradient(row, dx, b, db);
   const glm::dvec3 u(t.v[0]->uv.x, t.v[1]->uv.x, t.v[2]->uv.x);
@@ -586,6 +641,19 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
   tt.gradient = h * std::hypot(glm::dot(db[0], v), glm::dot(db[1], v));
   tt.reach = kTexelCoordinateReach *
              (h * std::max(std::fabs(uv.y), t.uq_max.y / std::fabs(q)) + tt.gradient * image);
+  if (scene_.state.texture_filter == TextureFilter::Linear) {
+    // Where float32 interpolation may move the sample (reach, texels), the filter may
+    // read any footprint within it: the colour range over all of them.
+    const glm::dvec4 range = linearReachRange(*t.texture, uv, scene_.state.texture_wrap, s.reach,
+                                              tt.reach, t.texture_range);
+    double alt = 0.0;
+    for (int c = 0; c < 3; ++c) alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
+    note.alt = static_cast<float>(255.0 * alt * weight);
+    const double reach = s.reach + tt.reach;
+    note.reach =
+        std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+    return note;
+  }
   const TexelChoice choice = nearestTexelChoice(*t.texture, s, tt, scene_.state.texture_wrap, 1.0);
   note.dist = static_cast<float>(choice.dist_px);
   double alt = 0.0;
@@ -666,10 +734,11 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       const std::uint32_t key = depthKey(z, kFormat);  // kFormat constant: the switch folds
       const bool pass = always || key < depth[index];
       if constexpr (kGaps) {
+        const float reach = t.depth_reach.at(px + 0.5, cy);
         if (pass) {
-          gaps_.passed(index, z, slope, !always, depth_write, blend);
+          gaps_.passed(index, z, slope, reach, !always, depth_write, blend);
         } else {
-          gaps_.failed(index, z, slope, blend);
+          gaps_.failed(index, z, slope, reach, blend);
         }
       }
       if (!pass) continue;
@@ -683,7 +752,8 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       }
       ids[index] = id;
       const TexelNote note = shade(index, row, dx);
-      if constexpr (kGaps) gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain);
+      if constexpr (kGaps)
+        gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain, note.reach);
     }
   });
 }
@@ -882,7 +952,8 @@ void Renderer::resolveABuffer() {
       const KeptFragment& f = kept_[k];
       writeColor(index, f.color, true);
       if (uncertainty_)
-        gaps_.colourWritten(index, true, f.alpha, f.note.dist, f.note.alt, f.note.gain);
+        gaps_.colourWritten(index, true, f.alpha, f.note.dist, f.note.alt, f.note.gain,
+                            f.note.reach);
       z.push_back(f.z);
       slope.push_back(f.slope);
       if (sorted_ != nullptr) sorted_->push_back({f.id, f.seq, f.z, f.color, storedColor(index)});
@@ -973,6 +1044,8 @@ constexpr bool kTakeSmallest[kUncertaintyChannels] = {
     true,   // clear_gap
     false,  // clear_slope
     false,  // texel_gain
+    false,  // depth_reach
+    false,  // texel_reach
 };
 
 // Multisampling: one render per sample (SampleShift), then the resolve: the colour is the

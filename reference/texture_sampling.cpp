@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <optional>
+#include <utility>
 
 namespace rc::ref {
 namespace {
@@ -86,21 +89,55 @@ AxisChoice axisChoice(const TexelAxis& a, int size, TextureWrap wrap, double cap
   return out;
 }
 
+// The texel indices [first, last] of one axis that footprints within `reach` texels of
+// coordinate `coord` (u * size) read: under repeat before wrapping (nullopt when they span
+// the axis), under clamp already clamped into [0, size - 1].
+std::optional<std::pair<double, double>> reachSpan(double coord, double reach, int size,
+                                                   TextureWrap wrap) {
+  const double first = std::floor(coord - 0.5 - reach);
+  const double last = std::floor(coord - 0.5 + reach) + 1.0;
+  if (std::isnan(first) || std::isnan(last)) return std::nullopt;
+  if (wrap == TextureWrap::Clamp)
+    return std::pair{std::clamp(first, 0.0, size - 1.0), std::clamp(last, 0.0, size - 1.0)};
+  if (!std::isfinite(first) || !std::isfinite(last) || last - first + 1.0 >= size)
+    return std::nullopt;
+  return std::pair{first, last};
+}
+
 }  // namespace
 
-glm::dvec4 linearFootprintRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap) {
-  const double fs = std::floor(uv.x * texture.width - 0.5);
-  const double ft = std::floor(uv.y * texture.height - 0.5);
-  const int i0 = wrapIndex(fs, texture.width, wrap);
-  const int i1 = wrapIndex(fs + 1.0, texture.width, wrap);
-  const int j0 = wrapIndex(ft, texture.height, wrap);
-  const int j1 = wrapIndex(ft + 1.0, texture.height, wrap);
-  const glm::dvec4 t00 = texel(texture, i0, j0);
-  const glm::dvec4 t10 = texel(texture, i1, j0);
-  const glm::dvec4 t01 = texel(texture, i0, j1);
-  const glm::dvec4 t11 = texel(texture, i1, j1);
-  return glm::max(glm::max(t00, t10), glm::max(t01, t11)) -
-         glm::min(glm::min(t00, t10), glm::min(t01, t11));
+glm::dvec4 linearReachRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap,
+                            double reach_s, double reach_t, const glm::dvec4& whole) {
+  const auto cols = reachSpan(uv.x * texture.width, reach_s, texture.width, wrap);
+  const auto rows = reachSpan(uv.y * texture.height, reach_t, texture.height, wrap);
+  const double ncols = cols ? cols->second - cols->first + 1.0 : texture.width;
+  const double nrows = rows ? rows->second - rows->first + 1.0 : texture.height;
+  if (ncols * nrows > static_cast<double>(kMaxReachTexels)) return whole;
+  glm::dvec4 lo(std::numeric_limits<double>::infinity());
+  glm::dvec4 hi(-std::numeric_limits<double>::infinity());
+  for (double r = 0; r < nrows; ++r) {
+    const int j = rows ? wrapIndex(rows->first + r, texture.height, wrap) : static_cast<int>(r);
+    for (double c = 0; c < ncols; ++c) {
+      const int i = cols ? wrapIndex(cols->first + c, texture.width, wrap) : static_cast<int>(c);
+      const glm::dvec4 v = texel(texture, i, j);
+      lo = glm::min(lo, v);
+      hi = glm::max(hi, v);
+    }
+  }
+  return hi - lo;
+}
+
+glm::dvec4 textureRange(const Texture& texture) {
+  if (texture.width <= 0 || texture.height <= 0) return glm::dvec4(0.0);
+  glm::dvec4 lo(std::numeric_limits<double>::infinity());
+  glm::dvec4 hi(-std::numeric_limits<double>::infinity());
+  for (int j = 0; j < texture.height; ++j)
+    for (int i = 0; i < texture.width; ++i) {
+      const glm::dvec4 v = texel(texture, i, j);
+      lo = glm::min(lo, v);
+      hi = glm::max(hi, v);
+    }
+  return hi - lo;
 }
 
 TexelChoice nearestTexelChoice(const Texture& texture, const TexelAxis& s, const TexelAxis& t,

@@ -44,8 +44,16 @@ struct TexelChoice {
 TexelChoice nearestTexelChoice(const Texture& texture, const TexelAxis& s, const TexelAxis& t,
                                TextureWrap wrap, double cap);
 
-// Per channel, the largest minus the smallest of the (up to four) texels the linear filter
-// reads at uv: how far a change of the filter weights can move the filtered value.
-glm::dvec4 linearFootprintRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap);
+// Per channel, the largest minus the smallest texel of every footprint the linear filter
+// may read when the sample at uv moves by up to reach_s, reach_t texels (with 0, 0 its own
+// 2x2 footprint): columns floor(u W - 0.5 - reach_s) to floor(u W - 0.5 + reach_s) + 1, rows
+// alike, wrapped (every one once they span the texture) or clamped as `wrap` says. `whole`
+// (the range of the whole texture) answers when more than kMaxReachTexels would be visited.
+inline constexpr long kMaxReachTexels = 256;
+glm::dvec4 linearReachRange(const Texture& texture, const glm::dvec2& uv, TextureWrap wrap,
+                            double reach_s, double reach_t, const glm::dvec4& whole);
+
+// Per channel, the largest minus the smallest texel of the whole texture.
+glm::dvec4 textureRange(const Texture& texture);
 
 }  // namespace rc::ref

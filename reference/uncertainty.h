@@ -72,9 +72,11 @@ namespace rc::ref {
 //    changes the pixel's colour when it flips, whether or not it decides the id; so do the
 //    comparisons that decided the opaque fragment the first blend goes over (depth_gap and
 //    clear_gap as they stand then): the smallest such gap, and the steepest fragment;
-//  - blend_count, texel_dist, texel_alt, texel_gain: composited like the colour itself
-//    (colourWritten()): an opaque write starts them afresh, a blended one adds its own,
-//    weighted by alpha.
+//  - depth_reach: the largest float32 reach (steps) of every fragment the pixel saw, drawn
+//    or not: it bounds the stored depth's error and both sides of every comparison above;
+//  - blend_count, texel_dist, texel_alt, texel_gain, texel_reach: composited like the
+//    colour itself (colourWritten()): an opaque write starts them afresh, a blended one
+//    adds its own, weighted by alpha (texel_reach: the largest).
 //
 // Storage: the window depth of the fragment that stored each pixel's depth (a double: the
 // gap must be exact), and the gaps already in steps, as the floats the frame keeps:
@@ -101,13 +103,18 @@ class UncertaintyTracker {
     texel_alt_ = frame.texel_alt.data();
     clear_slope_ = frame.clear_slope.data();
     texel_gain_ = frame.texel_gain.data();
+    depth_reach_ = frame.depth_reach.data();
+    texel_reach_ = frame.texel_reach.data();
   }
 
-  // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px),
-  // passed the test (tested: LESS; else ALWAYS) and, when `writes`, stored its depth.
+  // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px)
+  // whose vertices' window depth a float32 transform may move by `reach` (steps), passed
+  // the test (tested: LESS; else ALWAYS) and, when `writes`, stored its depth.
   // `blended`: drawn in a blending pass.
-  void passed(std::size_t index, double z, float slope, bool tested, bool writes, bool blended) {
+  void passed(std::size_t index, double z, float slope, float reach, bool tested, bool writes,
+              bool blended) {
     if (blended && blend_count_[index] == 0.0f) baseDecided(index);
+    depth_reach_[index] = std::max(depth_reach_[index], reach);
     if (tested) {
       // +inf against the clear depth (|z - inf| = inf).
       const float g = toSteps(std::fabs(z - stored_z_[index]));
@@ -126,7 +133,8 @@ class UncertaintyTracker {
     }
   }
   // Fragment at clamped window depth z failed the LESS test.
-  void failed(std::size_t index, double z, float slope, bool blended) {
+  void failed(std::size_t index, double z, float slope, float reach, bool blended) {
+    depth_reach_[index] = std::max(depth_reach_[index], reach);
     const float g = toSteps(std::fabs(z - stored_z_[index]));  // +inf against the clear depth
     clearTest(index, z, slope);
     if (blended) blendTest(index, z, slope);
@@ -139,15 +147,17 @@ class UncertaintyTracker {
   // else in its place. texel_dist / texel_alt are the fragment's own (texel_alt already
   // weighted by alpha when blended).
   void colourWritten(std::size_t index, bool blended, float alpha, float texel_dist,
-                     float texel_alt, float texel_gain) {
+                     float texel_alt, float texel_gain, float texel_reach) {
     if (!blended) {
       blend_count_[index] = 0.0f;
       texel_dist_[index] = texel_dist;
       texel_alt_[index] = texel_alt;
       texel_gain_[index] = texel_gain;
+      texel_reach_[index] = texel_reach;
       return;
     }
     blend_count_[index] += 1.0f;
+    texel_reach_[index] = std::max(texel_reach_[index], texel_reach);
     texel_dist_[index] = std::min(texel_dist_[index], texel_dist);
     texel_alt_[index] = (1.0f - alpha) * texel_alt_[index] + texel_alt;
     texel_gain_[index] = (1.0f - alpha) * texel_gain_[index] + texel_gain;
@@ -243,6 +253,8 @@ class UncertaintyTracker {
   float* texel_alt_ = nullptr;
   float* clear_slope_ = nullptr;
   float* texel_gain_ = nullptr;
+  float* depth_reach_ = nullptr;
+  float* texel_reach_ = nullptr;
 };
 
 // Twice the signed area (> 0 counter-clockwise) and the perimeter of a window polygon.

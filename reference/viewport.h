@@ -42,4 +42,10 @@ inline double windowErrorPx(const ClipVertex& c, int width, int height) {
   return std::hypot(ex, ey);
 }
 
+// The same for window depth (z_w = z / w * 0.5 + 0.5, in [0, 1] units): how far a float32
+// implementation's vertex transform may put it (docs/tolerances.md "Vertex precision").
+inline double windowDepthError(const ClipVertex& c) {
+  return 0.5 * (c.err.z + std::fabs(c.clip.z / c.clip.w) * c.err.w) / std::fabs(c.clip.w);
+}
+
 }  // namespace rc::ref

@@ -679,6 +679,35 @@ TEST_F(CompareTest, LinearFilteringAllowsTheFootprintAndTheFilteredTexelsRoundin
   EXPECT_EQ(compare().shading.over_fail, static_cast<std::uint64_t>(b.size()));
 }
 
+// Linear filtering at a sample float32 interpolation may move (texel_reach texels): the
+// colour range of the footprints within the reach (texel_alt) times min(1, reach) more.
+// With reach 0.25 and texel_alt 40: (2^-7 + 0.25) * 40 = 10.3125 units pass, a unit more
+// fails; a reach above 1 texel never allows more than the whole range (plus the weights').
+TEST_F(CompareTest, TexelReachWidensLinearFilteringByItsShare) {
+  const Block b = kBackBlock;
+  DrawnWith linear;
+  linear.linear_textures = true;
+  tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F, linear);
+  auto run = [&](float reach, double units) {
+    forBlock(b, [&](int x, int y) {
+      const std::size_t i = ref_.index(x, y);
+      ref_.texel_alt[i] = 40.0f;
+      ref_.texel_reach[i] = reach;
+      gl_.color[i * 4] = ref_.color[i * 4] + static_cast<float>(units / 255.0);
+    });
+    return compare().shading.over_fail;
+  };
+  const auto n = static_cast<std::uint64_t>(b.size());
+  const double fail = tol_.shading.fail;
+  const double share = (tol_.texture_weight_error + 0.25) * 40.0;
+  EXPECT_EQ(run(0.25f, share + fail * 0.9), 0u);
+  EXPECT_EQ(run(0.25f, share + fail + 1.0), n);
+  EXPECT_EQ(run(0.0f, share + fail * 0.9), n) << "without the reach";
+  const double whole = (tol_.texture_weight_error + 1.0) * 40.0;
+  EXPECT_EQ(run(1e6f, whole + fail * 0.9), 0u);
+  EXPECT_EQ(run(1e6f, whole + fail + 1.0), n);
+}
+
 // rgba8 blending: each blended fragment may round its way (2 units, docs/tolerances.md).
 TEST_F(CompareTest, Rgba8BlendsEachAddTheirRounding) {
   tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);
@@ -779,6 +808,67 @@ TEST_F(CompareTest, ClearGapExcusesMissingOnlyWithinOneDepthTolerance) {
   EXPECT_EQ(r.visibility.missing_hard, 1u);
   EXPECT_EQ(r.visibility.ambiguous_by_depth_gap, 1u);
   EXPECT_EQ(r.visibility.worst.x, 71);
+}
+
+// The vertices' float32 reach in window depth (the reference's depth_reach, steps) widens
+// the depth tolerance by exactly itself: an offset of fail + reach passes the fail
+// threshold, one step more fails, in the depth class only; without the channel the first
+// offset fails too.
+TEST_F(CompareTest, DepthReachWidensTheDepthToleranceByExactlyItsSteps) {
+  constexpr double kReach = 1000.0;
+  const auto n = static_cast<std::uint64_t>(kBackBlock.size());
+  auto offset = [&](double steps) {
+    forBlock(kBackBlock, [&](int x, int y) {
+      const std::size_t i = gl_.index(x, y);
+      gl_.depth[i] = quantized(ref_.depth[i], steps);
+    });
+    return compare();
+  };
+  forBlock(kBackBlock, [&](int x, int y) { ref_.depth_reach[ref_.index(x, y)] = kReach; });
+  // The slope allowance in the block is ~0.13 steps (DepthThresholdsGiveWarnThenFail).
+  const PairResult within = offset(tol_.depth.fail + kReach);
+  EXPECT_EQ(within.depth.over_fail, 0u);
+  EXPECT_EQ(within.depth.status, Status::Warn);
+  EXPECT_NEAR(within.depth.worst_allowance, kReach, 1.0);
+  const PairResult beyond = offset(tol_.depth.fail + kReach + 1.0);
+  EXPECT_EQ(beyond.depth.over_fail, n);
+  EXPECT_EQ(beyond.depth.status, Status::Fail);
+  expectNoVisibilityChange(beyond);
+  EXPECT_EQ(beyond.shading.max_abs, 0.0);
+  forBlock(kBackBlock, [&](int x, int y) { ref_.depth_reach[ref_.index(x, y)] = 0.0f; });
+  EXPECT_EQ(offset(tol_.depth.fail + kReach).depth.over_fail, n);
+}
+
+// Both fragments of a depth tie and a fragment against the clear depth may each be off by
+// their reach: a gap within 2 (fail + reach) (a tie) or fail + reach (the clear depth) is
+// ambiguous, one step beyond it is hard.
+TEST_F(CompareTest, DepthReachWidensDepthTiesAndTheClearDepth) {
+  constexpr float kReach = 500.0f;
+  const double tie_limit = 2.0 * (tol_.depth.fail + kReach);
+  const double clear_limit = tol_.depth.fail + kReach;
+  const std::size_t tie_in = ref_.index(80, 30);
+  const std::size_t tie_out = ref_.index(90, 40);
+  const std::size_t clear_in = ref_.index(75, 35);
+  const std::size_t clear_out = ref_.index(85, 35);
+  for (std::size_t i : {tie_in, tie_out, clear_in, clear_out}) {
+    ref_.depth_reach[i] = kReach;
+    ref_.gap_slope[i] = 0.0f;
+    ref_.clear_slope[i] = 0.0f;
+  }
+  ref_.depth_gap[tie_in] = static_cast<float>(tie_limit - 1.0);
+  ref_.depth_gap[tie_out] = static_cast<float>(tie_limit + 1.0);
+  ref_.clear_gap[clear_in] = static_cast<float>(clear_limit - 1.0);
+  ref_.clear_gap[clear_out] = static_cast<float>(clear_limit + 1.0);
+  gl_.id[tie_in] = 3;
+  gl_.id[tie_out] = 3;
+  gl_.id[clear_in] = 0;
+  gl_.id[clear_out] = 0;
+  const PairResult r = compare();
+  EXPECT_EQ(r.visibility.wrong_primitive, 2u);
+  EXPECT_EQ(r.visibility.wrong_primitive_hard, 1u);
+  EXPECT_EQ(r.visibility.missing, 2u);
+  EXPECT_EQ(r.visibility.missing_hard, 1u);
+  EXPECT_EQ(r.visibility.ambiguous_by_depth_gap, 2u);
 }
 
 }  // namespace

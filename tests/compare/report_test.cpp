@@ -398,6 +398,33 @@ TEST(ReportWrite, NothingIsLeftWhenAFileCannotBeWritten) {
   fs::remove_all(out);
 }
 
+// The per-backend table of report.html counts every status, not_supported too (it was
+// indexed past a table of four: a heap overflow under ASan, a wrong count without).
+TEST(ReportHtml, BackendCountsIncludeNotSupported) {
+  Report report;
+  PairResult pass;
+  pass.fixture = "f1";
+  pass.expected = "ref";
+  pass.actual = "gl:a";
+  report.results = {pass, notSupportedResult("f2", "ref", "gl:a", "4 samples"),
+                    notSupportedResult("f1", "ref", "gl:b", "4 samples"),
+                    notSupportedResult("f2", "ref", "gl:b", "4 samples"),
+                    errorResult("f3", "ref", "gl:b", "no driver")};
+  const std::string html = reportHtml(report, freshDir("not_supported"));
+  const std::size_t table = html.find("<table id=\"backends\">");
+  ASSERT_NE(table, std::string::npos);
+  const std::string counts = html.substr(table, html.find("</table>", table) - table);
+  EXPECT_NE(counts.find("<th>not supported</th>"), std::string::npos) << counts;
+  EXPECT_NE(counts.find("<tr><td>gl:a</td><td class=\"n\">1</td><td class=\"n\">0</td>"
+                        "<td class=\"n\">0</td><td class=\"n\">0</td><td class=\"n\">1</td>"),
+            std::string::npos)
+      << counts;
+  EXPECT_NE(counts.find("<tr><td>gl:b</td><td class=\"n\">0</td><td class=\"n\">0</td>"
+                        "<td class=\"n\">0</td><td class=\"n\">1</td><td class=\"n\">2</td>"),
+            std::string::npos)
+      << counts;
+}
+
 TEST(ReportExit, CodesFollowTheWorstRow) {
   Report report;
   EXPECT_EQ(exitCodeFor(report), 0);

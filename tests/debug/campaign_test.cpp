@@ -2,6 +2,8 @@
 // files and the exit code, on hand-written reports (no rendering).
 #include "debug/campaign.h"
 
+#include <map>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -74,6 +76,47 @@ TEST(CampaignFailures, OneFailurePerFailingClassAndOneForAnError) {
   EXPECT_EQ(failures[2].cls, "error");
   EXPECT_EQ(failures[2].reduction, "skipped");
   EXPECT_EQ(failures[2].message, "c: gl:egl:softpipe: crashed (Segmentation fault)");
+}
+
+// The campaign re-applies the expectations file to its runs' reports: an entry added
+// after a run covers its failures (scoped like `run` scopes it: backend, GL version from
+// the row's stacks, render state), the row's own stale `known` no longer counts, and a
+// pair is known only when all its failing classes are.
+TEST(CampaignFailures, ExpectationsAreAppliedAsTheyAreNowNotAsTheRunMarkedThem) {
+  const Expectations x = parseExpectations(json::parse(R"({"expectations": [
+      {"id": "sp-d16-depth", "fixture": "*", "backend": "gl:*:softpipe", "driver_version": "*Mesa 22.*",
+       "state": {"depth_format": "d16"}, "class": "depth", "reason": "r"},
+      {"id": "sp-d16-vis", "fixture": "*", "backend": "gl:*:softpipe", "state": {"depth_format": "d16"},
+       "class": "visibility", "reason": "r"}]})"),
+                                           "test");
+  auto pair = [](const std::string& fixture, const std::string& version, const std::string& depth,
+                 const std::string& vis, const std::string& shading) {
+    json r = row(fixture, "gl:egl:softpipe", "fail", vis, "fail", shading);
+    r["state"] = {{"depth_format", depth}};
+    r["stacks"] = {{"actual", {{"gl_version", version}}}, {"expected", nullptr}};
+    r["known"] = json::array({{{"id", "stale"}, {"class", "depth"}, {"reason", "old"}}});
+    return r;
+  };
+  const json r = report({pair("a", "3.3 (Core Profile) Mesa 22.3.6", "d16", "pass", "pass"),
+                         pair("b", "3.3 (Core Profile) Mesa 22.3.6", "d16", "fail", "pass"),
+                         pair("c", "3.3 (Core Profile) Mesa 23.1.0", "d16", "pass", "pass"),
+                         pair("d", "3.3 (Core Profile) Mesa 22.3.6", "d24", "pass", "pass"),
+                         pair("e", "3.3 (Core Profile) Mesa 22.3.6", "d16", "pass", "fail")});
+  const auto now = failuresOfReport(r, "runs/0", info, "report.json", &x);
+  std::map<std::string, std::string> known;
+  for (const CampaignFailure& f : now) known[f.fixture + "/" + f.cls] = f.known;
+  EXPECT_EQ(known["a/depth"], "sp-d16-depth");
+  EXPECT_EQ(known["b/depth"], "sp-d16-depth");
+  EXPECT_EQ(known["b/visibility"], "sp-d16-vis");
+  EXPECT_EQ(known["c/depth"], "") << "another Mesa version";
+  EXPECT_EQ(known["d/depth"], "") << "another depth format";
+  EXPECT_EQ(known["e/depth"], "") << "its shading failure is not covered: not known at all";
+  EXPECT_EQ(known["e/shading"], "");
+  // Without the file, what the run wrote.
+  for (const CampaignFailure& f : read(r))
+    if (f.cls == "depth") {
+      EXPECT_EQ(f.known, "stale") << f.fixture;
+    }
 }
 
 TEST(CampaignFailures, MalformedReportsNameTheFileAndPath) {

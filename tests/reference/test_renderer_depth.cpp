@@ -3,8 +3,11 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <limits>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +15,8 @@
 #include "reference/fragment_ops.h"
 #include "reference/reference_renderer.h"
 #include "reference/uncertainty.h"
+#include "reference/vertex_stage.h"
+#include "reference/viewport.h"
 #include "tests/reference/test_scenes.h"
 
 namespace rc {
@@ -273,11 +278,11 @@ TEST(DepthGap, TrackerEqualsTheBruteForceDefinitionOnRandomPixels) {
     for (const TestFragment& f : frags) {
       const std::uint32_t key = ref::depthKey(f.z, format);
       if (!f.tested || key < stored) {
-        tracker.passed(0, f.z, 0.0f, f.tested, f.writes, !f.writes);
+        tracker.passed(0, f.z, 0.0f, 0.0f, f.tested, f.writes, !f.writes);
         pixel.id[0] = 1;  // drawn
         if (f.writes) stored = key;
       } else {
-        tracker.failed(0, f.z, 0.0f, !f.writes);
+        tracker.failed(0, f.z, 0.0f, 0.0f, !f.writes);
       }
     }
     tracker.finish(pixel);
@@ -397,6 +402,135 @@ TEST(EdgeDist, CulledTrianglesCountOnlyWhenTheCullDecisionCouldFlip) {
   EXPECT_FLOAT_EQ(at(1, 4), 1.0f);   // 0.5 from the culled big triangle's edge x = 2: ignored
   EXPECT_NEAR(at(8, 8), 0.0, 1e-6);  // centre (8.5, 8.5) lies on the sliver's bottom edge
   EXPECT_NEAR(at(8, 9), 1.0 - (6.5 / 12.0) / 64.0, 1e-3);  // below its top edge
+}
+
+// depth_reach against an independent float32 vertex transform, as a GL driver runs it
+// (shaders.cpp: world positions as float attributes, view_projection as a float uniform,
+// gl_Position = u_view_projection * vec4(p, 1)): the four sums of each clip component
+// in three orders (GLSL fixes none), then the divide and viewport in double, so that only
+// the vertex transform's error is measured. Cameras from 1 to 1e4 units from the origin,
+// near 1e-3 to 1, far to 1e5, points between near and 50 units in front: the float32
+// window depth must stay within windowDepthError() of the exact one, and the bound must
+// not be loose by more than a factor of 20 (its 8 ulps against the observed worst).
+TEST(DepthReach, BoundsTheWindowDepthOfAFloat32VertexTransform) {
+  std::mt19937 rng(20261202);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> exponent(0.0, 4.0);
+  double worst_ratio = 0.0;
+  int trials = 0;
+  for (int c = 0; c < 200; ++c) {
+    Scene s = test::windowScene(256, 192);
+    s.camera.projection = c % 4 == 0 ? Projection::Orthographic : Projection::Perspective;
+    s.camera.bounds = {-2.0, 2.0, -1.5, 1.5};
+    const glm::dvec3 dir = glm::normalize(glm::dvec3(unit(rng), unit(rng), unit(rng)));
+    s.camera.eye = std::pow(10.0, exponent(rng)) * dir;
+    s.camera.target = s.camera.eye - glm::dvec3(unit(rng), unit(rng), 1.5 + unit(rng));
+    s.camera.near = std::pow(10.0, -3.0 * std::fabs(unit(rng)));
+    s.camera.far = std::pow(10.0, 1.0 + 4.0 * std::fabs(unit(rng)));
+    const ref::CameraTransform cam = ref::cameraTransform(s);
+    const glm::dvec3 forward = glm::normalize(s.camera.target - s.camera.eye);
+    Object object;
+    for (int k = 0; k < 20; ++k) {
+      const double depth = s.camera.near + (50.0 - s.camera.near) * 0.5 * (1.0 + unit(rng));
+      object.mesh.positions.emplace_back(glm::vec3(
+          s.camera.eye + depth * forward + 0.3 * depth * glm::dvec3(unit(rng), unit(rng), 0.0)));
+    }
+    std::vector<ref::TransformedVertex> out;
+    ref::transformObject(object, cam, out, false, true);
+    const glm::mat4 vp(cam.view_projection);
+    for (const ref::TransformedVertex& v : out) {
+      if (!(v.clip.w > 0.0)) continue;
+      const double exact = v.clip.z / v.clip.w * 0.5 + 0.5;
+      const glm::vec4 p(glm::vec3(v.world), 1.0f);
+      const double bound = ref::windowDepthError(ref::ClipVertex{v.clip, {}, v.clip_err});
+      for (int order = 0; order < 3; ++order) {
+        auto sum = [&](int row) {
+          const float t[4] = {vp[0][row] * p.x, vp[1][row] * p.y, vp[2][row] * p.z, vp[3][row]};
+          if (order == 0) return ((t[0] + t[1]) + t[2]) + t[3];
+          if (order == 1) return ((t[3] + t[2]) + t[1]) + t[0];
+          return (t[0] + t[1]) + (t[2] + t[3]);
+        };
+        const double z = sum(2);
+        const double w = sum(3);
+        const double err = std::fabs(z / w * 0.5 + 0.5 - exact);
+        ASSERT_LE(err, bound * (1.0 + 1e-6)) << "camera " << c << " order " << order;
+        worst_ratio = std::max(worst_ratio, err / bound);
+        ++trials;
+      }
+    }
+  }
+  EXPECT_GT(trials, 10000);
+  EXPECT_GT(worst_ratio, 0.05) << "the 8-ulp bound is far looser than float32 transforms get";
+}
+
+// The channel in a rendered frame: a triangle 0.4 units in front of a camera 1.9e3 units
+// from the origin (a random scene's, where llvmpipe and zink stored d32f depth 1477 steps
+// from the reference) has a depth_reach of thousands of steps; the same triangle moved
+// with its camera to the origin has a small one, below the d24/d32f base threshold.
+TEST(DepthReach, FollowsTheMagnitudeOfTheWorldCoordinates) {
+  auto render = [](const glm::dvec3& offset) {
+    Scene s = test::windowScene(64, 48);
+    s.state.depth_format = DepthFormat::D32F;
+    s.camera.projection = Projection::Perspective;
+    s.camera.fovy_deg = 31.6;
+    s.camera.near = 0.001;
+    s.camera.far = 1e5;
+    s.camera.eye = offset;
+    s.camera.target = offset + glm::dvec3(-1.0, 0.2, 0.05);
+    const glm::dvec3 a = offset + glm::dvec3(-0.4, -0.08, -0.1);
+    const glm::dvec3 b = offset + glm::dvec3(-0.45, 0.1, 0.05);
+    const glm::dvec3 c = offset + glm::dvec3(-0.4, 0.05, 0.15);
+    test::addTriangle(s, glm::vec3(a), glm::vec3(b), glm::vec3(c));
+    return renderReference(s);
+  };
+  const Frame far = render({1872.88, -393.969, -91.988});
+  const Frame near = render({0.0, 0.0, 0.0});
+  float far_max = 0.0f;
+  float near_max = 0.0f;
+  int drawn = 0;
+  for (std::size_t i = 0; i < far.pixelCount(); ++i) {
+    if (far.id[i] != 0) ++drawn;
+    far_max = std::max(far_max, far.depth_reach[i]);
+    near_max = std::max(near_max, near.depth_reach[i]);
+    if (far.id[i] == 0) {
+      EXPECT_EQ(far.depth_reach[i], 0.0f) << "nothing tested there";
+    }
+  }
+  EXPECT_GT(drawn, 100);
+  EXPECT_GT(far_max, 1477.0f);  // what the drivers measured must be inside it
+  EXPECT_LT(near_max, 16.0f);
+  EXPECT_GT(near_max, 0.0f);
+}
+
+// The reach is interpolated over each triangle in screen space, as GL interpolates window
+// z: a triangle whose one vertex lies behind the camera is cut at the near plane (near
+// 0.01), where a vertex's window depth is as uncertain as its clip coordinates' error
+// divided by w = near; pixels far from the cut get a much smaller share of it.
+TEST(DepthReach, IsInterpolatedAcrossTheTriangleNotItsLargestVertex) {
+  Scene s = test::windowScene(64, 64);
+  s.state.depth_format = DepthFormat::D24;
+  s.camera.projection = Projection::Perspective;
+  s.camera.fovy_deg = 60.0;
+  s.camera.near = 0.01;
+  s.camera.far = 100.0;
+  s.camera.eye = {0.0, 0.0, 0.0};
+  s.camera.target = {0.0, 0.0, -1.0};
+  // A floor-like triangle 0.002 below the eye, from 5 units ahead to 1 unit behind it: the
+  // near-plane cut is in view at the bottom of the image.
+  test::addTriangle(s, {-3.0f, -0.002f, -5.0f}, {3.0f, -0.002f, -5.0f}, {0.0f, -0.002f, 1.0f});
+  const Frame f = renderReference(s);
+  float lo = std::numeric_limits<float>::infinity();
+  float hi = 0.0f;
+  for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+    if (f.id[i] == 0) continue;
+    lo = std::min(lo, f.depth_reach[i]);
+    hi = std::max(hi, f.depth_reach[i]);
+  }
+  ASSERT_GT(hi, 0.0f);
+  // Measured: 304 to 6492 d24 steps (screen-space weights give the cut's corner a share
+  // even near the horizon, as they do to its error in a driver).
+  EXPECT_GT(hi, 10.0f * lo) << "the cut's reach is not spread over the whole triangle";
+  std::cout << "depth_reach on the floor: " << lo << " to " << hi << " d24 steps\n";
 }
 
 }  // namespace

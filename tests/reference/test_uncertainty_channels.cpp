@@ -107,6 +107,41 @@ TEST(UncertaintyChannels, ATriangleSampledExactlyOnATexelBoundaryMayTakeEitherTe
   EXPECT_EQ(centre.texel_alt[i], 0.0f);
 }
 
+// texel_reach: how far float32 interpolation may move a linear-filtered sample (16 ulps of
+// the magnitudes the coordinate comes from, docs/tolerances.md (c)). On an ordinary
+// rectangle (0.25 texels per px) it is a small fraction of a texel and texel_alt stays the
+// 2x2 footprint's range; on a sliver whose v runs to 50,000 across 0.6 px (~1.7e5 texels
+// per px) it exceeds a texel, and texel_alt is the contrast of every footprint within it.
+TEST(UncertaintyChannels, TexelReachFollowsTheTextureCoordinatesMagnitudes) {
+  Scene s = test::windowScene(16, 16);
+  s.materials[0].texture = rowsTexture();
+  s.state.texture_filter = TextureFilter::Linear;
+  test::addRect(s, 0, 0, 16, 16, 0.5f);
+  const Frame f = renderReference(s);
+  const std::size_t i = f.index(5, 10);  // s = 1.375, t = 0.6875: rows 0 and 1
+  EXPECT_GT(f.texel_reach[i], 0.0f);
+  EXPECT_LT(f.texel_reach[i], 1e-4f);
+  EXPECT_NEAR(f.texel_alt[i], kRowsContrast, 1e-3);
+  // Nearest filtering has its own reach (in texel_dist): texel_reach stays 0.
+  s.state.texture_filter = TextureFilter::Nearest;
+  EXPECT_EQ(renderReference(s).texel_reach[i], 0.0f);
+
+  Scene sliver = test::windowScene(16, 16);
+  sliver.materials[0].texture = rowsTexture();
+  sliver.state.texture_filter = TextureFilter::Linear;
+  test::addMesh(sliver, {{0, 8.0f, 0.5f}, {16, 8.5f, 0.5f}, {0, 8.6f, 0.5f}}, {{0, 1, 2}}, 0,
+                {0, 0, 1}, {{0, 0}, {1, 0}, {0, 50000}});
+  const Frame g = renderReference(sliver);
+  int drawn = 0;
+  for (std::size_t k = 0; k < g.pixelCount(); ++k) {
+    if (g.id[k] == 0) continue;
+    ++drawn;
+    EXPECT_GT(g.texel_reach[k], 1.0f) << k;
+    EXPECT_NEAR(g.texel_alt[k], kRowsContrast, 1e-3) << k;
+  }
+  EXPECT_GT(drawn, 3);
+}
+
 TEST(UncertaintyChannels, TexelDistIsTheScreenDistanceToTheNextTexelBoundary) {
   // A 4x2 texture over a 16x16 rectangle: a texel is 4 px wide and 8 px high, boundaries
   // at window x = 4, 8, 12 and y = 8 (and the wrap boundaries at 0 and 16).
