@@ -380,6 +380,20 @@ TEST(Reliability, EveryRefusalIsOneSafeLine) {
   fs::remove_all(dir);
 }
 
+// An ASE file on which Assimp 5.2 segfaults inside ReadFile (found by fuzz_mesh): the
+// import runs in a child process, so `render` refuses it with one line (it exited 139).
+TEST(Reliability, AMeshFileThatCrashesAssimpIsOneLine) {
+  const fs::path dir = scratch("assimp_crash");
+  const std::string found =
+      readBytes(fs::path(RC_SOURCE_DIR) / "tests/fuzz/regressions/mesh/ase-segv-in-assimp");
+  writeBytes(dir / "crash.ase", found.substr(1));  // the fuzz input's first byte: the format
+  expectOneLine(dir, "crash.json",
+                R"({"format": "rastercheck-scene/1", "image": {"width": 8, "height": 8},
+    "camera": {"eye": [0, 0, 5]}, "objects": [{"mesh": {"file": "crash.ase"}}]})",
+                "the mesh importer crashed (signal 11", "crash.ase");
+  fs::remove_all(dir);
+}
+
 TEST(Reliability, ReportFoldersAreUniqueWhateverTheNames) {
   const fs::path dir = scratch("unique");
   int k = 0;
