@@ -44,6 +44,10 @@ std::string toString(const GlSpec& spec);
 // without them fails the loaded-library check (exit 3) unless glvnd's vendor file and
 // LIBGL_DRIVERS_PATH, which renderGl sets itself, are enough.
 std::vector<std::pair<std::string, std::string>> startupEnvironment(const GlSpec& spec);
+// The same for a given LD_LIBRARY_PATH value (null: unset), without reading the process
+// environment (tests: setenv in a process whose GL driver runs threads is a data race).
+std::vector<std::pair<std::string, std::string>> startupEnvironment(const GlSpec& spec,
+                                                                    const char* ld_library_path);
 
 // Renders one scene. The first call in a process picks the driver (GALLIUM_DRIVER is
 // read once per process); later calls reuse that context. Throws BackendError with one

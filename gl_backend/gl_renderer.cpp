@@ -1117,6 +1117,16 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   }
   const int max_samples = glInteger(gl, GL_MAX_SAMPLES);
   const int samples = scene.state.samples;
+  if (samples > 1 && s.driver == "zink" && s.version.find("Mesa 22.") != std::string::npos) {
+    // zink on lavapipe in Mesa 22 deadlocks or crashes now and then in the read-back of a
+    // multisampled render in a process that rendered before (a lavapipe mutex, under
+    // readBackMultisample; docs/results/findings.md "Open"). Until that is understood the
+    // pair is not run rather than left to the watchdog.
+    throw NotSupportedError(
+        fmt::format("{} samples per pixel: zink on Mesa 22 hangs in the multisample read-back "
+                    "(docs/results/findings.md); not run",
+                    samples));
+  }
   if (samples > 1) {
     const int usable = maxUsableSamples(gl);
     if (usable < samples)

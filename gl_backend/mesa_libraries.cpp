@@ -97,9 +97,9 @@ bool holdsDriver(std::string_view name) {
 
 bool inside(const std::string& path, const std::string& dir) { return startsWith(path, dir + "/"); }
 
-// Whether LD_LIBRARY_PATH starts with `dir` (what startupEnvironment asks for).
-bool startupEnvironmentApplied(const std::string& dir) {
-  const char* have = std::getenv("LD_LIBRARY_PATH");
+// Whether the LD_LIBRARY_PATH value `have` (null: unset) starts with `dir` (what
+// startupEnvironment asks for).
+bool startupEnvironmentApplied(const std::string& dir, const char* have) {
   if (have == nullptr) return false;
   const std::string_view list(have);
   return list.substr(0, list.find(':')) == dir;
@@ -226,7 +226,7 @@ LoadedMesa checkLoadedMesa(const GlSpec& spec) {
     } else {
       throw BackendError(fmt::format(
           "asked for the Mesa in {}, but this process loaded {} from outside it{}", out.dir, lib,
-          startupEnvironmentApplied(out.dir)
+          startupEnvironmentApplied(out.dir, std::getenv("LD_LIBRARY_PATH"))
               ? ""
               : " (LD_LIBRARY_PATH does not start with it: render through `rastercheck "
                 "render`, which sets it)"));
@@ -258,11 +258,15 @@ nlohmann::json toJson(const LoadedMesa& mesa, const GlSpec& spec, const std::str
 namespace rc {
 
 std::vector<std::pair<std::string, std::string>> startupEnvironment(const GlSpec& spec) {
+  return startupEnvironment(spec, std::getenv("LD_LIBRARY_PATH"));
+}
+
+std::vector<std::pair<std::string, std::string>> startupEnvironment(const GlSpec& spec,
+                                                                    const char* old) {
   if (spec.mesa_dir.empty()) return {};
   const std::string dir = gl::mesaDir(spec).string();
-  const char* old = std::getenv("LD_LIBRARY_PATH");
   // Already first: the process was started with it (idempotent, so no exec loop).
-  if (gl::startupEnvironmentApplied(dir)) return {{"LD_LIBRARY_PATH", old}};
+  if (gl::startupEnvironmentApplied(dir, old)) return {{"LD_LIBRARY_PATH", old}};
   std::string value = dir;
   if (old != nullptr && *old != '\0') {
     value += ':';
