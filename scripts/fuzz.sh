@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Fuzzes the fixture loader, mesh import and texture import for a bounded time with
-# libFuzzer (the fuzz preset: clang, ASan, UBSan). Seeds come from the catalog (fixtures,
+# libFuzzer (the fuzz preset: clang, ASan, UBSan). fuzz_mesh runs the Assimp side of mesh
+# import in its own process, not through the rastercheck-mesh-import child, so that its
+# coverage counts (tests/fuzz/fuzz_entries.h). Seeds come from the catalog (fixtures,
 # meshes, textures) and from every input kept in tests/fuzz/regressions; each target runs
 # for SECONDS (default 60) and the figures go to stdout. A crash, a sanitizer report, a
 # leak or an abort from fuzz_entries.h (an exception other than InputError, a message

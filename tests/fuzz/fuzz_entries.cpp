@@ -23,21 +23,6 @@ namespace rc::fuzz {
 namespace fs = std::filesystem;
 namespace {
 
-// The promise every refusal keeps (fixtures/errors.h): the line the command prints is
-// one line of valid UTF-8 and not unbounded. Aborts with the message otherwise.
-void checkMessage(const InputError& e) {
-  const std::string line = oneLineMessage(e.what());
-  bool ok = line.size() <= 1100 && line.find('\n') == std::string::npos &&
-            line.find('\r') == std::string::npos && line.find('\0') == std::string::npos;
-  // Valid UTF-8: printable() of a valid line changes only quotes and backslashes, never
-  // adds \x escapes for bytes.
-  ok = ok && printable(line, std::string::npos) == line;
-  if (!ok) {
-    std::fprintf(stderr, "message is not one safe line: %s\n", line.c_str());
-    std::abort();
-  }
-}
-
 // A folder of this process's own for the files the fuzzers write.
 const fs::path& scratch() {
   static const fs::path dir = [] {
@@ -50,6 +35,23 @@ const fs::path& scratch() {
 
 }  // namespace
 
+// The promise every refusal keeps (fixtures/errors.h): the line the command prints is
+// one line of valid UTF-8 and not unbounded. Aborts with the message otherwise.
+void checkRefusalMessage(const char* what) {
+  const std::string line = oneLineMessage(what);
+  bool ok = line.size() <= 1100 && line.find('\n') == std::string::npos &&
+            line.find('\r') == std::string::npos && line.find('\0') == std::string::npos;
+  // Valid UTF-8: printable() of a valid line changes only quotes and backslashes, never
+  // adds \x escapes for bytes.
+  ok = ok && printable(line, std::string::npos) == line;
+  if (!ok) {
+    std::fprintf(stderr, "message is not one safe line: %s\n", line.c_str());
+    std::abort();
+  }
+}
+
+std::string scratchFile(const std::string& name) { return (scratch() / name).string(); }
+
 void loadFixtureBytes(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   const fs::path source = fs::path(RC_SOURCE_DIR) / "tests/fixtures/data/fuzz.json";
@@ -58,14 +60,14 @@ void loadFixtureBytes(const std::uint8_t* data, std::size_t size) {
     (void)estimateResources(scene, RendererKind::Reference);
     (void)estimateResources(scene, RendererKind::Gl);
   } catch (const InputError& e) {
-    checkMessage(e);
+    checkRefusalMessage(e.what());
   }
 }
 
 void importMeshBytes(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return;
   constexpr std::size_t kFormats = std::size(kMeshExtensions);
-  const fs::path file = scratch() / (std::string("mesh.") + kMeshExtensions[data[0] % kFormats]);
+  const fs::path file = scratchFile(std::string("mesh.") + kMeshExtensions[data[0] % kFormats]);
   {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
@@ -74,7 +76,7 @@ void importMeshBytes(const std::uint8_t* data, std::size_t size) {
     TextureCache textures;
     (void)importMeshFile(file, &textures);
   } catch (const InputError& e) {
-    checkMessage(e);
+    checkRefusalMessage(e.what());
   }
 }
 
@@ -86,7 +88,7 @@ void decodeTextureBytes(const std::uint8_t* data, std::size_t size) {
     (void)decodeTexture(std::span<const std::byte>(bytes, size - 1),
                         kTextureExtensions[data[0] % kFormats], "fuzz");
   } catch (const InputError& e) {
-    checkMessage(e);
+    checkRefusalMessage(e.what());
   }
 }
 
