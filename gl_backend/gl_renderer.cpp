@@ -599,12 +599,6 @@ std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max
       per_material[m] = it->second;
       continue;
     }
-    if (t->width <= 0 || t->height <= 0 ||
-        t->rgba.size() != static_cast<std::size_t>(t->width) * t->height * 4) {
-      throw InputError(fmt::format("{}: materials[{}] ({}): texture {} is {}x{} with {} bytes",
-                                   scene.name, m, scene.materials[m].name, t->path.string(),
-                                   t->width, t->height, t->rgba.size()));
-    }
     if (t->width > max_texture_size || t->height > max_texture_size) {
       throw BackendError(fmt::format("texture {} is {}x{}, GL_MAX_TEXTURE_SIZE is {}",
                                      t->path.string(), t->width, t->height, max_texture_size));
@@ -632,9 +626,7 @@ glm::vec3 toFloat(const glm::dvec3& v) { return glm::vec3(v); }
 
 void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& scene,
                       const gl::testing::Faults& faults) {
-  const double aspect = static_cast<double>(scene.width) / scene.height;
-  const glm::mat4 view_projection(projectionMatrix(scene.camera, aspect) *
-                                  viewMatrix(scene.camera));
+  const glm::mat4 view_projection(viewProjectionMatrix(scene));
   gl.UseProgram(p.id);
   gl.UniformMatrix4fv(p.view_projection, 1, GL_FALSE, glm::value_ptr(view_projection));
   const RenderState& st = scene.state;
@@ -1077,10 +1069,7 @@ void injectStall(const gl::testing::Faults& faults, const std::string& fixture) 
 }
 
 Frame renderLocked(const Scene& scene, const GlSpec& spec) {
-  if (scene.width <= 0 || scene.height <= 0) {
-    throw InputError(
-        fmt::format("{}: image size {}x{} is not positive", scene.name, scene.width, scene.height));
-  }
+  validateForRendering(scene);  // bad input is exit 2 before any driver starts
   const gl::testing::Faults faults = activeFaults();  // bad RASTERCHECK_GL_FAULT: exit 2
   auto start = Clock::now();
   Session& s = acquireSession(spec);

@@ -4,9 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include <fmt/format.h>
-
-#include "fixtures/errors.h"
+#include "fixtures/scene_geometry.h"
 
 namespace rc::gl {
 namespace {
@@ -27,32 +25,6 @@ bool fitsFloat(const glm::dvec3& v) {
   return std::abs(v.x) <= kMax && std::abs(v.y) <= kMax && std::abs(v.z) <= kMax;
 }
 
-glm::dvec3 normalizeOrZero(const glm::dvec3& v) {
-  const double len = glm::length(v);
-  return len > 0.0 ? v / len : glm::dvec3(0.0);
-}
-
-void validateObject(const Scene& scene, std::size_t index) {
-  const Object& o = scene.objects[index];
-  const Mesh& m = o.mesh;
-  auto fail = [&](const std::string& what) {
-    throw InputError(fmt::format("{}: objects[{}] ({}): {}", scene.name, index, o.name, what));
-  };
-  if (o.material >= scene.materials.size())
-    fail(fmt::format("material index {} out of range ({} materials)", o.material,
-                     scene.materials.size()));
-  if (m.normals.size() != m.positions.size())
-    fail(fmt::format("{} normals for {} positions", m.normals.size(), m.positions.size()));
-  if (!m.uvs.empty() && m.uvs.size() != m.positions.size())
-    fail(fmt::format("{} uvs for {} positions", m.uvs.size(), m.positions.size()));
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    for (std::uint32_t vi : m.triangles[t]) {
-      if (vi >= m.positions.size())
-        fail(fmt::format("triangle {} uses vertex {} of {}", t, vi, m.positions.size()));
-    }
-  }
-}
-
 WorldMesh toWorld(const Object& o, const glm::dmat4& view_projection, bool model_matrix_normals) {
   WorldMesh w;
   const std::size_t n = o.mesh.positions.size();
@@ -64,11 +36,12 @@ WorldMesh toWorld(const Object& o, const glm::dmat4& view_projection, bool model
   const glm::dmat3 normal_matrix =
       model_matrix_normals ? glm::dmat3(o.model) : normalMatrix(o.model);
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::dvec4 p = o.model * glm::dvec4(glm::dvec3(o.mesh.positions[i]), 1.0);
-    w.positions[i] = glm::dvec3(p);
-    w.finite[i] = isFinite(p) && isFinite(view_projection * glm::dvec4(w.positions[i], 1.0)) &&
-                  fitsFloat(w.positions[i]);
-    w.normals[i] = glm::vec3(normalizeOrZero(normal_matrix * glm::dvec3(o.mesh.normals[i])));
+    w.positions[i] = worldPosition(o.model, o.mesh.positions[i]);
+    // The reference drops a triangle whose clip position is not finite; the GPU also
+    // needs the world position as finite floats (fitsFloat is false for inf and NaN).
+    w.finite[i] =
+        fitsFloat(w.positions[i]) && isFinite(view_projection * glm::dvec4(w.positions[i], 1.0));
+    w.normals[i] = glm::vec3(worldNormal(normal_matrix, o.mesh.normals[i]));
   }
   return w;
 }
@@ -92,10 +65,8 @@ glm::dvec3 onePixelRight(const glm::dvec3& world, const glm::dmat4& view_project
 
 VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes,
                            const testing::Faults& faults) {
-  for (std::size_t i = 0; i < scene.objects.size(); ++i) validateObject(scene, i);
-  const double aspect = static_cast<double>(scene.width) / scene.height;
-  const glm::dmat4 view_projection =
-      projectionMatrix(scene.camera, aspect) * viewMatrix(scene.camera);
+  validateForRendering(scene);  // every index below is in range after this
+  const glm::dmat4 view_projection = viewProjectionMatrix(scene);
   std::vector<WorldMesh> world;
   world.reserve(scene.objects.size());
   for (const Object& o : scene.objects)
@@ -123,8 +94,7 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
       const glm::dvec3 p0 = wm.positions[tri[0]];
       const glm::dvec3 p1 = wm.positions[tri[1]];
       const glm::dvec3 p2 = wm.positions[tri[2]];
-      const glm::dvec3 centroid = (p0 + p1 + p2) / 3.0;
-      const glm::dvec3 face_normal = normalizeOrZero(glm::cross(p1 - p0, p2 - p0));
+      const FlatFace face = flatFace(p0, p1, p2);
 
       const auto material = static_cast<std::uint32_t>(obj.material);
       const auto first = static_cast<std::uint32_t>(data.vertices.size());
@@ -150,8 +120,8 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
         v.uv[0] = uv.x;
         v.uv[1] = uv.y;
         v.primitive_id = prim.id;
-        store(v.face_centroid, centroid);
-        store(v.face_normal, face_normal);
+        store(v.face_centroid, face.centroid);
+        store(v.face_normal, face.normal);
       }
     }
     if (out.runs.empty()) data.passes.pop_back();

@@ -16,11 +16,11 @@ namespace rc::gl {
 
 struct Vertex {
   float world_position[3];
-  float world_normal[3];  // unit length, or zero when the model normal is zero
+  float world_normal[3];  // worldNormal(): unit length, or zero when it has no direction
   float uv[2];            // (0, 0) for meshes without uvs
   std::uint32_t primitive_id;
-  float face_centroid[3];  // flat shading: the original triangle's centroid, world space
-  float face_normal[3];    // flat shading: normalize(cross(p1 - p0, p2 - p0)), world space
+  float face_centroid[3];  // flat shading: flatFace().centroid of the original triangle
+  float face_normal[3];    // flat shading: flatFace().normal, safeNormalize(cross(p1-p0, p2-p0))
 };
 static_assert(sizeof(Vertex) == 60, "the attribute offsets in gl_renderer.cpp assume no padding");
 
@@ -44,9 +44,12 @@ struct VertexData {
   std::size_t skipped_triangles = 0;  // dropped for non-finite positions (as the reference does)
 };
 
-// Builds the buffer for drawPasses(scene). Triangles with a non-finite world or clip
-// position are left out; their ids stay unused. Throws InputError for indices out of
-// range (material, vertex) or attribute arrays whose size does not match the positions.
+// Builds the buffer for drawPasses(scene). World positions, normals and the flat
+// centroid and face normal are the shared ones (fixtures/scene_geometry.h: worldPosition,
+// worldNormal, flatFace), as the reference computes them. Triangles with a non-finite clip
+// position, or a world position that does not fit a float, are left out; their ids stay
+// unused. Throws InputError for what validateForRendering() (fixtures/scene_logic.h)
+// rejects.
 // Of the test-only faults, drop_primitive, move_vertex and no_inverse_transpose act here.
 VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes,
                            const testing::Faults& faults = {});

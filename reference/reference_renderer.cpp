@@ -14,6 +14,7 @@
 
 #include "fixtures/errors.h"
 #include "fixtures/multisample.h"
+#include "fixtures/scene_geometry.h"
 #include "fixtures/scene_logic.h"
 #include "reference/clipper.h"
 #include "reference/fragment_ops.h"
@@ -38,45 +39,20 @@ constexpr std::size_t kMaxReportedPairs = 64;
 
 // ---- input validation -------------------------------------------------------------------
 
-std::string sceneLabel(const Scene& scene) {
-  if (!scene.source.empty()) return scene.source.string();
-  return scene.name.empty() ? std::string("scene") : scene.name;
-}
-
+// The scene's own consistency is fixtures' validateForRendering(), shared with the GL
+// backend; what is checked here is what only the reference limits: its options and the
+// image size it allocates.
 void validate(const Scene& scene, const ReferenceOptions& options) {
+  validateForRendering(scene);
   const std::string label = sceneLabel(scene);
   auto fail = [&](const std::string& what) { throw InputError(label + ": " + what); };
   if (options.subpixel_bits < 0 || options.subpixel_bits > kMaxSubpixelBits)
     fail("reference subpixel bits " + std::to_string(options.subpixel_bits) + " out of range [0, " +
          std::to_string(kMaxSubpixelBits) + "]");
-  if (scene.width < 1 || scene.height < 1 || scene.width > kMaxImageSide ||
-      scene.height > kMaxImageSide || std::int64_t{scene.width} * scene.height > kMaxImagePixels)
+  if (scene.width > kMaxImageSide || scene.height > kMaxImageSide ||
+      std::int64_t{scene.width} * scene.height > kMaxImagePixels)
     fail("image " + std::to_string(scene.width) + "x" + std::to_string(scene.height) +
          " outside what the reference renders (1..16384 a side, at most 2^26 pixels)");
-  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
-    const Texture* t = scene.materials[m].texture.get();
-    if (t && (t->width < 1 || t->height < 1 ||
-              t->rgba.size() != 4 * static_cast<std::size_t>(t->width) * t->height))
-      fail("materials[" + std::to_string(m) + "]: texture size does not match its data");
-  }
-  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-    const Object& obj = scene.objects[o];
-    const Mesh& mesh = obj.mesh;
-    const std::string where = "objects[" + std::to_string(o) + "] (" + obj.name + "): ";
-    if (obj.material >= scene.materials.size())
-      fail(where + "material index " + std::to_string(obj.material) + " out of range");
-    if (mesh.normals.size() != mesh.positions.size())
-      fail(where + std::to_string(mesh.normals.size()) + " normals for " +
-           std::to_string(mesh.positions.size()) + " positions");
-    if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
-      fail(where + std::to_string(mesh.uvs.size()) + " uvs for " +
-           std::to_string(mesh.positions.size()) + " positions");
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-      for (std::uint32_t vi : mesh.triangles[t])
-        if (vi >= mesh.positions.size())
-          fail(where + "triangle " + std::to_string(t) + " uses vertex " + std::to_string(vi) +
-               " of " + std::to_string(mesh.positions.size()));
-  }
 }
 
 bool isFinite(const glm::dvec4& v) {
@@ -415,11 +391,9 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   }
   if (scene_.state.shading != Shading::Flat) return;
   // Flat: lit once, at the original triangle's centroid, with its face normal.
-  const glm::dvec3& p0 = t.v[0]->world;
-  const glm::dvec3& p1 = t.v[1]->world;
-  const glm::dvec3& p2 = t.v[2]->world;
-  t.centroid = (p0 + p1 + p2) / 3.0;
-  t.face_normal = safeNormalize(glm::cross(p1 - p0, p2 - p0));
+  const FlatFace face = flatFace(t.v[0]->world, t.v[1]->world, t.v[2]->world);
+  t.centroid = face.centroid;
+  t.face_normal = face.normal;
   t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
   t.constant = t.texture == nullptr && !t.pass->blend;
   if (t.constant) {

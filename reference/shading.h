@@ -21,6 +21,7 @@
 #include <glm/glm.hpp>
 
 #include "fixtures/scene.h"
+#include "fixtures/scene_geometry.h"
 
 namespace rc {
 
@@ -60,13 +61,11 @@ struct LitColor {
   glm::dvec3 specular{0.0};         // sum specular
 };
 
-// normalize(v) with zero (or a non-finite length) staying zero. One division, not three
-// (within an ulp of v / |v|).
-[[gnu::always_inline]] inline glm::dvec3 safeNormalize(const glm::dvec3& v) {
-  const double len = std::sqrt(glm::dot(v, v));
-  if (!(len > 0.0) || !std::isfinite(len)) return glm::dvec3(0.0);
-  return v * (1.0 / len);
-}
+// normalize(v), zero when v has no direction: the one normaliser of the project,
+// rc::safeNormalize in fixtures/scene_geometry.h (its rule for zero, denormal, infinite
+// and NaN lengths is documented there). Named here too because callers outside the
+// reference spell it ref::safeNormalize.
+using rc::safeNormalize;
 
 // max(0, base)^shininess with x^0 = 1. Integral exponents up to 128 use repeated squaring
 // (relative error below shininess * 2^-52 against the exact power, and several times

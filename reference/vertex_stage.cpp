@@ -1,15 +1,14 @@
 // Vertex stage: see vertex_stage.h.
 #include "reference/vertex_stage.h"
 
+#include "fixtures/scene_geometry.h"
 #include "fixtures/scene_logic.h"
-#include "reference/shading.h"
 
 namespace rc::ref {
 
 CameraTransform cameraTransform(const Scene& scene) {
   CameraTransform t;
-  const double aspect = static_cast<double>(scene.width) / static_cast<double>(scene.height);
-  t.view_projection = projectionMatrix(scene.camera, aspect) * viewMatrix(scene.camera);
+  t.view_projection = viewProjectionMatrix(scene);
   t.eye = scene.camera.eye;
   return t;
 }
@@ -23,11 +22,10 @@ void transformObject(const Object& object, const CameraTransform& camera,
   out.resize(mesh.positions.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     TransformedVertex& v = out[i];
-    v.world = glm::dvec3(object.model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0));
+    v.world = worldPosition(object.model, mesh.positions[i]);
     v.clip = camera.view_projection * glm::dvec4(v.world, 1.0);
-    v.normal = normals && i < mesh.normals.size()
-                   ? safeNormalize(normal_matrix * glm::dvec3(mesh.normals[i]))
-                   : glm::dvec3(0.0);
+    v.normal = normals && i < mesh.normals.size() ? worldNormal(normal_matrix, mesh.normals[i])
+                                                  : glm::dvec3(0.0);
     v.uv = i < mesh.uvs.size() ? glm::dvec2(mesh.uvs[i]) : glm::dvec2(0.0);
     if (errors)
       v.clip_err = (kClipRoundingUlps * kUlp32) * (abs_vp * glm::dvec4(glm::abs(v.world), 1.0));

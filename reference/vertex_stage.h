@@ -21,7 +21,7 @@ CameraTransform cameraTransform(const Scene& scene);
 // One mesh vertex after the vertex stage.
 struct TransformedVertex {
   glm::dvec3 world{0.0};   // model * position
-  glm::dvec3 normal{0.0};  // safeNormalize(normalMatrix(model) * normal): zero stays zero
+  glm::dvec3 normal{0.0};  // worldNormal(normalMatrix(model), normal): zero stays zero
   glm::dvec4 clip{0.0};    // view_projection * world
   glm::dvec2 uv{0.0};      // (0, 0) when the mesh has no uvs (as the GL backend feeds)
   // How far a float32 implementation's clip coordinates may be from `clip`, per
