@@ -174,6 +174,10 @@ struct Session {
   Scratch scratch;
   GLuint sample_program = 0;  // reads one sample of the ids / depth (multisampled renders)
   GLuint empty_vertex_array = 0;
+  // zink on Mesa 22 must never see a context destroyed (keepsOneContext): the next render
+  // reuses this one, and a render that did not finish leaves it to be abandoned.
+  bool keep_context = false;
+  bool render_unfinished = false;
 };
 
 std::mutex g_mutex;
@@ -251,6 +255,18 @@ void enableDebugOutput(Session& s) {
   s.gl.DebugMessageCallback(&onDebugMessage, &s);
 }
 
+// zink in Mesa 22 leaves resources (their memory objects, reused through its buffer
+// cache) pointing at the batch state of the context that last used them; destroying that
+// context frees the batch state, and a later context that maps such a resource waits on a
+// condition variable inside freed memory: a hang or an abort (docs/results/findings.md,
+// "zink: dangling batch usage"). With one context per process that never happens, so
+// under zink on Mesa 22 a process keeps its context: each render starts from the state
+// resetReusedContext leaves, which sets everything a fresh context would differ in that a
+// render reads. Fixed upstream in Mesa 23 (batch states outlive their context).
+bool keepsOneContext(const Session& s) {
+  return s.zink && s.mesa_version.rfind("Mesa 22.", 0) == 0;
+}
+
 std::unique_ptr<Session> createSession(const GlSpec& spec) {
   const std::string& forced = gl::testing::hooks().gallium_driver;
   const std::string gallium = forced.empty() ? spec.driver : forced;
@@ -296,6 +312,7 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
     s->vulkan_query_ms = msSince(start);
   }
   chooseSubpixelBits(*s);
+  s->keep_context = keepsOneContext(*s);
   s->stack = describeStack(*s, loaded);
   enableDebugOutput(*s);
   checkGl(*s, "context creation");
@@ -317,6 +334,29 @@ void renewContext(Session& s) {
   s.gl.load(s.context->loader());
   enableDebugOutput(s);
   checkGl(s, "context creation");
+}
+
+// The GL state of a fresh context for everything renderLocked does not set itself.
+void resetReusedContext(Session& s) {
+  const gl::Functions& gl = s.gl;
+  s.context->makeCurrent();
+  s.debug_errors.clear();
+  while (gl.GetError() != GL_NO_ERROR) {
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
+  gl.UseProgram(0);
+  gl.BindVertexArray(0);
+  gl.BindBuffer(GL_ARRAY_BUFFER, 0);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  gl.DepthMask(GL_TRUE);
+  gl.DepthFunc(GL_LESS);
+  gl.Disablei(GL_BLEND, 0);
+  gl.Disablei(GL_BLEND, 1);
+  gl.BlendFunc(GL_ONE, GL_ZERO);
+  checkGl(s, "context reuse");
 }
 
 // Returns the session for spec, made current on this thread.
@@ -341,8 +381,27 @@ Session& acquireSession(const GlSpec& spec) {
         "process): run {} in its own process",
         spec.driver, have.driver, toString(spec)));
   }
-  renewContext(*g_session);
-  return *g_session;
+  Session& s = *g_session;
+  if (!s.keep_context) {
+    renewContext(s);
+  } else if (s.render_unfinished) {
+    // The last render threw halfway: its state is unknown, and destroying the context is
+    // what zink on Mesa 22 cannot take, so it is left allocated (one per failed render).
+    s.render_unfinished = false;
+    s.programs.clear();
+    s.sample_program = 0;
+    s.empty_vertex_array = 0;
+    s.framebuffer = Framebuffer{};
+    s.debug_errors.clear();
+    s.context->abandon();
+    s.context->makeCurrent();
+    s.gl.load(s.context->loader());
+    enableDebugOutput(s);
+    checkGl(s, "context creation");
+  } else {
+    resetReusedContext(s);
+  }
+  return s;
 }
 
 GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& source) {
@@ -1117,16 +1176,6 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   }
   const int max_samples = glInteger(gl, GL_MAX_SAMPLES);
   const int samples = scene.state.samples;
-  if (samples > 1 && s.driver == "zink" && s.version.find("Mesa 22.") != std::string::npos) {
-    // zink on lavapipe in Mesa 22 deadlocks or crashes now and then in the read-back of a
-    // multisampled render in a process that rendered before (a lavapipe mutex, under
-    // readBackMultisample; docs/results/findings.md "Open"). Until that is understood the
-    // pair is not run rather than left to the watchdog.
-    throw NotSupportedError(
-        fmt::format("{} samples per pixel: zink on Mesa 22 hangs in the multisample read-back "
-                    "(docs/results/findings.md); not run",
-                    samples));
-  }
   if (samples > 1) {
     const int usable = maxUsableSamples(gl);
     if (usable < samples)
@@ -1135,6 +1184,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
           "and integer texture limits included)",
           samples, usable, max_samples));
   }
+  s.render_unfinished = true;  // until the frame is read back (keep_context)
   bindFramebuffer(s, scene);
   checkGl(s, "framebuffer setup");
   MultisampleTargets ms(gl);
@@ -1198,6 +1248,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
     readBack(s, scene, frame);
   }
   checkGl(s, "readback");
+  s.render_unfinished = false;
   const double readback_ms = msSince(start);
   const double readback_cpu_ms = threadCpuMs() - cpu_start;
 
