@@ -178,6 +178,7 @@ struct Session {
   // reuses this one, and a render that did not finish leaves it to be abandoned.
   bool keep_context = false;
   bool render_unfinished = false;
+  const char* context_use = "new";  // frame.json "context": new, reused or replaced
 };
 
 std::mutex g_mutex;
@@ -365,6 +366,7 @@ Session& acquireSession(const GlSpec& spec) {
   if (spec.platform == GlSpec::Platform::EglDevice) gl::findEglDevice(spec.device);
   if (g_session == nullptr) {
     g_session = createSession(spec).release();
+    g_session->context_use = "new";
     return *g_session;
   }
   const Session& have = *g_session;
@@ -382,6 +384,7 @@ Session& acquireSession(const GlSpec& spec) {
         spec.driver, have.driver, toString(spec)));
   }
   Session& s = *g_session;
+  s.context_use = !s.keep_context ? "new" : s.render_unfinished ? "replaced" : "reused";
   if (!s.keep_context) {
     renewContext(s);
   } else if (s.render_unfinished) {
@@ -1262,6 +1265,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["gl_subpixel_bits"] = s.gl_subpixel_bits;
   m["subpixel_bits_source"] = s.subpixel_source;
   m["platform"] = s.context->platform();
+  m["context"] = s.context_use;
   m["driver"] = s.driver;
   m["stack"] = s.stack;
   m["mesa"] = gl::toJson(s.mesa, s.spec, s.mesa_version);
