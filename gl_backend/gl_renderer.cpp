@@ -256,14 +256,14 @@ void enableDebugOutput(Session& s) {
   s.gl.DebugMessageCallback(&onDebugMessage, &s);
 }
 
-// zink in Mesa 22 leaves resources (their memory objects, reused through its buffer
-// cache) pointing at the batch state of the context that last used them; destroying that
-// context frees the batch state, and a later context that maps such a resource waits on a
-// condition variable inside freed memory: a hang or an abort (docs/results/findings.md,
-// "zink: dangling batch usage"). With one context per process that never happens, so
-// under zink on Mesa 22 a process keeps its context: each render starts from the state
-// resetReusedContext leaves, which sets everything a fresh context would differ in that a
-// render reads. Fixed upstream in Mesa 23 (batch states outlive their context).
+// zink in Mesa 22 frees a context's batch states when the context is destroyed, while
+// resources may still point at them (the last batch that read or wrote them); a later
+// context that waits on such a resource sleeps on a condition variable in freed memory: a
+// hang or an abort (docs/results/findings.md, "zink on Mesa 22: a destroyed context leaves
+// dangling batch usage"). With one context per process that cannot happen, so under zink
+// on Mesa 22 a process keeps its context, and each render starts from the state
+// resetReusedContext leaves (everything a fresh context has that a render does not set
+// itself). Later zink hands a destroyed context's batch states to the screen instead.
 bool keepsOneContext(const Session& s) {
   return s.zink && s.mesa_version.rfind("Mesa 22.", 0) == 0;
 }
