@@ -28,6 +28,10 @@ class Context {
   // Replaces the GL context by a new one on the same display (the driver stays loaded),
   // unbound; every GL object of the old one is gone. Throws BackendError on failure.
   virtual void renew() = 0;
+  // Like renew(), but the old context is never destroyed while the provider lives, only
+  // unbound: for a driver that must not see a context destroyed (zink on Mesa 22 keeps
+  // pointers into a destroyed context's batch states; docs/gl_backend.md).
+  virtual void abandon() = 0;
   // The provider's getProcAddress (eglGetProcAddress / OSMesaGetProcAddress).
   virtual ProcLoader loader() const = 0;
   // "egl", "egl-device" or "osmesa" (frame.json "platform").

@@ -102,6 +102,7 @@ class EglContext final : public Context {
       eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       eglDestroyContext(display_, context_);
     }
+    for (EGLContext old : abandoned_) eglDestroyContext(display_, old);
     if (initialized_) eglTerminate(display_);
   }
 
@@ -119,6 +120,13 @@ class EglContext final : public Context {
   void renew() override {
     release();
     eglDestroyContext(display_, context_);
+    context_ = EGL_NO_CONTEXT;
+    createContext();
+  }
+
+  void abandon() override {
+    release();
+    abandoned_.push_back(context_);
     context_ = EGL_NO_CONTEXT;
     createContext();
   }
@@ -142,6 +150,7 @@ class EglContext final : public Context {
 
   EGLDisplay display_;
   EGLContext context_ = EGL_NO_CONTEXT;
+  std::vector<EGLContext> abandoned_;  // abandon(): destroyed only with the display
   bool initialized_ = false;
   const char* platform_;
 };

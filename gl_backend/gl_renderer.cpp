@@ -174,6 +174,11 @@ struct Session {
   Scratch scratch;
   GLuint sample_program = 0;  // reads one sample of the ids / depth (multisampled renders)
   GLuint empty_vertex_array = 0;
+  // zink on Mesa 22 must never see a context destroyed (keepsOneContext): the next render
+  // reuses this one, and a render that did not finish leaves it to be abandoned.
+  bool keep_context = false;
+  bool render_unfinished = false;
+  const char* context_use = "new";  // frame.json "context": new, reused or replaced
 };
 
 std::mutex g_mutex;
@@ -251,6 +256,18 @@ void enableDebugOutput(Session& s) {
   s.gl.DebugMessageCallback(&onDebugMessage, &s);
 }
 
+// zink in Mesa 22 frees a context's batch states when the context is destroyed, while
+// resources may still point at them (the last batch that read or wrote them); a later
+// context that waits on such a resource sleeps on a condition variable in freed memory: a
+// hang or an abort (docs/results/findings.md, "zink on Mesa 22: a destroyed context leaves
+// dangling batch usage"). With one context per process that cannot happen, so under zink
+// on Mesa 22 a process keeps its context, and each render starts from the state
+// resetReusedContext leaves (everything a fresh context has that a render does not set
+// itself). Later zink hands a destroyed context's batch states to the screen instead.
+bool keepsOneContext(const Session& s) {
+  return s.zink && s.mesa_version.rfind("Mesa 22.", 0) == 0;
+}
+
 std::unique_ptr<Session> createSession(const GlSpec& spec) {
   const std::string& forced = gl::testing::hooks().gallium_driver;
   const std::string gallium = forced.empty() ? spec.driver : forced;
@@ -296,6 +313,7 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
     s->vulkan_query_ms = msSince(start);
   }
   chooseSubpixelBits(*s);
+  s->keep_context = keepsOneContext(*s);
   s->stack = describeStack(*s, loaded);
   enableDebugOutput(*s);
   checkGl(*s, "context creation");
@@ -319,12 +337,36 @@ void renewContext(Session& s) {
   checkGl(s, "context creation");
 }
 
+// The GL state of a fresh context for everything renderLocked does not set itself.
+void resetReusedContext(Session& s) {
+  const gl::Functions& gl = s.gl;
+  s.context->makeCurrent();
+  s.debug_errors.clear();
+  while (gl.GetError() != GL_NO_ERROR) {
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
+  gl.UseProgram(0);
+  gl.BindVertexArray(0);
+  gl.BindBuffer(GL_ARRAY_BUFFER, 0);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  gl.DepthMask(GL_TRUE);
+  gl.DepthFunc(GL_LESS);
+  gl.Disablei(GL_BLEND, 0);
+  gl.Disablei(GL_BLEND, 1);
+  gl.BlendFunc(GL_ONE, GL_ZERO);
+  checkGl(s, "context reuse");
+}
+
 // Returns the session for spec, made current on this thread.
 Session& acquireSession(const GlSpec& spec) {
   // A missing GPU is the answer for an egl-device spec, whatever else this process runs.
   if (spec.platform == GlSpec::Platform::EglDevice) gl::findEglDevice(spec.device);
   if (g_session == nullptr) {
     g_session = createSession(spec).release();
+    g_session->context_use = "new";
     return *g_session;
   }
   const Session& have = *g_session;
@@ -341,8 +383,28 @@ Session& acquireSession(const GlSpec& spec) {
         "process): run {} in its own process",
         spec.driver, have.driver, toString(spec)));
   }
-  renewContext(*g_session);
-  return *g_session;
+  Session& s = *g_session;
+  s.context_use = !s.keep_context ? "new" : s.render_unfinished ? "replaced" : "reused";
+  if (!s.keep_context) {
+    renewContext(s);
+  } else if (s.render_unfinished) {
+    // The last render threw halfway: its state is unknown, and destroying the context is
+    // what zink on Mesa 22 cannot take, so it is left allocated (one per failed render).
+    s.render_unfinished = false;
+    s.programs.clear();
+    s.sample_program = 0;
+    s.empty_vertex_array = 0;
+    s.framebuffer = Framebuffer{};
+    s.debug_errors.clear();
+    s.context->abandon();
+    s.context->makeCurrent();
+    s.gl.load(s.context->loader());
+    enableDebugOutput(s);
+    checkGl(s, "context creation");
+  } else {
+    resetReusedContext(s);
+  }
+  return s;
 }
 
 GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& source) {
@@ -1106,16 +1168,6 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   }
   const int max_samples = glInteger(gl, GL_MAX_SAMPLES);
   const int samples = scene.state.samples;
-  if (samples > 1 && s.driver == "zink" && s.version.find("Mesa 22.") != std::string::npos) {
-    // zink on lavapipe in Mesa 22 deadlocks or crashes now and then in the read-back of a
-    // multisampled render in a process that rendered before (a lavapipe mutex, under
-    // readBackMultisample; docs/results/findings.md "Open"). Until that is understood the
-    // pair is not run rather than left to the watchdog.
-    throw NotSupportedError(
-        fmt::format("{} samples per pixel: zink on Mesa 22 hangs in the multisample read-back "
-                    "(docs/results/findings.md); not run",
-                    samples));
-  }
   if (samples > 1) {
     const int usable = maxUsableSamples(gl);
     if (usable < samples)
@@ -1124,6 +1176,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
           "and integer texture limits included)",
           samples, usable, max_samples));
   }
+  s.render_unfinished = true;  // until the frame is read back (keep_context)
   bindFramebuffer(s, scene);
   checkGl(s, "framebuffer setup");
   MultisampleTargets ms(gl);
@@ -1187,6 +1240,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
     readBack(s, scene, frame);
   }
   checkGl(s, "readback");
+  s.render_unfinished = false;
   const double readback_ms = msSince(start);
   const double readback_cpu_ms = threadCpuMs() - cpu_start;
 
@@ -1200,6 +1254,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["gl_subpixel_bits"] = s.gl_subpixel_bits;
   m["subpixel_bits_source"] = s.subpixel_source;
   m["platform"] = s.context->platform();
+  m["context"] = s.context_use;
   m["driver"] = s.driver;
   m["stack"] = s.stack;
   m["mesa"] = gl::toJson(s.mesa, s.spec, s.mesa_version);

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <string>
 #include <type_traits>
+#include <vector>
 #endif
 
 namespace rc::gl {
@@ -67,7 +68,10 @@ class OsMesaContext final : public Context {
     osmesa(mesa_dir);  // loads the library on the process's first context
     createContext();
   }
-  ~OsMesaContext() override { osmesa().destroy_context(context_); }
+  ~OsMesaContext() override {
+    osmesa().destroy_context(context_);
+    for (OSMesaContext old : abandoned_) osmesa().destroy_context(old);
+  }
 
   void makeCurrent() override {
     // OSMesa needs a colour buffer to become current; everything is drawn into the
@@ -81,6 +85,12 @@ class OsMesaContext final : public Context {
 
   void renew() override {
     osmesa().destroy_context(context_);
+    context_ = nullptr;
+    createContext();
+  }
+
+  void abandon() override {
+    abandoned_.push_back(context_);
     context_ = nullptr;
     createContext();
   }
@@ -111,6 +121,7 @@ class OsMesaContext final : public Context {
   }
 
   OSMesaContext context_ = nullptr;
+  std::vector<OSMesaContext> abandoned_;  // abandon(): destroyed only with this object
   std::array<unsigned char, 4> pixel_{};
 };
 

@@ -20,12 +20,8 @@ namespace fs = std::filesystem;
 
 class GlMultisample : public GlTest {};
 
-// softpipe has GL_MAX_SAMPLES 1; zink on Mesa 22 is refused (gl_renderer.cpp: its
-// multisample read-back hangs now and then; docs/results/findings.md "Open").
-bool expectNoMsaa() {
-  return specText().find("softpipe") != std::string::npos ||
-         specText().find("zink") != std::string::npos;
-}
+// softpipe has GL_MAX_SAMPLES 1.
+bool expectNoMsaa() { return specText().find("softpipe") != std::string::npos; }
 
 TEST_F(GlMultisample, CatalogFixturesAgreeWithTheReferenceOrAreNotSupported) {
   for (const char* name :
