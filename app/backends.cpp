@@ -1,7 +1,6 @@
 // Backend SPEC parsing and dispatch: see backends.h.
 #include "app/backends.h"
 
-#include <algorithm>
 #include <charconv>
 #include <chrono>
 
@@ -84,13 +83,8 @@ Frame renderWith(const BackendSpec& backend, const Scene& scene) {
   if (!scene.tags.empty()) m["tags"] = scene.tags;
   m["width"] = scene.width;
   m["height"] = scene.height;
-  m["depth_format"] = toString(scene.state.depth_format);
-  m["color_format"] = toString(scene.state.color_format);
   m["clear_depth"] = scene.clear_depth;
-  // What the comparator's shading allowance depends on (docs/tolerances.md).
-  m["texture_filter"] = toString(scene.state.texture_filter);
-  m["textured"] = std::any_of(scene.materials.begin(), scene.materials.end(),
-                              [](const Material& mat) { return mat.texture != nullptr; });
+  // (The formats and texture facts are frame.drawn, set by the renderer.)
   m["tolerance"] = toleranceJson(scene.tolerance);
   m["state"] = stateJson(scene.state);     // what expected failures are scoped by
   m["color_digest"] = colorDigest(frame);  // tells `compare` color.png shows this frame

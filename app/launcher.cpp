@@ -18,14 +18,17 @@ int main(int argc, char** argv) {
     std::printf("rastercheck %s\n", rc::kVersion);
     return 0;
   }
-  // The core lives beside the launcher, wherever both were built or installed.
+  // The core is beside the launcher in the build tree; installed, the launcher is in
+  // <prefix>/bin and the core in <prefix>/libexec/rastercheck (RC_CORE_FROM_LAUNCHER: the
+  // relative path, so that an installed tree can be moved).
   char self[PATH_MAX];
   const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
   std::string core = "rastercheck-core";
   if (n > 0) {
     std::string dir(self, static_cast<std::size_t>(n));
     dir.resize(dir.rfind('/') + 1);
-    core = dir + core;
+    core = dir + "rastercheck-core";
+    if (::access(core.c_str(), X_OK) != 0) core = dir + RC_CORE_FROM_LAUNCHER "/rastercheck-core";
   }
   ::execv(core.c_str(), argv);
   std::fprintf(stderr, "rastercheck: internal error: cannot start %s: %s\n", core.c_str(),

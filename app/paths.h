@@ -1,16 +1,17 @@
-// Where the installed tool finds its catalog and itself (for child processes).
+// Where the tool finds its catalog and itself (for child processes), built or installed.
 #pragma once
 
 #include <filesystem>
 
 namespace rc {
 
-// fixtures/scenes of the source tree this binary was built from, unless
-// RASTERCHECK_CATALOG names another folder.
+// The catalog: RASTERCHECK_CATALOG when set, else share/rastercheck/fixtures/scenes of the
+// installed tree this program runs from, else fixtures/scenes of the source tree it was
+// built from (a build tree).
 std::filesystem::path defaultCatalogDir();
 
-// The known driver differences run applies by default: fixtures/expectations.json of the
-// source tree, unless RASTERCHECK_EXPECTATIONS names another file.
+// The known driver differences run applies by default: RASTERCHECK_EXPECTATIONS when set,
+// else fixtures/expectations.json, installed or in the source tree as for the catalog.
 std::filesystem::path defaultExpectationsFile();
 
 // The running executable (/proc/self/exe), used to start one child process per render.

@@ -1121,48 +1121,25 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
 }
 
 Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual) {
-  auto format = [](const Frame& f, const char* key, const char* role) {
-    std::string v = metaString(f, key);
-    if (v.empty() && f.meta.contains(key))
-      throw InputError(
-          fmt::format("{}: frame.json: {} must be a string", frameLabel(f, role), key));
-    return v;
-  };
-  const std::string de = format(expected, "depth_format", "expected");
-  const std::string da = format(actual, "depth_format", "actual");
-  const std::string ce = format(expected, "color_format", "expected");
-  const std::string ca = format(actual, "color_format", "actual");
-  if (!de.empty() && !da.empty() && de != da)
+  const DrawFacts& e = expected.drawn;
+  const DrawFacts& a = actual.drawn;
+  if (e.depth_format && a.depth_format && *e.depth_format != *a.depth_format)
     throw InputError(fmt::format("{} has depth_format {}, {} has {}",
-                                 frameLabel(expected, "expected"), de, frameLabel(actual, "actual"),
-                                 da));
-  if (!ce.empty() && !ca.empty() && ce != ca)
+                                 frameLabel(expected, "expected"), toString(*e.depth_format),
+                                 frameLabel(actual, "actual"), toString(*a.depth_format)));
+  if (e.color_format && a.color_format && *e.color_format != *a.color_format)
     throw InputError(fmt::format("{} has color_format {}, {} has {}",
-                                 frameLabel(expected, "expected"), ce, frameLabel(actual, "actual"),
-                                 ca));
-  const std::string depth = de.empty() ? da : de;
-  const std::string color = ce.empty() ? ca : ce;
-  DepthFormat df = DepthFormat::D24;
-  if (depth == "d16")
-    df = DepthFormat::D16;
-  else if (depth == "d32f")
-    df = DepthFormat::D32F;
-  else if (!depth.empty() && depth != "d24")
-    throw InputError(fmt::format("frame.json: unknown depth_format '{}'", depth));
-  ColorFormat cf = ColorFormat::RGBA32F;
-  if (color == "rgba8")
-    cf = ColorFormat::RGBA8;
-  else if (!color.empty() && color != "rgba32f")
-    throw InputError(fmt::format("frame.json: unknown color_format '{}'", color));
-  // The filter of a textured material (frame.json "texture_filter", "textured").
-  auto texturedWith = [](const Frame& f, const char* filter) {
-    const auto textured = f.meta.find("textured");
-    return metaString(f, "texture_filter") == filter && textured != f.meta.end() &&
-           textured->is_boolean() && textured->get<bool>();
-  };
+                                 frameLabel(expected, "expected"), toString(*e.color_format),
+                                 frameLabel(actual, "actual"), toString(*a.color_format)));
+  const DepthFormat depth = e.depth_format.value_or(a.depth_format.value_or(DepthFormat::D24));
+  const ColorFormat color = e.color_format.value_or(a.color_format.value_or(ColorFormat::RGBA32F));
   DrawnWith drawn;
-  drawn.linear_textures = texturedWith(expected, "linear") || texturedWith(actual, "linear");
-  return defaultTolerances(df, cf, drawn);
+  drawn.linear_textures = e.linearTextures() || a.linearTextures();
+  return defaultTolerances(depth, color, drawn);
+}
+
+PairResult compareFrames(const Frame& expected, const Frame& actual) {
+  return compareFrames(expected, actual, expected, tolerancesForFrames(expected, actual));
 }
 
 void checkSameSize(const Frame& expected, const Frame& actual,

@@ -220,10 +220,17 @@ struct ClassMaps {
 PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                          const Tolerances& tolerances, ClassMaps* maps = nullptr);
 
-// The defaults for a pair, from the frames' meta depth_format/color_format (d24 and
-// rgba32f when absent) and texture_filter/textured (the linear filtering allowance).
-// Throws InputError when the two frames name different formats.
+// The defaults for a pair, from the frames' typed facts (Frame::drawn): depth and colour
+// format (d24 and rgba32f when neither frame says) and whether a textured material is
+// filtered linearly (the linear filtering allowance). Throws InputError when the two frames
+// name different formats.
 Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual);
+
+// What `rastercheck compare` gives for two frames, e.g. compareFrames(renderReference(s),
+// renderGl(s, spec)): `expected` classifies, tolerances from tolerancesForFrames. A
+// fixture's "tolerance" block and command-line thresholds are further layers the caller
+// applies (applyOverrides) and the other overload takes.
+PairResult compareFrames(const Frame& expected, const Frame& actual);
 
 // Throws InputError naming both directories when the frames differ in size.
 void checkSameSize(const Frame& expected, const Frame& actual,

@@ -1165,9 +1165,12 @@ Frame renderMultisample(const Scene& scene, const ReferenceOptions& options) {
 
 Frame renderReference(const Scene& scene, const ReferenceOptions& options) {
   validate(scene, options);
-  if (scene.state.samples > 1) return renderMultisample(scene, options);
-  Renderer renderer(scene, options, PixelRect{0, 0, scene.width, scene.height}, nullptr);
-  return renderer.run();
+  Frame frame =
+      scene.state.samples > 1
+          ? renderMultisample(scene, options)
+          : Renderer(scene, options, PixelRect{0, 0, scene.width, scene.height}, nullptr).run();
+  frame.drawn = drawFacts(scene);  // what a comparison of this frame needs
+  return frame;
 }
 
 std::vector<FragmentTrace> tracePixel(const Scene& scene, const ReferenceOptions& options, int x,

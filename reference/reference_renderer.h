@@ -49,6 +49,7 @@ struct ReferenceOptions {
 // [0, 12]), images larger than 16384 px a side or 2^26 px in all, and inconsistent
 // scenes (material index, normal/uv counts, vertex indices, texture sizes). NaN or
 // infinite geometry is not an error: those triangles are dropped.
+// frame.drawn: the scene's formats and texture facts (fixtures/frame.h).
 // frame.meta: {"renderer", "subpixel_bits", "painter_forced", "triangles_rasterized" (fan
 // triangles, after clipping and culling, that covered a pixel centre's bounding box),
 // "fragments" (covered pixel centres, whether they passed the depth test or not),

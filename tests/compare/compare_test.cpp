@@ -466,20 +466,29 @@ TEST_F(CompareTest, SizeMismatchIsAnInputErrorNamingBothSides) {
   EXPECT_THROW(compare(), InputError);
 }
 
-TEST_F(CompareTest, FormatsComeFromFrameMeta) {
+TEST_F(CompareTest, FormatsComeFromTheFramesDrawFacts) {
   EXPECT_EQ(tolerancesForFrames(ref_, gl_).depth_format, DepthFormat::D24);
-  gl_.meta["color_format"] = "rgba8";
-  ref_.meta["color_format"] = "rgba8";
-  ref_.meta["depth_format"] = "d16";
-  gl_.meta.erase("depth_format");
+  gl_.drawn.color_format = ColorFormat::RGBA8;
+  ref_.drawn.color_format = ColorFormat::RGBA8;
+  ref_.drawn.depth_format = DepthFormat::D16;
+  gl_.drawn.depth_format.reset();  // a frame that does not say takes the other's
   const Tolerances t = tolerancesForFrames(ref_, gl_);
   EXPECT_EQ(t.depth_format, DepthFormat::D16);
   EXPECT_EQ(t.color_format, ColorFormat::RGBA8);
-  gl_.meta["depth_format"] = "d24";
+  EXPECT_EQ(compareFrames(ref_, gl_).tolerances.depth_format, DepthFormat::D16);
+  gl_.drawn.depth_format = DepthFormat::D24;
   EXPECT_THROW(tolerancesForFrames(ref_, gl_), InputError);
-  gl_.meta["depth_format"] = "d99";
-  ref_.meta.erase("depth_format");
-  EXPECT_THROW(tolerancesForFrames(ref_, gl_), InputError);
+  // Linear filtering widens the shading allowance only on a textured material.
+  gl_.drawn = ref_.drawn;
+  EXPECT_EQ(tolerancesForFrames(ref_, gl_).texture_weight_error, 0.0);
+  gl_.drawn.texture_filter = TextureFilter::Linear;
+  EXPECT_EQ(tolerancesForFrames(ref_, gl_).texture_weight_error, 0.0);
+  gl_.drawn.textured = true;
+  const Tolerances linear = tolerancesForFrames(ref_, gl_);
+  EXPECT_GT(linear.texture_weight_error, 0.0);
+  EXPECT_EQ(linear.texture_weight_error,
+            defaultTolerances(DepthFormat::D16, ColorFormat::RGBA8, DrawnWith{true})
+                .texture_weight_error);
 }
 
 // The comparator has a vector path (whole chunks of matching pixels, no maps) and a

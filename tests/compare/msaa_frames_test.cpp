@@ -23,8 +23,6 @@ Frame render(const char* rel, ReferenceOptions options = {}, const char* backend
   Frame f = renderReference(scene, options);
   f.meta["backend"] = backend;
   f.meta["fixture"] = scene.name;
-  f.meta["depth_format"] = toString(scene.state.depth_format);
-  f.meta["color_format"] = toString(scene.state.color_format);
   f.meta["subpixel_bits"] = options.subpixel_bits;
   return f;
 }

@@ -28,8 +28,6 @@ Frame render(const fs::path& fixture, ReferenceOptions options = {}, const char*
   Frame f = renderReference(scene, options);
   f.meta["backend"] = backend;
   f.meta["fixture"] = scene.name;
-  f.meta["depth_format"] = toString(scene.state.depth_format);
-  f.meta["color_format"] = toString(scene.state.color_format);
   return f;
 }
 

@@ -32,11 +32,9 @@ Frame renderRects(int width, int height, const std::vector<Rect>& rects) {
   Frame f;
   const float clear[4] = {0.f, 0.f, 0.f, 0.f};
   f.allocate(width, height, clear, 1.0f, true);
-  f.meta = {{"backend", "ref"},
-            {"fixture", "synthetic/rects"},
-            {"subpixel_bits", 8},
-            {"depth_format", "d24"},
-            {"color_format", "rgba32f"}};
+  f.meta = {{"backend", "ref"}, {"fixture", "synthetic/rects"}, {"subpixel_bits", 8}};
+  f.drawn.depth_format = DepthFormat::D24;
+  f.drawn.color_format = ColorFormat::RGBA32F;
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const Vec p{x + 0.5, y + 0.5};

@@ -52,7 +52,16 @@ rc::Frame makeFrame(bool uncertainty) {
   }
   f.color[0] = std::numeric_limits<float>::quiet_NaN();
   f.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
+  f.drawn.depth_format = rc::DepthFormat::D16;
+  f.drawn.color_format = rc::ColorFormat::RGBA8;
+  f.drawn.texture_filter = rc::TextureFilter::Nearest;
+  f.drawn.textured = true;
   return f;
+}
+
+nlohmann::json readJson(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
 }
 
 }  // namespace
@@ -76,6 +85,7 @@ TEST(FrameIo, RoundTripsEveryChannelExactly) {
     EXPECT_EQ(out.depth_gap, in.depth_gap);
     EXPECT_EQ(out.hasUncertainty(), unc);
     EXPECT_EQ(out.meta, in.meta);
+    EXPECT_EQ(out.drawn, in.drawn);
     fs::remove_all(dir);
   }
 }
@@ -371,4 +381,50 @@ TEST(FrameIo, RoundTripsMultisampledFrames) {
   rc::Frame bad = makeFrame(false);
   bad.samples = 4;  // planes missing
   EXPECT_THROW(rc::writeFrameDir(bad, tempDir("ms_bad")), rc::InputError);
+}
+
+// The typed facts are frame.json's contract keys (DESIGN.md: depth format beside the
+// backend); a frame that does not say keeps them unset, and a wrong value is refused on
+// reading with the file and the key.
+TEST(FrameIo, DrawFactsAreFrameJsonKeys) {
+  const fs::path dir = tempDir("facts");
+  rc::writeFrameDir(makeFrame(false), dir);
+  nlohmann::json doc = readJson(dir / "frame.json");
+  EXPECT_EQ(doc["depth_format"], "d16");
+  EXPECT_EQ(doc["color_format"], "rgba8");
+  EXPECT_EQ(doc["texture_filter"], "nearest");
+  EXPECT_EQ(doc["textured"], true);
+  EXPECT_EQ(doc["backend"], "ref");
+  // Read back, they are typed, not left in meta as strings.
+  const rc::Frame read = rc::readFrameDir(dir);
+  EXPECT_FALSE(read.meta.contains("depth_format"));
+  EXPECT_EQ(read.drawn.depth_format, rc::DepthFormat::D16);
+
+  rc::Frame unsaid = makeFrame(false);
+  unsaid.drawn = {};
+  rc::writeFrameDir(unsaid, dir);
+  doc = readJson(dir / "frame.json");
+  for (const char* key : {"depth_format", "color_format", "texture_filter", "textured"})
+    EXPECT_FALSE(doc.contains(key)) << key;
+  EXPECT_EQ(rc::readFrameDir(dir).drawn, rc::DrawFacts{});
+
+  const std::pair<const char*, nlohmann::json> bad[] = {{"depth_format", "d99"},
+                                                        {"depth_format", 16},
+                                                        {"color_format", "rgb8"},
+                                                        {"texture_filter", "cubic"},
+                                                        {"textured", "yes"}};
+  for (const auto& [key, value] : bad) {
+    doc[key] = value;
+    std::ofstream(dir / "frame.json") << doc.dump();
+    try {
+      (void)rc::readFrameDir(dir);
+      ADD_FAILURE() << key << " = " << value.dump() << " was accepted";
+    } catch (const rc::InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find((dir / "frame.json").string()), std::string::npos) << what;
+      EXPECT_NE(what.find(key), std::string::npos) << what;
+    }
+    doc.erase(key);
+  }
+  fs::remove_all(dir);
 }

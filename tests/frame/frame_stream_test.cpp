@@ -31,6 +31,10 @@ Frame sample(bool uncertainty) {
   }
   f.color[5] = std::numeric_limits<float>::quiet_NaN();
   f.meta = {{"backend", "gl:egl:llvmpipe"}, {"fixture", "a/b"}, {"time_ms", 1.25}};
+  f.drawn.depth_format = DepthFormat::D16;
+  f.drawn.color_format = ColorFormat::RGBA8;
+  f.drawn.texture_filter = TextureFilter::Linear;
+  f.drawn.textured = true;
   return f;
 }
 
@@ -55,6 +59,7 @@ TEST(FrameStream, RoundTripsEveryBufferBitForBit) {
           << kUncertaintyChannelInfo[c].name;
     EXPECT_EQ(out.hasUncertainty(), uncertainty);
     EXPECT_EQ(out.meta, in.meta);
+    EXPECT_EQ(out.drawn, in.drawn);  // the formats and texture facts travel too
   }
 }
 
