@@ -266,8 +266,9 @@ class Renderer {
   void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
                 const FragmentInterpolator& interp);
   template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
-  void fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
-                 const FragmentInterpolator& interp, Shade&& shade);
+  [[gnu::always_inline]] inline void fillSpans(const TriangleContext& t,
+                                               const TriangleCoverage& coverage,
+                                               const FragmentInterpolator& interp, Shade&& shade);
   template <DepthFormat kFormat>
   void shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
                       const FragmentInterpolator& interp);
@@ -415,13 +416,19 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
     if (scene_.state.shading == Shading::Gouraud) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];
   }
   if (scene_.state.shading != Shading::Flat) return;
-  // Flat: lit once, at the original triangle's centroid, with its face normal.
-  const glm::dvec3& p0 = t.v[0]->world;
-  const glm::dvec3& p1 = t.v[1]->world;
-  const glm::dvec3& p2 = t.v[2]->world;
-  t.centroid = (p0 + p1 + p2) / 3.0;
-  t.face_normal = safeNormalize(glm::cross(p1 - p0, p2 - p0));
-  t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
+  // Flat: lit once, at the original triangle's centroid, with its face normal. Without
+  // lights shadePrepared() returns the material's ambient term (and zero specular) for
+  // any point and normal, so those are needed only when tracing (traceTerms()).
+  if (t.shading->lights.empty() && trace_ == nullptr) {
+    t.flat = LitColor{t.shading->ambient, glm::dvec3(0.0)};
+  } else {
+    const glm::dvec3& p0 = t.v[0]->world;
+    const glm::dvec3& p1 = t.v[1]->world;
+    const glm::dvec3& p2 = t.v[2]->world;
+    t.centroid = (p0 + p1 + p2) / 3.0;
+    t.face_normal = safeNormalize(glm::cross(p1 - p0, p2 - p0));
+    t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
+  }
   t.constant = t.texture == nullptr && !t.pass->blend;
   if (t.constant) {
     const glm::dvec4 c = finalColor(t.flat, glm::dvec3(1.0), t.material->opacity);
@@ -704,6 +711,11 @@ inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool 
   const glm::dvec4 out = blendSourceOver(src, storedColor(index), color_format_);
   for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
 }
+
+// Lane4 values stay inside shadePhongQuad() (everything it calls is inlined): -Wpsabi's
+// note on passing 32-byte vectors without AVX does not apply (for the rest of the file:
+// GCC also gives it at the end of the translation unit).
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 // Untextured, unblended Phong fragments of one row, up to four: what PhongQuads shades.
 struct PhongQuad {
