@@ -15,6 +15,7 @@
 
 #include <glm/glm.hpp>
 
+#include "reference/lanes.h"
 #include "reference/viewport.h"
 
 namespace rc::ref {
@@ -60,6 +61,19 @@ class FragmentInterpolator {
     return glm::dvec3((r.num[0] + num_[0].ddx * dx) * inv, (r.num[1] + num_[1].ddx * dx) * inv,
                       (r.num[2] + num_[2].ddx * dx) * inv);
   }
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // inlined: no 32-byte vector crosses a call
+  // barycentricAt() at four pixels of the row (dx per lane): in each lane the same
+  // operations on the same operands, the quotient's choice as a per-lane select.
+  [[gnu::always_inline]] void barycentricAt4(const Row& r, Lane4 dx, Lane4 out[3]) const {
+    const Lane4 den = splat4(r.inv_w) + splat4(inv_w_.ddx) * dx;
+    const Mask4 row_quotient = (den == splat4(r.inv_w)) & (den != splat4(0.0));
+    const Lane4 inv = row_quotient ? splat4(r.w) : splat4(1.0) / den;
+    for (int k = 0; k < 3; ++k) out[k] = (splat4(r.num[k]) + splat4(num_[k].ddx) * dx) * inv;
+  }
+
+#pragma GCC diagnostic pop
 
   // Moves the depth plane by (ox, oy) px: depth at (x, y) is then the plane's value at
   // (x + ox, y + oy) (multisampling: depth at the sample, attributes at the centre).

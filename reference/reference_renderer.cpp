@@ -21,6 +21,7 @@
 #include "reference/interpolation.h"
 #include "reference/rasterizer.h"
 #include "reference/shading.h"
+#include "reference/shading_lanes.h"
 #include "reference/texture_sampling.h"
 #include "reference/uncertainty.h"
 #include "reference/vertex_stage.h"
@@ -241,8 +242,9 @@ class Renderer {
   void shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
                 const FragmentInterpolator& interp);
   template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
-  void fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
-                 const FragmentInterpolator& interp, Shade&& shade);
+  [[gnu::always_inline]] inline void fillSpans(const TriangleContext& t,
+                                               const TriangleCoverage& coverage,
+                                               const FragmentInterpolator& interp, Shade&& shade);
   template <DepthFormat kFormat>
   void shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
                       const FragmentInterpolator& interp);
@@ -390,11 +392,17 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
     if (scene_.state.shading == Shading::Gouraud) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];
   }
   if (scene_.state.shading != Shading::Flat) return;
-  // Flat: lit once, at the original triangle's centroid, with its face normal.
-  const FlatFace face = flatFace(t.v[0]->world, t.v[1]->world, t.v[2]->world);
-  t.centroid = face.centroid;
-  t.face_normal = face.normal;
-  t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
+  // Flat: lit once, at the original triangle's centroid, with its face normal. Without
+  // lights shadePrepared() returns the material's ambient term (and zero specular) for
+  // any point and normal, so those are needed only when tracing (traceTerms()).
+  if (t.shading->lights.empty() && trace_ == nullptr) {
+    t.flat = LitColor{t.shading->ambient, glm::dvec3(0.0)};
+  } else {
+    const FlatFace face = flatFace(t.v[0]->world, t.v[1]->world, t.v[2]->world);
+    t.centroid = face.centroid;
+    t.face_normal = face.normal;
+    t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
+  }
   t.constant = t.texture == nullptr && !t.pass->blend;
   if (t.constant) {
     const glm::dvec4 c = finalColor(t.flat, glm::dvec3(1.0), t.material->opacity);
@@ -678,6 +686,90 @@ inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool 
   for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
 }
 
+// Lane4 values stay inside shadePhongQuad() (everything it calls is inlined): -Wpsabi's
+// note on passing 32-byte vectors without AVX does not apply (for the rest of the file:
+// GCC also gives it at the end of the translation unit).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+// Untextured, unblended Phong fragments of one row, up to four: what PhongQuads shades.
+struct PhongQuad {
+  const FragmentInterpolator* interp = nullptr;
+  const PreparedShading* shading = nullptr;
+  glm::dvec3 world[3];   // the original vertices' world positions
+  glm::dvec3 normal[3];  // and normals
+  float* colors = nullptr;
+  bool rgba8 = false;
+  float alpha = 0.0f;  // the stored opacity
+  int count = 0;       // fragments pending
+  std::size_t index[4] = {0, 0, 0, 0};
+  double dx[4] = {0.0, 0.0, 0.0, 0.0};
+};
+
+// The colour of the quad's fragments: with b = barycentricAt(row, dx), the scalar form is
+// store(ambient_diffuse + specular of shadePrepared(shading, b.x * w0 + b.y * w1 + b.z *
+// w2, safeNormalize(b.x * n0 + b.y * n1 + b.z * n2))); here lane by lane the same
+// operations (shading_lanes.h). Compiled twice, for x86-64's baseline and for AVX2 (no
+// FMA), and picked at load time: the bits are the same either way, AVX2 only does four
+// lanes per instruction where SSE2 does two.
+__attribute__((target_clones("avx2", "default"))) void shadePhongQuad(
+    const PhongQuad& q, const FragmentInterpolator::Row& row) {
+  Lane4 dx = splat4(q.dx[0]);  // unused lanes repeat the first fragment
+  for (int lane = 1; lane < q.count; ++lane) dx[lane] = q.dx[lane];
+  Lane4 b[3];
+  q.interp->barycentricAt4(row, dx, b);
+  const Vec3x4 p = combine4(b[0], b[1], b[2], q.world[0], q.world[1], q.world[2]);
+  const Vec3x4 n =
+      safeNormalize4(combine4(b[0], b[1], b[2], q.normal[0], q.normal[1], q.normal[2]));
+  const LitColor4 lit = shadePrepared4(*q.shading, p, n);
+  const Vec3x4 c = lit.ambient_diffuse + lit.specular;
+  for (int lane = 0; lane < q.count; ++lane) {
+    float* out = q.colors + 4 * q.index[lane];
+    if (q.rgba8) {
+      out[0] = storeColor(c.x[lane], ColorFormat::RGBA8);
+      out[1] = storeColor(c.y[lane], ColorFormat::RGBA8);
+      out[2] = storeColor(c.z[lane], ColorFormat::RGBA8);
+    } else {
+      out[0] = static_cast<float>(c.x[lane]);
+      out[1] = static_cast<float>(c.y[lane]);
+      out[2] = static_cast<float>(c.z[lane]);
+    }
+    out[3] = q.alpha;
+  }
+}
+
+// The shade functor of fillSpans() for untextured, unblended Phong: fragments that passed
+// are collected and coloured four at a time, the rest at the end of each span (fillSpans()
+// calls flush()). Deferring a colour write past later fragments of the span changes
+// nothing: nothing in the loop reads colour, and a span's pixels are distinct.
+class PhongQuads {
+ public:
+  PhongQuads(const TriangleContext& t, const FragmentInterpolator& interp, float* colors,
+             bool rgba8, float alpha) {
+    q_.interp = &interp;
+    q_.shading = t.shading;
+    for (int k = 0; k < 3; ++k) {
+      q_.world[k] = t.v[k]->world;
+      q_.normal[k] = t.v[k]->normal;
+    }
+    q_.colors = colors;
+    q_.rgba8 = rgba8;
+    q_.alpha = alpha;
+  }
+  TexelNote operator()(std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+    q_.index[q_.count] = index;
+    q_.dx[q_.count] = dx;
+    if (++q_.count == 4) flush(row);
+    return TexelNote{};
+  }
+  void flush(const FragmentInterpolator::Row& row) {
+    if (q_.count != 0) shadePhongQuad(q_, row);
+    q_.count = 0;
+  }
+
+ private:
+  PhongQuad q_;
+};
+
 // The fragment loop: for every covered pixel centre, depth (from the unsnapped plane,
 // clamped, quantized), the depth test, the uncertainty bookkeeping, then depth, id and
 // colour writes. `shade(index, row, dx)` writes the colour of a fragment that passed.
@@ -729,6 +821,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       if constexpr (kGaps)
         gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain, note.reach);
     }
+    if constexpr (requires { shade.flush(row); }) shade.flush(row);
   });
 }
 
@@ -796,21 +889,9 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
         return TexelNote{};
       });
     } else {
-      const glm::dvec3 w0 = t.v[0]->world;
-      const glm::dvec3 w1 = t.v[1]->world;
-      const glm::dvec3 w2 = t.v[2]->world;
-      const glm::dvec3 n0 = t.v[0]->normal;
-      const glm::dvec3 n1 = t.v[1]->normal;
-      const glm::dvec3 n2 = t.v[2]->normal;
-      const PreparedShading& shading = *t.shading;
-      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
-        const glm::dvec3 b = interp.barycentricAt(row, dx);
-        const glm::dvec3 p = b.x * w0 + b.y * w1 + b.z * w2;
-        const glm::dvec3 n = safeNormalize(b.x * n0 + b.y * n1 + b.z * n2);
-        const LitColor lit = shadePrepared(shading, p, n);
-        store(index, lit.ambient_diffuse + lit.specular);
-        return TexelNote{};
-      });
+      // Phong: four fragments at a time (shadePhongQuad() has the scalar form).
+      PhongQuads quads(t, interp, colors, rgba8, alpha);
+      fill(quads);
     }
     return;
   }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "reference/fragment_ops.h"
 
@@ -38,6 +39,8 @@ bool cullCouldFlip(const WindowVertex* polygon, int count, double extra_px) {
 }
 
 namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // floor(x) without a libm call (SSE2 has no rounding instruction): truncation through
 // int64 is exact for |x| < 2^52 and is corrected downwards for negative fractions. Only
@@ -102,7 +105,27 @@ void lowerRow(float* row, int first, int last, double cy, const Point& a, const 
     const double qy = py - (a.y + t * dy);
     const double cur = row[px];
     const double limit = cur + reach;  // == cur without reach: the same test, bit for bit
-    if (qx * qx + qy * qy >= limit * limit * (1.0 + 0x1p-40)) continue;
+    const double sum = qx * qx + qy * qy;
+    if (sum >= limit * limit * (1.0 + 0x1p-40)) continue;
+    // What hypot would store, decided without calling it where an interval around it
+    // decides: for a normal sum, s = sqrt(sum) is within 2^-51 (relative) of |q| (two
+    // roundings in the sum, one in the root; an underflowed square is below 2^-74 of it)
+    // and hypot within an ulp (2^-52) of |q|, so hypot(q) lies in [s (1 - 2^-48), s (1 +
+    // 2^-48)] with room to spare. Subtracting reach, max and the float conversion are
+    // monotone, so when both ends give the same outcome (no change, or the same stored
+    // float) hypot's value gives it too. Otherwise (about 2^-24 of the visits, and NaN or
+    // extreme sums) hypot itself.
+    if (sum >= 0x1p-1000 && sum < kInfinity) {
+      const double root = std::sqrt(sum);
+      const double lo = root * (1.0 - 0x1p-48) - reach;
+      if (!(lo < cur)) continue;  // hypot(q) - reach >= lo >= cur: no change
+      const double hi = root * (1.0 + 0x1p-48) - reach;
+      const auto stored = static_cast<float>(std::max(lo, 0.0));
+      if (hi < cur && stored == static_cast<float>(std::max(hi, 0.0))) {
+        row[px] = stored;
+        continue;
+      }
+    }
     const double d = std::hypot(qx, qy) - reach;
     if (d < cur) row[px] = static_cast<float>(std::max(d, 0.0));
   }
