@@ -10,6 +10,7 @@
 #include "compare/compare.h"
 #include "compare/pair_tolerances.h"
 #include "debug/pixel_history.h"
+#include "fixtures/errors.h"
 #include "reference/reference_renderer.h"
 #include "tests/debug/debug_lib_scenes.h"
 
@@ -50,9 +51,8 @@ const Json& factorsOf(const Json& doc, int light) {
 }
 
 TEST(PixelHistory, BlinnPhongFactorsAreTheClosedForms) {
-  const Json doc = historyAt(factorScene(SpecularModel::BlinnPhong, Attenuation::Inverse,
-                                         Shading::Phong),
-                             1, 1);
+  const Json doc =
+      historyAt(factorScene(SpecularModel::BlinnPhong, Attenuation::Inverse, Shading::Phong), 1, 1);
   ASSERT_EQ(doc["fragments"].size(), 1u) << doc.dump(2);
   const Json& point = factorsOf(doc, 0);
   EXPECT_NEAR(point["distance"].get<double>(), 5.0, 1e-9);
@@ -97,8 +97,8 @@ TEST(PixelHistory, PhongFactorsAreTheClosedForms) {
 }
 
 TEST(PixelHistory, FlatShadingIsEvaluatedAtTheCentroidWithTheFaceNormal) {
-  const Json doc = historyAt(
-      factorScene(SpecularModel::BlinnPhong, Attenuation::None, Shading::Flat), 1, 1);
+  const Json doc =
+      historyAt(factorScene(SpecularModel::BlinnPhong, Attenuation::None, Shading::Flat), 1, 1);
   const Json& sh = doc["fragments"][0]["shading"];
   EXPECT_EQ(sh["evaluated_at"], "centroid");
   ASSERT_EQ(sh["points"].size(), 1u);
@@ -119,8 +119,8 @@ TEST(PixelHistory, FlatShadingIsEvaluatedAtTheCentroidWithTheFaceNormal) {
 }
 
 TEST(PixelHistory, GouraudFactorsAtEachVertexWeightedByTheBarycentrics) {
-  const Json doc = historyAt(
-      factorScene(SpecularModel::BlinnPhong, Attenuation::None, Shading::Gouraud), 1, 1);
+  const Json doc =
+      historyAt(factorScene(SpecularModel::BlinnPhong, Attenuation::None, Shading::Gouraud), 1, 1);
   const Json& sh = doc["fragments"][0]["shading"];
   EXPECT_EQ(sh["evaluated_at"], "vertices");
   ASSERT_EQ(sh["points"].size(), 3u);

@@ -22,7 +22,9 @@ Items range(std::uint32_t n) {
   return v;
 }
 
-bool contains(const Items& v, std::uint32_t x) { return std::find(v.begin(), v.end(), x) != v.end(); }
+bool contains(const Items& v, std::uint32_t x) {
+  return std::find(v.begin(), v.end(), x) != v.end();
+}
 
 TEST(Ddmin, FindsTheThreeElementsAFailureNeeds) {
   int calls = 0;
@@ -149,9 +151,9 @@ TEST(ReduceScene, NeedsOneTriangleOneLightAndAMinimumSize) {
           if (o.mesh.positions[t[1]] == glm::vec3(1, 1, 0) &&
               o.mesh.positions[t[2]] == glm::vec3(0, 1, 0))
             has_triangle = true;
-    const bool has_light = std::any_of(scene.lights.begin(), scene.lights.end(), [](const Light& l) {
-      return l.type == LightType::Directional;
-    });
+    const bool has_light =
+        std::any_of(scene.lights.begin(), scene.lights.end(),
+                    [](const Light& l) { return l.type == LightType::Directional; });
     return has_triangle && has_light && scene.width >= 16;
   };
   hooks.note = [&](const std::string& line) { notes.push_back(line); };
