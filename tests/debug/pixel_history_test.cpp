@@ -145,16 +145,33 @@ TEST(PixelHistory, GouraudFactorsAtEachVertexWeightedByTheBarycentrics) {
 }
 
 TEST(PixelHistory, ANonContributingLightStillShowsItsFactors) {
-  // A point light exactly at the shaded point: no direction, contributes nothing.
+  // Gouraud lights the vertices: a point light exactly at vertex (-10, -10, 0) has no
+  // direction there and contributes nothing at that vertex only.
   Scene s = litWindow();
+  s.state.shading = Shading::Gouraud;
   addBigQuad(s, 0.0f, "quad");
-  s.lights = {pointLight({0.0, 0.0, 0.0})};
-  const Json doc = historyAt(s, 1, 1);
+  s.lights = {pointLight({-10.0, -10.0, 0.0})};
+  Json doc = historyAt(s, 1, 1);
+  const Json& factors = doc["fragments"][0]["shading"]["lights"][0]["factors"];
+  ASSERT_EQ(factors.size(), 3u);
+  EXPECT_FALSE(factors[0]["contributes"].get<bool>());
+  EXPECT_EQ(factors[0]["distance"].get<double>(), 0.0);
+  EXPECT_EQ(factors[0]["attenuation"].get<double>(), 1.0);
+  EXPECT_EQ(factors[0]["n_dot_l"].get<double>(), 0.0);  // l = 0 there
+  EXPECT_TRUE(factors[1]["contributes"].get<bool>());
+  EXPECT_EQ(doc["fragments"][0]["shading"]["points"][0]["specular"], Json::array({0.0, 0.0, 0.0}));
+
+  // A zero normal lights nothing at all, whatever the factors say.
+  Scene z = litWindow();
+  addBigQuad(z, 0.0f, "quad");
+  z.objects[0].mesh.normals.assign(4, glm::vec3(0.0f));
+  z.lights = {directionalLight({0.0, 0.0, -1.0})};
+  doc = historyAt(z, 1, 1);
   const Json& f = factorsOf(doc, 0);
   EXPECT_FALSE(f["contributes"].get<bool>());
-  EXPECT_NEAR(f["distance"].get<double>(), 0.0, 1e-9);
-  const Json& light = doc["fragments"][0]["shading"]["lights"][0];
-  EXPECT_EQ(light["diffuse"], Json::array({0.0, 0.0, 0.0}));
+  EXPECT_EQ(f["n_dot_l"].get<double>(), 0.0);
+  EXPECT_EQ(doc["fragments"][0]["shading"]["lights"][0]["diffuse"], Json::array({0.0, 0.0, 0.0}));
+  EXPECT_EQ(doc["fragments"][0]["shading"]["lights"][0]["specular"], Json::array({0.0, 0.0, 0.0}));
 }
 
 TEST(PixelHistory, TwoQuadsInDrawOrderWithTheirDepthTests) {
