@@ -42,10 +42,7 @@ int listCommand(const ListArgs& args);
 
 namespace rc {
 
-// `--tolerance CLASS.KEY=VALUE` as typed on the command line, e.g. "depth.fail=8",
-// "shading.warn=1.5", "visibility.fail=20", "depth.slope_factor=2", "shading.relative=0.001".
-struct CommandLineTolerances;
-void parseToleranceArgs(const std::vector<std::string>& args, CommandLineTolerances& out);
+// `--tolerance CLASS.KEY=VALUE` arguments are parsed by compare/pair_tolerances.h.
 
 struct CompareArgs {
   std::filesystem::path expected;

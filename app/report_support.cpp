@@ -25,31 +25,6 @@ Expectations expectationsFromArgument(const std::string& arg) {
 }
 namespace fs = std::filesystem;
 
-ToleranceOverrides fixtureTolerance(const Frame& expected, const Frame& actual) {
-  for (const Frame* f : {&expected, &actual}) {
-    const auto it = f->meta.find("tolerance");
-    if (it == f->meta.end()) continue;
-    const std::string backend = f->meta.contains("backend") && f->meta["backend"].is_string()
-                                    ? f->meta["backend"].get<std::string>()
-                                    : std::string(f == &expected ? "expected" : "actual");
-    return toleranceFromJson(*it, fmt::format("frame.json of {}", backend));
-  }
-  // Frames written before frame.json recorded the block: read the fixture itself.
-  if (expected.meta.contains("fixture_file") && expected.meta["fixture_file"].is_string()) {
-    const fs::path fixture = expected.meta["fixture_file"].get<std::string>();
-    if (fs::exists(fixture)) return loadScene(fixture).tolerance;
-  }
-  return {};
-}
-
-Tolerances pairTolerances(const Frame& expected, const Frame& actual,
-                          const ToleranceOverrides& fixture, const CommandLineTolerances& cli) {
-  Tolerances tol = tolerancesForFrames(expected, actual);
-  applyOverrides(tol, fixture);
-  applyOverrides(tol, cli);
-  return tol;
-}
-
 fs::path readyPicture(const fs::path& frame_dir, const Frame& frame) {
   const auto it = frame.meta.find("color_digest");
   if (it == frame.meta.end() || !it->is_string() || it->get<std::string>() != colorDigest(frame))

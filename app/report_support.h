@@ -13,6 +13,7 @@
 #include "compare/compare.h"
 #include "compare/expectations.h"
 #include "compare/pair_images.h"
+#include "compare/pair_tolerances.h"
 #include "compare/report.h"
 #include "compare/tolerances.h"
 #include "fixtures/frame.h"
@@ -26,16 +27,6 @@ namespace rc {
 // or empty for defaultExpectationsFile() when it exists. `campaign` re-applies the same
 // file to its runs' reports. Throws InputError for a file that cannot be read or is invalid.
 Expectations expectationsFromArgument(const std::string& arg);
-
-// The fixture's own tolerance block for a pair: frame.json "tolerance" (recorded by
-// `render`; the expected side's, else the actual side's), else the fixture file named by
-// frame.json "fixture_file" when it still exists, else none. Throws InputError for a
-// malformed block.
-ToleranceOverrides fixtureTolerance(const Frame& expected, const Frame& actual);
-
-// Tolerances of a pair: the formats' defaults, then `fixture`, then the command line.
-Tolerances pairTolerances(const Frame& expected, const Frame& actual,
-                          const ToleranceOverrides& fixture, const CommandLineTolerances& cli);
 
 class ReportFolder;
 

@@ -1,5 +1,5 @@
-// See variants.h (orchestration only; the probes and their analysis are in
-// compare/variants.cpp).
+// See variants.h (orchestration only: files and worker renders; the probes, their
+// analysis and the reference renders they are matched against are in debug/variants.cpp).
 #include "app/variants.h"
 
 #include <algorithm>
@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "app/backends.h"
-#include "compare/variants.h"
+#include "debug/variants.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
@@ -60,18 +60,10 @@ nlohmann::json analyseVariants(const VariantProbes& probes,
   if (probes.gl_specs.empty()) return out;
   const auto start = std::chrono::steady_clock::now();
   // ref:subpixel=N for every candidate N, once for all backends.
-  std::map<int, Frame> reference;
-  const Scene subpixel_scene = loadScene(probes.files.at("subpixel"));
-  for (int n = variants::kMinCandidateBits; n <= variants::kMaxCandidateBits; ++n) {
-    ReferenceOptions options;
-    options.subpixel_bits = n;
-    options.uncertainty = false;
-    reference[n] = renderReference(subpixel_scene, options);
-  }
+  const std::map<int, Frame> reference =
+      variants::subpixelReferences(loadScene(probes.files.at("subpixel")));
   const double shared_seconds =
       seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const variants::TieBreakProbe tie = variants::tieBreakProbe();
-  const variants::DepthProbe depth = variants::depthProbe();
 
   for (const std::string& spec : probes.gl_specs) {
     std::map<std::string, const RenderOutcome*> got;
@@ -91,31 +83,8 @@ nlohmann::json analyseVariants(const VariantProbes& probes,
     try {
       const fs::path dir = probes.work_dir / fixtureSlug(spec);
       for (const auto& [name, outcome] : got) writeFrameDir(outcome->frame, dir / name);
-      const Frame& sub = got.at("subpixel")->frame;
-      if (sub.meta.contains("renderer")) v["renderer"] = sub.meta["renderer"];
-      if (sub.meta.contains("stack")) v["stack"] = sub.meta["stack"];
-      auto key = [&](const char* name) {
-        return sub.meta.contains(name) ? sub.meta[name] : nlohmann::json(nullptr);
-      };
-      // GL's answer; older frames carried it as subpixel_bits only.
-      v["subpixel_bits"] =
-          sub.meta.contains("gl_subpixel_bits") ? key("gl_subpixel_bits") : key("subpixel_bits");
-      v["band_subpixel_bits"] = key("subpixel_bits");
-      const variants::SubpixelResult subpixel = variants::analyseSubpixel(sub, reference);
-      v["subpixel"] = variants::toJson(subpixel);
-      v["findings"] = nlohmann::json::array();
-      if (!subpixel.finding.empty()) v["findings"].push_back("subpixel: " + subpixel.finding);
-      // A band finer than the driver's snapping would call legal edge pixels hard; a
-      // coarser one (softpipe's 4 bits over its float edges) only excuses more.
-      if (subpixel.band >= 0 && subpixel.best >= 0 && !subpixel.band_confirmed &&
-          subpixel.best < subpixel.band)
-        v["findings"].push_back(fmt::format(
-            "subpixel: the driver snaps to {} bits, coarser than the {} bits its frames carry "
-            "for the snap band: legal edge pixels may be reported hard",
-            subpixel.best, subpixel.band));
-      v["tie_break"] = variants::toJson(variants::analyseTieBreak(tie, got.at("tie_break")->frame));
-      v["depth_rounding"] =
-          variants::toJson(variants::analyseDepthRounding(depth, got.at("depth_rounding")->frame));
+      v = variants::backendVariants(got.at("subpixel")->frame, got.at("tie_break")->frame,
+                                    got.at("depth_rounding")->frame, reference);
       v["probe_seconds"] = shared_seconds;
     } catch (const InputError& e) {
       v = {{"error", e.what()}};

@@ -1,4 +1,4 @@
-// Variant detection for `run`: the probes of compare/variants.h rendered with every GL
+// Variant detection for `run`: the probes of debug/variants.h rendered with every GL
 // backend (by the run's workers, app/worker_pool.h) and the subpixel probe with the
 // reference at every candidate precision (in this process), then analysed. Done once
 // per backend per run; the probe fixtures and frames stay under the run's output folder
@@ -32,7 +32,7 @@ VariantProbes prepareVariantProbes(const std::vector<std::string>& specs,
 // Returns {"SPEC": {...}} for every probed spec: "renderer", "stack" (frame.json's one-line
 // driver stack), "subpixel_bits" (GL_SUBPIXEL_BITS as the driver answers it),
 // "band_subpixel_bits" (what the backend's frames carry for the comparator's snap band),
-// "subpixel", "tie_break", "depth_rounding" (see compare/variants.h toJson), "findings"
+// "subpixel", "tie_break", "depth_rounding" (see debug/variants.h toJson), "findings"
 // (sentences: where the driver's answer and its rasterization disagree) and
 // "probe_seconds"; or "error" when a probe render failed. `outcomes` are those of
 // probes.requests, in order; `seconds` is the time the probes took. Writes

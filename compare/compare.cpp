@@ -741,16 +741,17 @@ class Comparator {
     DepthStats& d = r_.depth;
     const double slope = depthSlope(i);  // NaN excuses nothing
     const double allow = depthAllowance(i, slope);
-    if (maps_) maps_->depth_tolerance[i] = static_cast<float>(tol_.depth.warn + allow);
+    const Thresholds at = tol_.depth.raisedBy(allow);
+    if (maps_) maps_->depth_tolerance[i] = static_cast<float>(at.warn);
     d.max_slope = std::max(d.max_slope, slope);
-    const double excess = dz - (tol_.depth.warn + allow);
+    const double excess = dz - at.warn;
     if (excess <= 0.0) return;
     if (blendUncertain(i)) {
       ++d.blend_uncertain;
       return;
     }
     ++d.over_tolerance;
-    if (dz > tol_.depth.fail + allow) ++d.over_fail;
+    if (at.verdict(dz) == Status::Fail) ++d.over_fail;  // dz is finite here
     depth_worst_.offer(excess, i, dz, allow);
   }
 
@@ -828,9 +829,12 @@ class Comparator {
       // The threshold the pixel's largest channel error is held to: exceeding it by k is
       // exceeding warn by k in the deciding channel (the channels' allowances differ).
       const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
-      maps_->shading_tolerance[i] = static_cast<float>(warn + (e - s.excess));
+      maps_->shading_tolerance[i] = static_cast<float>(tol_.shading.raisedBy(e - s.excess).warn);
     }
-    if (s.excess <= warn) {
+    // The excess is already net of the channel's allowance: the base thresholds judge it
+    // (never NaN: a NaN channel excess is never the largest).
+    const Status verdict = tol_.shading.verdict(s.excess);
+    if (verdict == Status::Pass) {
       if (s.excess_without_texel > warn) ++r_.shading.texel_choice;
       return;
     }
@@ -839,7 +843,7 @@ class Comparator {
       return;
     }
     ++r_.shading.over_tolerance;
-    if (s.excess > tol_.shading.fail) ++r_.shading.over_fail;
+    if (verdict == Status::Fail) ++r_.shading.over_fail;
     shade_worst_.offer(s.excess, i, d[s.channel], s.allowance);
   }
 
@@ -1000,26 +1004,21 @@ class Comparator {
 
 }  // namespace
 
-const char* toString(PixelClass c) {
-  switch (c) {
-    case PixelClass::Background:
-      return "background";
-    case PixelClass::Match:
-      return "match";
-    case PixelClass::MissingAmbiguous:
-      return "missing (ambiguous)";
-    case PixelClass::MissingHard:
-      return "missing";
-    case PixelClass::ExtraAmbiguous:
-      return "extra (ambiguous)";
-    case PixelClass::ExtraHard:
-      return "extra";
-    case PixelClass::WrongAmbiguous:
-      return "wrong_primitive (ambiguous)";
-    case PixelClass::WrongHard:
-      return "wrong_primitive";
-  }
-  return "?";
+namespace {
+Thresholds heldTo(const Thresholds& base, const std::vector<float>& recorded, std::size_t i) {
+  // The map holds the raised warn only where the error exceeded the base warn (0
+  // elsewhere); within it the pixel passes whatever its allowance, and the base applies.
+  const double warn_at = std::max<double>(recorded[i], base.warn);
+  return base.raisedBy(warn_at - base.warn);
+}
+}  // namespace
+
+Thresholds depthThresholdsAt(const ClassMaps& maps, std::size_t i, const Tolerances& tolerances) {
+  return heldTo(tolerances.depth, maps.depth_tolerance, i);
+}
+
+Thresholds shadingThresholdsAt(const ClassMaps& maps, std::size_t i, const Tolerances& tolerances) {
+  return heldTo(tolerances.shading, maps.shading_tolerance, i);
 }
 
 std::uint64_t NonFiniteCounts::total() const {

@@ -17,25 +17,11 @@
 #include "compare/flip.h"
 #include "compare/histogram.h"
 #include "compare/oit.h"
+#include "compare/pixel_class.h"
 #include "compare/tolerances.h"
 #include "fixtures/frame.h"
 
 namespace rc {
-
-// Per-pixel visibility class (a = expected id, b = actual id). The codes are stored in
-// ClassMaps and in diff.exr's id_class channel.
-enum class PixelClass : std::uint8_t {
-  Background = 0,        // a = b = 0
-  Match = 1,             // a = b != 0: depth and shading are compared here
-  MissingAmbiguous = 2,  // a != 0, b = 0, within the band
-  MissingHard = 3,
-  ExtraAmbiguous = 4,  // a = 0, b != 0
-  ExtraHard = 5,
-  WrongAmbiguous = 6,  // a, b != 0, a != b: within the band or a depth tie
-  WrongHard = 7,
-};
-inline constexpr int kPixelClassCount = 8;
-const char* toString(PixelClass c);
 
 // A pixel in image coordinates (origin top-left, y down); x = -1 when there is none.
 // Reports add the GL window coordinate [x, height - 1 - y].
@@ -209,6 +195,13 @@ struct ClassMaps {
   // more than the rest of the comparison, so it is opt-in (a threshold also asks for it).
   bool want_flip = false;
 };
+
+// The thresholds compared pixel i (class Match) was held to by the comparison that filled
+// `maps` with `tolerances`: the class's warn and fail raised by the pixel's allowance
+// (Thresholds::raisedBy). verdict() of them on maps.depth_steps[i] / shading_abs[i] is the
+// pixel's verdict.
+Thresholds depthThresholdsAt(const ClassMaps& maps, std::size_t i, const Tolerances& tolerances);
+Thresholds shadingThresholdsAt(const ClassMaps& maps, std::size_t i, const Tolerances& tolerances);
 
 // Compares `actual` with `expected`. `uncertainty` is the reference frame whose
 // edge_dist/depth_gap and Z classify the pair: usually `expected` itself (pass the same

@@ -228,27 +228,7 @@ std::string colorDigest(const Frame& frame) {
   return fmt::format("{:016x}", h);
 }
 
-Rgb8 classColor(PixelClass c) {
-  switch (c) {
-    case PixelClass::Background:
-      return {0, 0, 0};
-    case PixelClass::Match:
-      return {96, 96, 96};
-    case PixelClass::MissingAmbiguous:
-      return {255, 170, 170};
-    case PixelClass::MissingHard:
-      return {230, 20, 20};
-    case PixelClass::ExtraAmbiguous:
-      return {160, 200, 255};
-    case PixelClass::ExtraHard:
-      return {30, 110, 255};
-    case PixelClass::WrongAmbiguous:
-      return {255, 240, 150};
-    case PixelClass::WrongHard:
-      return {255, 200, 0};
-  }
-  return {255, 0, 255};
-}
+Rgb8 classColor(PixelClass c) { return pixelClassInfo(c).color; }
 
 float heatPosition(float value, double scale) {
   if (!(value > 0.0f)) return 0.0f;  // zero and NaN

@@ -22,10 +22,15 @@ const char* toString(Status status);
 Status worse(Status a, Status b);
 
 // A measure above `warn` warns, above `fail` fails; equal to a threshold still passes.
+// The per-pixel verdict of depth and shading is verdict() of the class's thresholds raised
+// by the pixel's allowance (raisedBy); the comparator and `explain` both use these two.
 struct Thresholds {
   double warn = 0.0;
   double fail = 0.0;
-  Status verdict(double measure) const;
+  Status verdict(double measure) const;  // NaN fails
+  // Both thresholds moved up by `allowance` (a pixel's slope, texture, blend allowance):
+  // warn_at = warn + allowance, fail_at = fail + allowance = fail + (warn_at - warn).
+  Thresholds raisedBy(double allowance) const { return {warn + allowance, fail + allowance}; }
 };
 
 struct Tolerances {

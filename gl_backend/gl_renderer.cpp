@@ -125,7 +125,7 @@ struct Program {
   GLuint id = 0;
   int max_lights = 0;
   GLint view_projection = -1, shading = -1, eye = -1, ambient_light = -1, light_count = -1;
-  GLint light_directional = -1, light_position = -1, light_direction = -1, light_color = -1;
+  GLint light_type = -1, light_position = -1, light_direction = -1, light_color = -1;
   GLint light_intensity = -1, specular_model = -1, attenuation = -1;
   GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
   GLint opacity = -1, has_texture = -1, texture = -1;
@@ -477,7 +477,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   p.eye = loc("u_eye");
   p.ambient_light = loc("u_ambient_light");
   p.light_count = loc("u_light_count");
-  p.light_directional = loc("u_light_directional");
+  p.light_type = loc("u_light_type");
   p.light_position = loc("u_light_position");
   p.light_direction = loc("u_light_direction");
   p.light_color = loc("u_light_color");
@@ -692,15 +692,9 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
   gl.UseProgram(p.id);
   gl.UniformMatrix4fv(p.view_projection, 1, GL_FALSE, glm::value_ptr(view_projection));
   const RenderState& st = scene.state;
-  gl.Uniform1i(p.shading, st.shading == Shading::Flat      ? gl::kShadingFlat
-                          : st.shading == Shading::Gouraud ? gl::kShadingGouraud
-                                                           : gl::kShadingPhong);
-  gl.Uniform1i(p.specular_model, st.specular_model == SpecularModel::BlinnPhong
-                                     ? gl::kSpecularBlinnPhong
-                                     : gl::kSpecularPhong);
-  gl.Uniform1i(p.attenuation, st.attenuation == Attenuation::Inverse         ? gl::kAttInverse
-                              : st.attenuation == Attenuation::InverseSquare ? gl::kAttInverseSquare
-                                                                             : gl::kAttNone);
+  gl.Uniform1i(p.shading, gl::uniformValue(st.shading));
+  gl.Uniform1i(p.specular_model, gl::uniformValue(st.specular_model));
+  gl.Uniform1i(p.attenuation, gl::uniformValue(st.attenuation));
   gl.Uniform3fv(p.eye, 1, glm::value_ptr(toFloat(scene.camera.eye)));
   gl.Uniform3fv(p.ambient_light, 1, glm::value_ptr(toFloat(scene.ambient_light)));
   const auto count = static_cast<GLsizei>(scene.lights.size());
@@ -718,17 +712,17 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
     gl.Uniform1f(p.fault_depth_bias, static_cast<GLfloat>(faults.depth_bias_steps * step));
   }
   if (count == 0) return;
-  std::vector<GLint> directional;
+  std::vector<GLint> type;
   std::vector<glm::vec3> position, direction, color;
   std::vector<GLfloat> intensity;
   for (const Light& l : scene.lights) {
-    directional.push_back(l.type == LightType::Directional ? 1 : 0);
+    type.push_back(gl::uniformValue(l.type));
     position.push_back(toFloat(l.position));
     direction.push_back(toFloat(l.direction));
     color.push_back(toFloat(l.color));
     intensity.push_back(static_cast<GLfloat>(l.intensity * faults.light_scale));
   }
-  gl.Uniform1iv(p.light_directional, count, directional.data());
+  gl.Uniform1iv(p.light_type, count, type.data());
   gl.Uniform3fv(p.light_position, count, glm::value_ptr(position[0]));
   gl.Uniform3fv(p.light_direction, count, glm::value_ptr(direction[0]));
   gl.Uniform3fv(p.light_color, count, glm::value_ptr(color[0]));

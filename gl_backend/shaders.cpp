@@ -2,9 +2,39 @@
 // has a same-named counterpart in reference/shading.cpp.
 #include "gl_backend/shaders.h"
 
+#include <algorithm>
+#include <cctype>
+
 #include <fmt/format.h>
 
+#include "fixtures/scene.h"
+
 namespace rc::gl {
+
+const std::vector<GlslEnumDefine>& glslEnumDefines() {
+  static const std::vector<GlslEnumDefine> defines = [] {
+    std::vector<GlslEnumDefine> out;
+    // RC_<PREFIX>_<the fixture-file name of the value, upper case, '-' as '_'>.
+    auto add = [&](const char* prefix, const char* value_name, int value) {
+      std::string name = fmt::format("RC_{}_{}", prefix, value_name);
+      std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) {
+        return c == '-' ? '_' : static_cast<char>(std::toupper(c));
+      });
+      out.push_back({name, value});
+    };
+    for (Shading v : {Shading::Flat, Shading::Gouraud, Shading::Phong})
+      add("SHADING", toString(v), uniformValue(v));
+    for (SpecularModel v : {SpecularModel::Phong, SpecularModel::BlinnPhong})
+      add("SPECULAR", toString(v), uniformValue(v));
+    for (Attenuation v : {Attenuation::None, Attenuation::Inverse, Attenuation::InverseSquare})
+      add("ATTENUATION", toString(v), uniformValue(v));
+    add("LIGHT", "point", uniformValue(LightType::Point));
+    add("LIGHT", "directional", uniformValue(LightType::Directional));
+    return out;
+  }();
+  return defines;
+}
+
 namespace {
 
 constexpr const char* kHeader = R"(#version 330 core
@@ -17,13 +47,13 @@ constexpr const char* kLighting = R"(
 uniform vec3 u_eye;               // camera.eye: v points towards it
 uniform vec3 u_ambient_light;
 uniform int u_light_count;
-uniform int u_light_directional[RC_MAX_LIGHTS];  // 1: directional, 0: point
+uniform int u_light_type[RC_MAX_LIGHTS];         // RC_LIGHT_POINT or RC_LIGHT_DIRECTIONAL
 uniform vec3 u_light_position[RC_MAX_LIGHTS];    // point lights, world space
 uniform vec3 u_light_direction[RC_MAX_LIGHTS];   // directional: the direction light travels
 uniform vec3 u_light_color[RC_MAX_LIGHTS];
 uniform float u_light_intensity[RC_MAX_LIGHTS];
-uniform int u_specular_model;     // 0 phong, 1 blinn-phong
-uniform int u_attenuation;        // 0 none, 1 inverse (1/r), 2 inverse_square (1/r^2)
+uniform int u_specular_model;     // RC_SPECULAR_PHONG or RC_SPECULAR_BLINN_PHONG
+uniform int u_attenuation;        // RC_ATTENUATION_NONE, _INVERSE (1/r), _INVERSE_SQUARE (1/r^2)
 uniform vec3 u_material_ambient;
 uniform vec3 u_material_diffuse;
 uniform vec3 u_material_specular;
@@ -51,21 +81,21 @@ void shadePoint(vec3 p, vec3 n, out vec3 ambient_diffuse, out vec3 specular) {
   for (int i = 0; i < u_light_count; ++i) {
     vec3 l;
     float att = 1.0;
-    if (u_light_directional[i] != 0) {
+    if (u_light_type[i] == RC_LIGHT_DIRECTIONAL) {
       l = -safeNormalize(u_light_direction[i]);
     } else {
       vec3 to_light = u_light_position[i] - p;
       float r = length(to_light);
       if (!(r > 0.0)) continue;  // light at the shaded point: contributes nothing
       l = to_light / r;
-      if (u_attenuation == 1) att = 1.0 / r;
-      else if (u_attenuation == 2) att = 1.0 / (r * r);
+      if (u_attenuation == RC_ATTENUATION_INVERSE) att = 1.0 / r;
+      else if (u_attenuation == RC_ATTENUATION_INVERSE_SQUARE) att = 1.0 / (r * r);
     }
     vec3 L = u_light_color[i] * u_light_intensity[i] * att;
     float n_dot_l = dot(n, l);
     ambient_diffuse += u_material_diffuse * L * max(0.0, n_dot_l);
     float base;
-    if (u_specular_model == 1) {
+    if (u_specular_model == RC_SPECULAR_BLINN_PHONG) {
       vec3 h = safeNormalize(l + v);
       base = max(0.0, dot(n, h));
     } else {
@@ -86,7 +116,7 @@ layout(location = 4) in vec3 a_face_centroid;
 layout(location = 5) in vec3 a_face_normal;
 
 uniform mat4 u_view_projection;  // projection * view, composed in double on the CPU
-uniform int u_shading;           // 0 flat, 1 gouraud, 2 phong
+uniform int u_shading;           // RC_SHADING_FLAT, _GOURAUD or _PHONG
 #ifdef RC_FAULT_SHIFT_X
 uniform float u_fault_shift_ndc;  // test-only: 2 * PX / width
 #endif
@@ -116,10 +146,10 @@ void main() {
   v_gouraud_specular = vec3(0.0);
   v_flat_ambient_diffuse = vec3(0.0);
   v_flat_specular = vec3(0.0);
-  if (u_shading == 0) shadePoint(a_face_centroid, a_face_normal, v_flat_ambient_diffuse,
-                                 v_flat_specular);
-  if (u_shading == 1) shadePoint(a_world_position, a_world_normal, v_gouraud_ambient_diffuse,
-                                 v_gouraud_specular);
+  if (u_shading == RC_SHADING_FLAT)
+    shadePoint(a_face_centroid, a_face_normal, v_flat_ambient_diffuse, v_flat_specular);
+  if (u_shading == RC_SHADING_GOURAUD)
+    shadePoint(a_world_position, a_world_normal, v_gouraud_ambient_diffuse, v_gouraud_specular);
 }
 )";
 
@@ -157,10 +187,10 @@ void main() {
 #endif
   vec3 ambient_diffuse;
   vec3 specular;
-  if (u_shading == 0) {
+  if (u_shading == RC_SHADING_FLAT) {
     ambient_diffuse = v_flat_ambient_diffuse;
     specular = v_flat_specular;
-  } else if (u_shading == 1) {
+  } else if (u_shading == RC_SHADING_GOURAUD) {
     ambient_diffuse = v_gouraud_ambient_diffuse;
     specular = v_gouraud_specular;
   } else {
@@ -181,6 +211,8 @@ void main() {
 
 ProgramSource programSource(int max_lights, const ShaderFaults& faults) {
   std::string header = fmt::format(kHeader, max_lights);
+  for (const GlslEnumDefine& d : glslEnumDefines())
+    header += fmt::format("#define {} {}\n", d.name, d.value);
   if (faults.depth_bias) header += "#define RC_FAULT_DEPTH_BIAS\n";
   if (faults.shift_x) header += "#define RC_FAULT_SHIFT_X\n";
   if (faults.texel_offset) header += "#define RC_FAULT_TEXEL_OFFSET\n";

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace rc::gl {
 
@@ -17,10 +18,22 @@ enum AttributeLocation : unsigned {
   kAttribFaceNormal = 5,
 };
 
-// Values of the u_shading / u_specular_model / u_attenuation uniforms.
-enum ShadingUniform : int { kShadingFlat = 0, kShadingGouraud = 1, kShadingPhong = 2 };
-enum SpecularUniform : int { kSpecularPhong = 0, kSpecularBlinnPhong = 1 };
-enum AttenuationUniform : int { kAttNone = 0, kAttInverse = 1, kAttInverseSquare = 2 };
+// The u_shading, u_specular_model, u_attenuation and u_light_type uniforms carry the C++
+// enum's own value, and the GLSL compares them with #defines generated from those enums
+// (glslEnumDefines: RC_SHADING_FLAT, RC_SPECULAR_BLINN_PHONG, RC_ATTENUATION_INVERSE,
+// RC_LIGHT_DIRECTIONAL, ...), so the two languages cannot disagree about a value.
+template <class E>
+constexpr int uniformValue(E value) {
+  return static_cast<int>(value);
+}
+
+// One generated #define: its name and the C++ value it stands for.
+struct GlslEnumDefine {
+  std::string name;  // RC_<ENUM>_<VALUE NAME>
+  int value;
+};
+// Every enum value the shaders test, in the order of the enums' declarations.
+const std::vector<GlslEnumDefine>& glslEnumDefines();
 
 struct ProgramSource {
   std::string vertex;

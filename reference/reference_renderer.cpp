@@ -586,6 +586,7 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
     terms->texture = tex;
+    terms->uv = uv;
     terms->color = color;
   }
   return color;
@@ -656,6 +657,11 @@ void Renderer::traceTerms(const TriangleContext& t, const glm::dvec3& b,
   }
   ShadingTerms vt[3];
   for (int k = 0; k < 3; ++k) shadePrepared(*t.shading, t.v[k]->world, t.v[k]->normal, &vt[k]);
+  terms.points.clear();
+  for (int k = 0; k < 3; ++k) {
+    terms.points.push_back(std::move(vt[k].points.front()));
+    terms.points.back().weight = b[k];
+  }
   terms.ambient = b.x * vt[0].ambient + b.y * vt[1].ambient + b.z * vt[2].ambient;
   terms.lights.assign(vt[0].lights.size(), LightTerms{});
   for (std::size_t i = 0; i < terms.lights.size(); ++i) {

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -31,6 +32,31 @@ struct LightTerms {
   glm::dvec3 specular{0.0};
 };
 
+// The factors one light's terms were computed from at one shaded point, recorded by the
+// lighting code itself when it traces (ref::shadePrepared with a ShadingTerms): NaN
+// where a factor does not apply. A light that does not contribute (zero normal, a point
+// light at the shaded point) still gets the factors the formulas give.
+struct LightFactors {
+  double distance = std::numeric_limits<double>::quiet_NaN();  // point lights: r
+  double attenuation = 1.0;                                    // att
+  double n_dot_l = 0.0;
+  double n_dot_h = std::numeric_limits<double>::quiet_NaN();  // Blinn-Phong
+  double r_dot_v = std::numeric_limits<double>::quiet_NaN();  // Phong
+  double specular_power = 0.0;                                // max(0, n.h or r.v)^shininess
+  bool contributes = false;
+};
+
+// A point where the lighting model was evaluated for a fragment: the centroid (flat), each
+// vertex (Gouraud, weight = the fragment's barycentric) or the fragment itself (Phong).
+struct ShadedPoint {
+  double weight = 1.0;
+  glm::dvec3 position{0.0};  // world space
+  glm::dvec3 normal{0.0};    // unit or zero
+  glm::dvec3 ambient_diffuse{0.0};
+  glm::dvec3 specular{0.0};
+  std::vector<LightFactors> lights;  // one per scene light, in scene order
+};
+
 // Every term of one shaded colour, for `rastercheck explain` (see tracePixel()):
 // color.rgb == (ambient + sum(lights[i].diffuse)) * texture + sum(lights[i].specular)
 // (up to rounding when Gouraud interpolates the terms), color.a == opacity.
@@ -38,7 +64,9 @@ struct ShadingTerms {
   glm::dvec3 ambient{0.0};
   std::vector<LightTerms> lights;  // one per scene light, in scene order
   glm::dvec3 texture{1.0};         // texel rgb multiplying ambient and diffuse; 1 if untextured
+  glm::dvec2 uv{0.0};              // the interpolated texture coordinate (textured only)
   glm::dvec4 color{0.0};
+  std::vector<ShadedPoint> points;  // where the lighting was evaluated, with its factors
 };
 
 }  // namespace rc
@@ -125,44 +153,70 @@ struct PreparedShading {
 PreparedShading prepareShading(const Lighting& lighting, const Material& material);
 
 // Lights world point p with unit (or zero) normal n (DESIGN.md "Shading"; the formulas
-// are at the top of this file). When terms is non-null it also records every term.
+// are at the top of this file). When terms is non-null it also records every term, and
+// the point with every light's factors as terms->points = {this point} (the trace hook of
+// `explain`: the factors it prints are the very values computed here). Tracing changes no
+// result: a light that contributes nothing is still evaluated for its factors, then
+// skipped, as it is without tracing.
 [[gnu::always_inline]] inline LitColor shadePrepared(const PreparedShading& s, const glm::dvec3& p,
                                                      const glm::dvec3& n,
                                                      ShadingTerms* terms = nullptr) {
   LitColor out;
   out.ambient_diffuse = s.ambient;
+  ShadedPoint* point = nullptr;
   if (terms) {
     terms->ambient = s.ambient;
     terms->lights.assign(s.lights.size(), LightTerms{});
+    terms->points.assign(1, ShadedPoint{1.0, p, n, s.ambient, glm::dvec3(0.0), {}});
+    point = &terms->points.front();
+    point->lights.assign(s.lights.size(), LightFactors{});
   }
-  if (n == glm::dvec3(0.0)) return out;  // zero normal: no diffuse, no specular
+  const bool zero_normal = n == glm::dvec3(0.0);  // no diffuse, no specular
+  if (zero_normal && !point) return out;
 
   const glm::dvec3 v = safeNormalize(s.eye - p);
   for (std::size_t i = 0; i < s.lights.size(); ++i) {
     const PreparedLight& light = s.lights[i];
-    glm::dvec3 l;
+    glm::dvec3 l(0.0);
     double att = 1.0;
+    bool contributes = !zero_normal;
     if (light.directional) {
       l = light.l;
     } else {
       const glm::dvec3 to_light = light.position - p;
       const double r = std::sqrt(glm::dot(to_light, to_light));
-      if (!(r > 0.0)) continue;  // light at the shaded point: contributes nothing
-      const double inv_r = 1.0 / r;
-      l = to_light * inv_r;
-      if (s.attenuation == Attenuation::Inverse) att = inv_r;
-      if (s.attenuation == Attenuation::InverseSquare) att = 1.0 / (r * r);
+      if (point) point->lights[i].distance = r;
+      if (!(r > 0.0)) {  // light at the shaded point: contributes nothing
+        if (!point) continue;
+        contributes = false;
+      } else {
+        const double inv_r = 1.0 / r;
+        l = to_light * inv_r;
+        if (s.attenuation == Attenuation::Inverse) att = inv_r;
+        if (s.attenuation == Attenuation::InverseSquare) att = 1.0 / (r * r);
+      }
     }
     const double n_dot_l = glm::dot(n, l);
     double base = 0.0;
+    double specular_cosine = 0.0;  // n.h or r.v before max(0, .)
     if (s.blinn) {
       const glm::dvec3 h = safeNormalize(l + v);
-      base = std::max(0.0, glm::dot(n, h));
+      specular_cosine = glm::dot(n, h);
     } else {
       const glm::dvec3 r = 2.0 * n_dot_l * n - l;
-      base = std::max(0.0, glm::dot(r, v));
+      specular_cosine = glm::dot(r, v);
     }
+    base = std::max(0.0, specular_cosine);
     const double power = specularPower(base, s.shininess, s.exponent);
+    if (point) {
+      LightFactors& f = point->lights[i];
+      f.attenuation = att;
+      f.n_dot_l = n_dot_l;
+      (s.blinn ? f.n_dot_h : f.r_dot_v) = specular_cosine;
+      f.specular_power = power;
+      f.contributes = contributes;
+      if (!contributes) continue;
+    }
     glm::dvec3 diffuse;
     glm::dvec3 specular;
     if (light.attenuated) {
@@ -176,6 +230,10 @@ PreparedShading prepareShading(const Lighting& lighting, const Material& materia
     out.ambient_diffuse += diffuse;
     out.specular += specular;
     if (terms) terms->lights[i] = LightTerms{diffuse, specular};
+  }
+  if (point) {
+    point->ambient_diffuse = out.ambient_diffuse;
+    point->specular = out.specular;
   }
   return out;
 }

@@ -12,6 +12,7 @@
 
 #include "app/backends.h"
 #include "compare/pair_images.h"
+#include "compare/pair_tolerances.h"
 #include "compare/report.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
@@ -207,9 +208,7 @@ const SuiteExpectations& expectations() {
 }
 
 Tolerances tolerancesFor(const Scene& scene, const Frame& expected, const Frame& actual) {
-  Tolerances tol = tolerancesForFrames(expected, actual);
-  applyOverrides(tol, scene.tolerance);
-  return tol;
+  return pairTolerances(expected, actual, scene.tolerance);
 }
 
 fs::path writeArtifacts(const std::string& test_name, const Frame& expected, const Frame& actual,

@@ -84,7 +84,8 @@ std::filesystem::path writeArtifacts(const std::string& test_name, const Frame& 
                                      const Frame& actual, const Frame& uncertainty,
                                      PairResult& result);
 
-// Tolerances for the pair: format defaults plus the fixture's overrides.
+// Tolerances for the pair: compare/pair_tolerances.h pairTolerances (format defaults, then
+// the fixture's overrides; the suite has no command line).
 Tolerances tolerancesFor(const Scene& scene, const Frame& expected, const Frame& actual);
 
 }  // namespace rc::conformance

@@ -287,26 +287,28 @@ TEST(DebugGl, ReduceWithAGlSideInThePredicate) {
 }
 
 // RASTERCHECK_GL_FAULT (test-only, in the GL backend): drop_primitive=ID makes GL skip the
-// triangle with that primitive id. Skipped while the GL backend does not have it.
+// triangle with that primitive id.
 constexpr const char* kFault = "RASTERCHECK_GL_FAULT=drop_primitive=3";
 
-bool glFaultSupported(const fs::path& dir) {
+// The fault hook must be there and work: the injected frame says so in frame.json and
+// has lost primitive 3 (a build without the hook fails here instead of skipping).
+void expectFaultInjected(const fs::path& dir) {
   const Frame f = renderRef(catalog("coverage/triangle_fan.json"), dir / "probe", kLlvmpipe);
   const Result r = run("render " + catalog("coverage/triangle_fan.json") + " --backend " +
                            kLlvmpipe + " --out " + (dir / "faulty").string(),
                        kFault);
-  if (r.code != 0) return false;
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
   const Frame g = readFrameDir(dir / "faulty");
-  const bool had = std::count(f.id.begin(), f.id.end(), 3u) > 0;
-  return had && std::count(g.id.begin(), g.id.end(), 3u) == 0;
+  ASSERT_TRUE(g.meta.contains("fault_injected"))
+      << "the GL backend ignored " << kFault << " (no fault_injected in frame.json)";
+  EXPECT_EQ(g.meta["fault_injected"], "drop_primitive=3");
+  ASSERT_GT(std::count(f.id.begin(), f.id.end(), 3u), 0) << "the fixture has no primitive 3";
+  ASSERT_EQ(std::count(g.id.begin(), g.id.end(), 3u), 0) << "primitive 3 was not dropped";
 }
 
 TEST(DebugGl, ReduceAnInjectedGlFault) {
   const fs::path dir = scratch("reduce_fault");
-  if (!glFaultSupported(dir)) {
-    fs::remove_all(dir);
-    GTEST_SKIP() << "the GL backend does not implement RASTERCHECK_GL_FAULT yet";
-  }
+  ASSERT_NO_FATAL_FAILURE(expectFaultInjected(dir));
   const std::string fixture = catalog("coverage/triangle_fan.json");
   const fs::path out = dir / "min.json";
   const Result r =

@@ -1,4 +1,4 @@
-// Variant detection (compare/variants.h) without a GL driver: the reference stands in for
+// Variant detection (debug/variants.h) without a GL driver: the reference stands in for
 // a driver whose variant is known (it follows its own documented rules, and
 // ref:subpixel=N snaps to N bits), and injected faults (a frame edited to follow another
 // rule) must be told apart. The probes' analytic facts are checked independently.
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "compare/variants.h"
+#include "debug/variants.h"
 #include "fixtures/loader.h"
 #include "fixtures/scene_writer.h"
 #include "reference/reference_renderer.h"

@@ -1,8 +1,10 @@
 // Variant detection: which of the legal rasterization variants a GL driver follows.
 // Three small probe scenes with analytically known answers, and pure functions that read
 // a driver's frames of them (plus reference frames where the answer is "which reference
-// option reproduces it"). Rendering the probes is the caller's job (app/variants.cpp);
-// nothing here renders, spawns or touches files. docs/debugging.md explains the probes.
+// option reproduces it", rendered here: subpixelReferences). Rendering the probes with GL
+// is the caller's job (app/variants.cpp: files and worker processes); nothing here spawns
+// or touches files. docs/debugging.md explains the probes. (In debug/, not compare/: it
+// needs the reference renderer, and DESIGN.md puts the variant probes here.)
 //
 // Every probe uses an orthographic camera whose bounds are the image (world x, y =
 // GL window x, y) and dyadic coordinates, so that GL's float32 vertex pipeline and the
@@ -170,5 +172,19 @@ nlohmann::json toJson(const DepthRoundingResult& r);
 std::string describeSubpixel(const SubpixelResult& r);
 std::string describeTieBreak(const TieBreakResult& r);
 std::string describeDepthRounding(const DepthRoundingResult& r);
+
+// The reference's frames of the subpixel probe `scene` at every candidate precision
+// (kMinCandidateBits..kMaxCandidateBits), without uncertainty channels: what
+// analyseSubpixel matches a driver's frame against.
+std::map<int, Frame> subpixelReferences(const Scene& scene);
+
+// What one GL backend's frames of the three probes say, report.json's "variants.SPEC"
+// without "probe_seconds": "renderer", "stack" (from the subpixel frame's frame.json),
+// "subpixel_bits" (GL_SUBPIXEL_BITS as the driver answers it), "band_subpixel_bits" (what
+// its frames carry for the comparator's snap band), "subpixel", "tie_break",
+// "depth_rounding" (toJson above) and "findings" (sentences: where the driver's answer and
+// its rasterization disagree). Throws InputError for frames that do not fit the probes.
+nlohmann::json backendVariants(const Frame& subpixel, const Frame& tie_break,
+                               const Frame& depth_rounding, const std::map<int, Frame>& reference);
 
 }  // namespace rc::variants

@@ -1,17 +1,44 @@
-// Command-line tolerance overrides (`--tolerance depth.fail=8`), applied after the
-// fixture's own "tolerance" block.
+// The tolerance layers of a pair: see pair_tolerances.h.
+#include "compare/pair_tolerances.h"
+
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <optional>
-#include <string>
 
 #include <fmt/format.h>
 
-#include "app/commands.h"
-#include "compare/tolerances.h"
+#include "compare/compare.h"
 #include "fixtures/errors.h"
+#include "fixtures/loader.h"
 
 namespace rc {
+namespace fs = std::filesystem;
+
+ToleranceOverrides fixtureTolerance(const Frame& expected, const Frame& actual) {
+  for (const Frame* f : {&expected, &actual}) {
+    const auto it = f->meta.find("tolerance");
+    if (it == f->meta.end()) continue;
+    const std::string backend = f->meta.contains("backend") && f->meta["backend"].is_string()
+                                    ? f->meta["backend"].get<std::string>()
+                                    : std::string(f == &expected ? "expected" : "actual");
+    return toleranceFromJson(*it, fmt::format("frame.json of {}", backend));
+  }
+  // Frames written before frame.json recorded the block: read the fixture itself.
+  if (expected.meta.contains("fixture_file") && expected.meta["fixture_file"].is_string()) {
+    const fs::path fixture = expected.meta["fixture_file"].get<std::string>();
+    if (fs::exists(fixture)) return loadScene(fixture).tolerance;
+  }
+  return {};
+}
+
+Tolerances pairTolerances(const Frame& expected, const Frame& actual,
+                          const ToleranceOverrides& fixture, const CommandLineTolerances& cli) {
+  Tolerances tol = tolerancesForFrames(expected, actual);
+  applyOverrides(tol, fixture);
+  applyOverrides(tol, cli);
+  return tol;
+}
 
 void parseToleranceArgs(const std::vector<std::string>& args, CommandLineTolerances& out) {
   constexpr const char* kKeys =

@@ -1,5 +1,5 @@
 // Variant detection probes and their analysis: see variants.h and docs/debugging.md.
-#include "compare/variants.h"
+#include "debug/variants.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "fixtures/errors.h"
+#include "reference/reference_renderer.h"
 
 namespace rc::variants {
 namespace {
@@ -576,6 +577,46 @@ std::string describeDepthRounding(const DepthRoundingResult& r) {
   if (!r.uniform) s += "; depth varies inside a constant-depth square";
   if (r.uncovered) s += fmt::format("; {} probe pixels not drawn", r.uncovered);
   return s;
+}
+
+std::map<int, Frame> subpixelReferences(const Scene& scene) {
+  std::map<int, Frame> reference;
+  for (int n = kMinCandidateBits; n <= kMaxCandidateBits; ++n) {
+    ReferenceOptions options;
+    options.subpixel_bits = n;
+    options.uncertainty = false;
+    reference[n] = renderReference(scene, options);
+  }
+  return reference;
+}
+
+nlohmann::json backendVariants(const Frame& sub, const Frame& tie_break,
+                               const Frame& depth_rounding, const std::map<int, Frame>& reference) {
+  nlohmann::json v = nlohmann::json::object();
+  if (sub.meta.contains("renderer")) v["renderer"] = sub.meta["renderer"];
+  if (sub.meta.contains("stack")) v["stack"] = sub.meta["stack"];
+  auto key = [&](const char* name) {
+    return sub.meta.contains(name) ? sub.meta[name] : nlohmann::json(nullptr);
+  };
+  // GL's answer; older frames carried it as subpixel_bits only.
+  v["subpixel_bits"] =
+      sub.meta.contains("gl_subpixel_bits") ? key("gl_subpixel_bits") : key("subpixel_bits");
+  v["band_subpixel_bits"] = key("subpixel_bits");
+  const SubpixelResult subpixel = analyseSubpixel(sub, reference);
+  v["subpixel"] = toJson(subpixel);
+  v["findings"] = nlohmann::json::array();
+  if (!subpixel.finding.empty()) v["findings"].push_back("subpixel: " + subpixel.finding);
+  // A band finer than the driver's snapping would call legal edge pixels hard; a
+  // coarser one (softpipe's 4 bits over its float edges) only excuses more.
+  if (subpixel.band >= 0 && subpixel.best >= 0 && !subpixel.band_confirmed &&
+      subpixel.best < subpixel.band)
+    v["findings"].push_back(fmt::format(
+        "subpixel: the driver snaps to {} bits, coarser than the {} bits its frames carry "
+        "for the snap band: legal edge pixels may be reported hard",
+        subpixel.best, subpixel.band));
+  v["tie_break"] = toJson(analyseTieBreak(tieBreakProbe(), tie_break));
+  v["depth_rounding"] = toJson(analyseDepthRounding(depthProbe(), depth_rounding));
+  return v;
 }
 
 }  // namespace rc::variants
