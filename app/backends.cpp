@@ -85,7 +85,6 @@ Frame renderWith(const BackendSpec& backend, const Scene& scene) {
   m["height"] = scene.height;
   m["clear_depth"] = scene.clear_depth;
   // (The formats and texture facts are frame.drawn, set by the renderer.)
-  m["tolerance"] = toleranceJson(scene.tolerance);
   m["state"] = stateJson(scene.state);     // what expected failures are scoped by
   m["color_digest"] = colorDigest(frame);  // tells `compare` color.png shows this frame
   if (!m.contains("subpixel_bits")) m["subpixel_bits"] = backend.reference.subpixel_bits;

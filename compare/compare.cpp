@@ -16,6 +16,7 @@
 
 #include <fmt/format.h>
 
+#include "compare/pair_tolerances.h"
 #include "compare/slopes.h"
 #include "fixtures/big_buffer.h"
 #include "fixtures/errors.h"
@@ -1138,7 +1139,8 @@ Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual) {
 }
 
 PairResult compareFrames(const Frame& expected, const Frame& actual) {
-  return compareFrames(expected, actual, expected, tolerancesForFrames(expected, actual));
+  return compareFrames(expected, actual, expected,
+                       pairTolerances(expected, actual, fixtureTolerance(expected, actual)));
 }
 
 void checkSameSize(const Frame& expected, const Frame& actual,

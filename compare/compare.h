@@ -220,9 +220,9 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
 Tolerances tolerancesForFrames(const Frame& expected, const Frame& actual);
 
 // What `rastercheck compare` gives for two frames, e.g. compareFrames(renderReference(s),
-// renderGl(s, spec)): `expected` classifies, tolerances from tolerancesForFrames. A
-// fixture's "tolerance" block and command-line thresholds are further layers the caller
-// applies (applyOverrides) and the other overload takes.
+// renderGl(s, spec)): `expected` classifies; the tolerances are the formats' defaults and
+// then the fixture's "tolerance" block the frames carry (compare/pair_tolerances.h).
+// Command-line thresholds are the one layer left to the caller (the other overload).
 PairResult compareFrames(const Frame& expected, const Frame& actual);
 
 // Throws InputError naming both directories when the frames differ in size.

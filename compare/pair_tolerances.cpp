@@ -17,6 +17,7 @@ namespace fs = std::filesystem;
 
 ToleranceOverrides fixtureTolerance(const Frame& expected, const Frame& actual) {
   for (const Frame* f : {&expected, &actual}) {
+    if (f->drawn.tolerance) return *f->drawn.tolerance;  // set by the renderer in this process
     const auto it = f->meta.find("tolerance");
     if (it == f->meta.end()) continue;
     const std::string backend = f->meta.contains("backend") && f->meta["backend"].is_string()

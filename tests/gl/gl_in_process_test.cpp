@@ -53,6 +53,11 @@ TEST_F(GlInProcess, CompareFramesGivesTheVerdictOfTheCommandLine) {
   EXPECT_EQ(in_process.tolerances.depth_format, DepthFormat::D16);
   EXPECT_EQ(in_process.tolerances.color_format, ColorFormat::RGBA8);
   EXPECT_GT(in_process.tolerances.texture_weight_error, 0.0);  // the linear filtering allowance
+  // The fixture's own "tolerance" block travels with the frames (the second layer).
+  EXPECT_EQ(in_process.tolerances.shading.warn, 0.25);
+  EXPECT_EQ(in_process.tolerances.shading.fail, 3.0);
+  EXPECT_EQ(in_process.tolerances.depth.warn, 1.0);
+  EXPECT_EQ(in_process.tolerances.depth.fail, 4.0);
 
   const fs::path dir =
       fs::temp_directory_path() /
@@ -85,6 +90,11 @@ TEST_F(GlInProcess, CompareFramesGivesTheVerdictOfTheCommandLine) {
   ref_unsaid.drawn = {};
   gl_unsaid.drawn = {};
   EXPECT_NE(verdictOf(toJson(compareFrames(ref_unsaid, gl_unsaid), dir / "cmp")), cli);
+  // ... and without the fixture's block only the formats' defaults apply.
+  Frame ref_default = ref, gl_default = gl;
+  ref_default.drawn.tolerance.reset();
+  gl_default.drawn.tolerance.reset();
+  EXPECT_NE(compareFrames(ref_default, gl_default).tolerances.shading.warn, 0.25);
   fs::remove_all(dir);
 }
 
