@@ -324,13 +324,19 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
 // render starts from a fresh context's state, as it did when each render was a process
 // of its own. Reusing one context showed softpipe's results depend on the fixture drawn
 // before (rgba8 with blending: 5 of 120 random scenes; docs/gl_backend.md).
-void renewContext(Session& s) {
+// `abandon_old`: leave the old context allocated instead of destroying it (zink on Mesa 22
+// cannot take the destruction; see acquireSession).
+void renewContext(Session& s, bool abandon_old = false) {
   s.programs.clear();  // their objects go with the old context
   s.sample_program = 0;
   s.empty_vertex_array = 0;
   s.framebuffer = Framebuffer{};
   s.debug_errors.clear();
-  s.context->renew();
+  if (abandon_old) {
+    s.context->abandon();
+  } else {
+    s.context->renew();
+  }
   s.context->makeCurrent();
   s.gl.load(s.context->loader());
   enableDebugOutput(s);
@@ -391,16 +397,7 @@ Session& acquireSession(const GlSpec& spec) {
     // The last render threw halfway: its state is unknown, and destroying the context is
     // what zink on Mesa 22 cannot take, so it is left allocated (one per failed render).
     s.render_unfinished = false;
-    s.programs.clear();
-    s.sample_program = 0;
-    s.empty_vertex_array = 0;
-    s.framebuffer = Framebuffer{};
-    s.debug_errors.clear();
-    s.context->abandon();
-    s.context->makeCurrent();
-    s.gl.load(s.context->loader());
-    enableDebugOutput(s);
-    checkGl(s, "context creation");
+    renewContext(s, /*abandon_old=*/true);
   } else {
     resetReusedContext(s);
   }
