@@ -171,7 +171,9 @@ TEST(CampaignGl, ShortCampaignFindsGroupsAndReproducesEveryOne) {
     // A group an expectations entry covers reproduces as a known failure (run exits 0).
     const bool known = g["expectation"]["entry"].is_string();
     EXPECT_EQ(r.code, known ? 0 : 1) << command << "\n" << r.out;
-    if (known) EXPECT_NE(r.out.find("KNOWN FAIL"), std::string::npos) << r.out;
+    if (known) {
+      EXPECT_NE(r.out.find("KNOWN FAIL"), std::string::npos) << r.out;
+    }
     EXPECT_TRUE(failingClasses(out).contains(g["class"].get<std::string>())) << command;
     fs::remove_all(out);
     ++reproduced;

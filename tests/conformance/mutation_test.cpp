@@ -83,10 +83,11 @@ class MutationTest : public testing::Test {
     ASSERT_TRUE(mutant.frame) << backend_ << " failed on the mutant: " << mutant.error;
     // The test-only fault hook must have run: a backend that ignored the variable would
     // render the original and the self-test would prove nothing.
-    if (!m_.gl_fault.empty())
+    if (!m_.gl_fault.empty()) {
       ASSERT_TRUE(mutant.frame->meta.contains("fault_injected"))
           << backend_ << " ignored " << kFaultVariable << "=" << m_.gl_fault
           << " (no fault_injected in frame.json)";
+    }
     const Scene original = loadScene(m_.original);
     const Frame ref = renderReference(m_.original);
 
