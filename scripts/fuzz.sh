@@ -84,8 +84,9 @@ for t in "${targets[@]}"; do
   # A mesh finding is replayed the way rastercheck reads the file, through the importer
   # child (RC_FUZZ_MESH_THROUGH_CHILD): when that accepts it or refuses it in one safe line,
   # the problem was inside Assimp and the child contains it (a crash, an abort, an
-  # allocation over the child's limit); the input is kept in findings/mesh/contained/ and
-  # fuzzing goes on for the time left. Anything else is a finding.
+  # allocation over the child's limit); the input is kept in findings/mesh/contained/ (keep
+  # it in tests/fuzz/regressions/mesh-contained/, which FuzzRegressions replays through the
+  # child) and fuzzing goes on for the time left. Anything else is a finding.
   end=$((SECONDS + seconds))
   contained=0
   while :; do
@@ -104,7 +105,12 @@ for t in "${targets[@]}"; do
     if [[ $t == mesh && ${#found[@]} -gt 0 ]]; then
       real=0
       for f in "${found[@]}"; do
-        if RC_FUZZ_MESH_THROUGH_CHILD=1 "$build/tests/fuzz/fuzz_mesh" "$f" >>"$log" 2>&1; then
+        if [[ -e "$findings/contained/$(basename "$f")" ]]; then
+          # The same input again: a seed (tests/fuzz/regressions/mesh) that stops the
+          # in-process target; restarting would loop on it. Its place is mesh-contained/.
+          echo "fuzz_mesh: $(basename "$f") stopped the target twice; move it from the seeds to tests/fuzz/regressions/mesh-contained/" >&2
+          real=1
+        elif RC_FUZZ_MESH_THROUGH_CHILD=1 "$build/tests/fuzz/fuzz_mesh" "$f" >>"$log" 2>&1; then
           mkdir -p "$findings/contained"
           mv "$f" "$findings/contained/"
           contained=$((contained + 1))

@@ -47,6 +47,16 @@ TEST(FuzzRegressions, MeshInputs) {
   RecordProperty("inputs", n);
 }
 
+// Inputs on which the in-process fuzzer stopped inside Assimp (a crash, an allocation over
+// the importer's limit) and which the importer child turns into a one-line refusal
+// (scripts/fuzz.sh keeps them in build/fuzz/findings/mesh/contained/). Replayed through the
+// child, never used as fuzzing seeds: they would stop the in-process target at once.
+TEST(FuzzRegressions, MeshInputsTheChildContains) {
+  const int n = replay("mesh-contained", rc::fuzz::importMeshBytes);
+  EXPECT_GE(n, 2);
+  RecordProperty("inputs", n);
+}
+
 TEST(FuzzRegressions, TextureInputs) {
   const int n = replay("texture", rc::fuzz::decodeTextureBytes);
   RecordProperty("inputs", n);
