@@ -1116,6 +1116,10 @@ void injectStall(const gl::testing::Faults& faults, const std::string& fixture) 
     std::raise(SIGSEGV);
   }
   if (faults.hangs(fixture)) {
+    // Said in the render's own output: a `run` worker keeps what it printed during the
+    // render it was killed in, and the once-per-process fault warning may belong to an
+    // earlier render of the same worker.
+    std::fprintf(stderr, "rastercheck: test fault: the draw of %s hangs\n", fixture.c_str());
     std::fflush(nullptr);
     for (;;) ::pause();
   }
