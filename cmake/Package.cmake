@@ -29,6 +29,7 @@ install(FILES ${PROJECT_BINARY_DIR}/package/rastercheckConfig.cmake
 # (app/launcher.cpp and app/paths.cpp find them, and the catalog, relative to themselves).
 install(TARGETS rastercheck RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(TARGETS rastercheck-core rastercheck-mesh-import RUNTIME DESTINATION ${RC_INSTALL_HELPERDIR})
+install(TARGETS rastercheck-image-io LIBRARY DESTINATION ${RC_INSTALL_HELPERDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/fixtures/scenes DESTINATION ${RC_INSTALL_DATADIR}/fixtures)
 install(FILES ${PROJECT_SOURCE_DIR}/fixtures/expectations.json ${PROJECT_SOURCE_DIR}/fixtures/README.md
         DESTINATION ${RC_INSTALL_DATADIR}/fixtures)

@@ -12,12 +12,11 @@
 #include <numeric>
 #include <thread>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <fmt/format.h>
 
 #include "compare/cube_root.h"
 #include "fixtures/errors.h"
+#include "fixtures/image_io.h"
 
 namespace rc {
 namespace {
@@ -505,10 +504,7 @@ std::vector<std::uint8_t> flipHeatRgb(const std::vector<float>& error) {
     constexpr int kCount = 256;
     std::vector<float> ramp(kCount);
     for (int i = 0; i < kCount; ++i) ramp[i] = static_cast<float>(i) / (kCount - 1);
-    OIIO::ImageBuf src(OIIO::ImageSpec(kCount, 1, 1, OIIO::TypeDesc::FLOAT), ramp.data());
-    OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, kFlipColorMap);
-    std::vector<float> rgb(std::size_t{3} * kCount, 0.0f);
-    mapped.get_pixels(mapped.roi(), OIIO::TypeDesc::FLOAT, rgb.data());
+    const std::vector<float> rgb = image_io::functions().color_map(ramp, kFlipColorMap);
     std::vector<std::uint8_t> out(std::size_t{3} * kCount);
     for (int i = 0; i < 3 * kCount; ++i)
       out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i], 0.0f, 1.0f) * 255.0f));

@@ -10,22 +10,19 @@
 #include <future>
 #include <string>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "compare/atomic_file.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
+#include "fixtures/image_io.h"
 
 namespace rc {
 namespace fs = std::filesystem;
 namespace {
 
-using OIIO::ImageBuf;
-using OIIO::ImageSpec;
-using OIIO::TypeDesc;
+using image_io::ImageFormat;
+using image_io::PixelType;
 
 // PNGs for people: fast deflate (level 1) and one cheap row filter (SUB) write a 1080p
 // image several times faster than the defaults for files ~1.5x larger; these images are
@@ -47,22 +44,15 @@ bool storePng(int w, int h) {
   return static_cast<std::size_t>(w) * static_cast<std::size_t>(h) > kPngStoreAbove;
 }
 
-void writeImage(const fs::path& file, ImageSpec spec, const TypeDesc& format, const void* data,
-                const fs::path& target) {
-  if (file.extension() == ".png") {
-    const bool store = storePng(spec.width, spec.height);
-    spec.attribute("png:compressionLevel", store ? 0 : kPngCompressionLevel);
-    spec.attribute("png:filter", store ? kPngFilterNone : kPngFilterSub);
-  }
-  auto out = OIIO::ImageOutput::create(file.string());
-  if (!out || !out->open(file.string(), spec) || !out->write_image(format, data) || !out->close())
-    throw InputError(fmt::format("{}: cannot write: {}", target.string(),
-                                 out ? out->geterror() : OIIO::geterror()));
-}
-
 void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_t>& rgb,
                const fs::path& target) {
-  writeImage(file, ImageSpec(w, h, 3, TypeDesc::UINT8), TypeDesc::UINT8, rgb.data(), target);
+  ImageFormat format{.width = w, .height = h, .channels = 3, .type = PixelType::UInt8};
+  const bool store = storePng(w, h);
+  if (file.extension() == ".png") {
+    format.numbers = {{"png:compressionLevel", store ? 0 : kPngCompressionLevel},
+                      {"png:filter", store ? kPngFilterNone : kPngFilterSub}};
+  }
+  image_io::writeImage(file, format, rgb.data(), target);
 }
 
 // v >= 0 rounded to nearest, halves up, as std::lround: v - trunc(v) is exact in float
@@ -139,19 +129,18 @@ void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& m
       "id_class", "depth_steps", "depth_tolerance", "shading_abs", "shading_tolerance", "dR", "dG",
       "dB",       "dA"};
   const int nch = static_cast<int>(names.size());
-  ImageSpec spec(w, h, nch, TypeDesc::FLOAT);
-  spec.channelnames = names;
-  spec.attribute("compression", static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo
-                                    ? kDiffExrCompression
-                                    : "none");
-  spec.attribute("rastercheck:fixture", result.fixture);
-  spec.attribute("rastercheck:pair", result.expected + " vs " + result.actual);
-  auto out = OIIO::ImageOutput::create(file.string());
-  auto fail = [&] {
-    throw InputError(fmt::format("{}: cannot write: {}", target.string(),
-                                 out ? out->geterror() : OIIO::geterror()));
-  };
-  if (!out || !out->open(file.string(), spec)) fail();
+  ImageFormat format{.width = w,
+                     .height = h,
+                     .channel_names = names,
+                     .channels = nch,
+                     .type = PixelType::Float};
+  format.text = {{"compression", static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo
+                                      ? kDiffExrCompression
+                                      : "none"},
+                 {"rastercheck:fixture", result.fixture},
+                 {"rastercheck:pair", result.expected + " vs " + result.actual}};
+  const std::unique_ptr<image_io::RowWriter> out =
+      image_io::functions().open_rows(file, format, target);
   constexpr int kBandRows = 32;  // a multiple of every EXR compression's block height
   std::vector<float> band(static_cast<std::size_t>(w) * kBandRows * nch);
   for (int y0 = 0; y0 < h; y0 += kBandRows) {
@@ -167,9 +156,9 @@ void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& m
       for (int c = 0; c < 4; ++c)
         p[5 + c] = (actual.color[i * 4 + c] - expected.color[i * 4 + c]) * 255.0f;
     }
-    if (!out->write_scanlines(y0, y1, 0, TypeDesc::FLOAT, band.data())) fail();
+    out->rows(y0, y1, band.data());
   }
-  if (!out->close()) fail();
+  out->close();
 }
 
 // Runs the writers concurrently (each file is independent and most time is deflate), and
@@ -240,10 +229,7 @@ std::vector<Rgb8> heatColorStops(int count) {
   count = std::max(count, 2);
   std::vector<float> ramp(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) ramp[i] = static_cast<float>(i) / static_cast<float>(count - 1);
-  ImageBuf src(ImageSpec(count, 1, 1, TypeDesc::FLOAT), ramp.data());
-  ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, kHeatColorMap);
-  std::vector<float> rgb(static_cast<std::size_t>(count) * 3, 0.0f);
-  mapped.get_pixels(mapped.roi(), TypeDesc::FLOAT, rgb.data());
+  const std::vector<float> rgb = image_io::functions().color_map(ramp, kHeatColorMap);
   std::vector<Rgb8> stops(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i)
     for (int c = 0; c < 3; ++c)
