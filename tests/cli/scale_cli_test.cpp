@@ -226,4 +226,26 @@ TEST(CliScale, VersionIsAnsweredWithoutLoadingTheHeavyLibraries) {
   EXPECT_EQ(help.out.find("worker"), std::string::npos) << "the worker mode is not for people";
 }
 
+// OpenImageIO comes with the image module, loaded when a command touches an image
+// (fixtures/image_io.h): `list` of untextured fixtures never does (it loads each scene, so
+// a textured one would), `render` writes frame.exr and color.png.
+TEST(CliScale, OnlyCommandsThatTouchImagesLoadOpenImageIO) {
+  const Result list = run("list " + catalog("zbuffer"), "LD_DEBUG=libs");
+  EXPECT_EQ(list.code, 0) << list.out;
+  EXPECT_NE(list.out.find("zbuffer/interpenetrating_ab"), std::string::npos) << list.out;
+  EXPECT_EQ(list.out.find("libOpenImageIO"), std::string::npos) << "list loaded OpenImageIO";
+  EXPECT_EQ(list.out.find("libassimp"), std::string::npos) << "list loaded Assimp";
+  const fs::path out = scratch("image_io");
+  const Result render =
+      run("render " + catalog("zbuffer/interpenetrating_ab.json") + " --backend ref --out " +
+              out.string(),
+          "LD_DEBUG=libs");
+  EXPECT_EQ(render.code, 0) << render.out;
+  EXPECT_NE(render.out.find("rastercheck-image-io.so"), std::string::npos) << render.out;
+  EXPECT_NE(render.out.find("libOpenImageIO"), std::string::npos) << render.out;
+  EXPECT_TRUE(fs::is_regular_file(out / "frame.exr"));
+  EXPECT_TRUE(fs::is_regular_file(out / "color.png"));
+  fs::remove_all(out);
+}
+
 }  // namespace
