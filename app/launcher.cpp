@@ -1,8 +1,8 @@
 // rastercheck as users start it: answers `--version` before any heavy library is loaded,
 // and hands every other command to rastercheck-core beside it (execv, same arguments).
-// rastercheck-core links OpenImageIO and Assimp, whose ~260 shared libraries take
-// ~0.1 s to load and relocate at every process start (docs/performance.md); this program
-// links only the C and C++ runtimes. It must stay that way: no project library here.
+// rastercheck-core loads OpenImageIO's ~260 shared libraries only when a command touches
+// an image (fixtures/image_io.h), but it still links EGL and the project's libraries; this
+// program links only the C and C++ runtimes. It must stay that way: no project library here.
 #include <unistd.h>
 
 #include <cerrno>

@@ -121,7 +121,8 @@ WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, w->log.c_str(),
                                    O_WRONLY | O_CREAT | O_APPEND, 0644);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  const std::string exe = selfExecutable().string();
+  const std::string exe =
+      options_.program.empty() ? selfExecutable().string() : options_.program.string();
   std::vector<std::string> args = {exe, "worker", "--backend", spec};
   std::vector<char*> argv;
   argv.reserve(args.size() + 1);

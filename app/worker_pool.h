@@ -40,6 +40,9 @@ class WorkerPool {
     int max_busy = 1;               // renders at a time, over all backends
     double timeout_seconds = 0.0;   // per render; 0: no watchdog
     std::filesystem::path log_dir;  // where worker logs go (created if needed)
+    // The program started in worker mode: empty for this one (`run`); a test names
+    // rastercheck.
+    std::filesystem::path program;
   };
   explicit WorkerPool(Options options);
   WorkerPool(const WorkerPool&) = delete;

@@ -1,4 +1,6 @@
-# Faster process start for programs that link OpenImageIO.
+# Faster loading of OpenImageIO: for the image module (fixtures/image_io.h), which a
+# process loads the first time it touches an image, and for test programs that call
+# OpenImageIO themselves.
 #
 # Debian's OpenImageIO pulls in ~260 shared libraries (OpenVDB, GDAL, ffmpeg, ...). The
 # dynamic loader resolves every symbol relocation by walking the global search list in
@@ -16,7 +18,10 @@
 # members) defined identically in several libraries.
 option(RASTERCHECK_STARTUP_ORDER "Put heavily relocated shared libraries first in the search list" ON)
 
-# rc_startup_order(TARGET LIB...): for an executable TARGET linked with the shared
+# The same holds for a module opened with dlopen: its own search list (breadth-first from
+# the module) follows the global one, so its DT_NEEDED order decides the walk.
+#
+# rc_startup_order(TARGET LIB...): for an executable or module TARGET linked with the shared
 # libraries LIB (full paths), lists the run-time dependencies of LIB with >= 1000 symbol
 # relocations first in TARGET's DT_NEEDED entries.
 function(rc_startup_order target)

@@ -6,11 +6,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <optional>
 #include <tuple>
 
 #include <fmt/format.h>
 
 #include "app/backends.h"
+#include "app/worker_pool.h"
 #include "compare/pair_images.h"
 #include "compare/pair_tolerances.h"
 #include "compare/report.h"
@@ -19,7 +22,6 @@
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
 #include "fixtures/scene_writer.h"
-#include "tests/support/command.h"
 
 namespace rc::conformance {
 namespace fs = std::filesystem;
@@ -57,12 +59,6 @@ class ScratchDir {
   fs::path path_;
 };
 
-std::string shellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 }  // namespace
 
 fs::path scratchRoot() {
@@ -72,29 +68,43 @@ fs::path scratchRoot() {
 
 std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& spec,
                                    std::string& error, int& exit_code, const std::string& env) {
-  static int counter = 0;
-  const fs::path out = scratchRoot() / fmt::format("frame{}", counter++);
-  const std::string cmd = fmt::format(
-      "{}{} render {} --backend {} --out {}", env.empty() ? "" : "env " + shellQuote(env) + " ",
-      RC_EXE, shellQuote(fixture.string()), shellQuote(spec), shellQuote(out.string()));
-  const test::CommandResult child = test::runShell(cmd);
-  std::string output = child.out;
-  exit_code = child.code;
-  if (exit_code == -1) {
-    error = "could not start a shell";
-    return std::nullopt;
+  // `rastercheck worker` processes, as `run` keeps them (app/worker_pool.h): the frame comes
+  // back through a pipe, so neither side encodes or decodes an image (and neither loads
+  // OpenImageIO for it: fixtures/image_io.h), and the renders of one test with the same
+  // environment share one worker. One pool per environment, whose workers inherit it.
+  (void)scratchRoot();  // made first, so that it outlives the pools (their logs are in it)
+  static std::map<std::string, std::unique_ptr<WorkerPool>> pools;
+  std::unique_ptr<WorkerPool>& pool = pools[env];
+  if (!pool) {
+    WorkerPool::Options options;
+    options.log_dir = scratchRoot() / fmt::format("workers{}", pools.size());
+    options.program = RC_EXE;
+    pool = std::make_unique<WorkerPool>(options);
   }
-  std::optional<Frame> frame;
-  if (exit_code != 0) {
-    while (!output.empty() && output.back() == '\n') output.pop_back();
-    const std::size_t nl = output.rfind('\n');
-    error = output.substr(nl == std::string::npos ? 0 : nl + 1);
-  } else {
-    frame = readFrameDir(out);
+  std::string name;
+  std::optional<std::string> before;
+  if (!env.empty()) {
+    const std::size_t eq = env.find('=');
+    name = env.substr(0, eq);
+    if (const char* old = std::getenv(name.c_str())) before = old;
+    ::setenv(name.c_str(), eq == std::string::npos ? "" : env.substr(eq + 1).c_str(), 1);
   }
-  std::error_code ec;
-  fs::remove_all(out, ec);
-  return frame;
+  RenderOutcome outcome = pool->renderAll({RenderRequest{fs::absolute(fixture), spec}}).front();
+  if (!name.empty()) {
+    if (before) {
+      ::setenv(name.c_str(), before->c_str(), 1);
+    } else {
+      ::unsetenv(name.c_str());
+    }
+  }
+  if (outcome.ok) {
+    exit_code = 0;
+    return std::move(outcome.frame);
+  }
+  // What `rastercheck render` would have exited with: 2 for a bad fixture, else 3.
+  exit_code = outcome.input_error ? 2 : 3;
+  error = outcome.error;
+  return std::nullopt;
 }
 
 Frame renderReference(const fs::path& fixture) {

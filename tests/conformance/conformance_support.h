@@ -27,10 +27,12 @@ std::vector<std::string> knownBackends();
 // This process's scratch folder (created on first use, removed at exit).
 std::filesystem::path scratchRoot();
 
-// Renders `fixture` with `spec` through the rastercheck binary into a scratch folder and
-// reads the frame back. `env` (e.g. "RASTERCHECK_GL_FAULT=shift_x=0.5") is set for the
-// child only. On failure returns nullopt and sets `error` to the child's last line and
-// `exit_code` to its exit code.
+// Renders `fixture` with `spec` in a `rastercheck worker` process (the path `run` takes;
+// the frame comes back through a pipe) and returns the frame. `env` (e.g.
+// "RASTERCHECK_GL_FAULT=shift_x=0.5") is set for the worker only; renders with the same
+// `env` reuse this process's worker of that backend. On failure returns nullopt and sets
+// `error` to the one-line reason and `exit_code` to what `rastercheck render` exits with
+// (2 bad fixture, 3 the backend could not render).
 std::optional<Frame> renderInChild(const std::filesystem::path& fixture, const std::string& spec,
                                    std::string& error, int& exit_code, const std::string& env = "");
 
@@ -44,7 +46,7 @@ Frame renderReference(const std::filesystem::path& fixture);
 bool backendStarts(const std::string& spec, std::string& why);
 bool glRequired();
 
-// renderInChild for a GL backend. Only when the child exits 3 is the probe scene tried
+// renderInChild for a GL backend. Only when the render fails with 3 is the probe scene tried
 // (one process fewer per test on the usual path): if the backend cannot render even that,
 // `unavailable` is set and the caller skips; a failure on this fixture alone is an error.
 struct BackendRender {
