@@ -1,8 +1,8 @@
 // Lists the determinism corpus (corpus.h) as one hash per frame. Built three times:
-// against the normal libraries (reference_dump) and against the reference AND fixtures
-// sources compiled at -O0 and at -O2 (reference_dump_O0, reference_dump_O2), so that
-// test_determinism can compare frames across optimisation levels, loader and scene logic
-// included.
+// against the normal libraries (reference_dump), against the reference AND fixtures
+// sources compiled at -O0 (reference_dump_O0), and against the reference compiled at -O2
+// with the release fixtures library (reference_dump_O2), so that test_determinism can
+// compare frames across optimisation levels, loader and scene logic included.
 //   reference_dump [--bench] [--out FILE] [FIXTURE|DIR...]
 // --bench adds the benchmark scenes; DIR means every *.json under it. Before/after check
 // of an optimisation: run it before and after, then diff the two listings.

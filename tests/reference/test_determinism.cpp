@@ -1,7 +1,8 @@
 // Determinism: bit-identical frames on every run, and across optimisation levels (the
-// reference AND fixtures sources compiled again at -O0 and at -O2 into two dump tools, so
-// that the camera, model and normal matrices, TRS transforms, generators, computed
-// normals and the painter's sort are covered along with the renderer).
+// reference compiled again at -O0 and at -O2 into two dump tools, the -O0 one with its own
+// -O0 copy of the fixtures sources, so that the camera, model and normal matrices, TRS
+// transforms, generators, computed normals and the painter's sort are covered along with
+// the renderer).
 #include <gtest/gtest.h>
 
 #include <algorithm>
