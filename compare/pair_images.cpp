@@ -129,16 +129,13 @@ void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& m
       "id_class", "depth_steps", "depth_tolerance", "shading_abs", "shading_tolerance", "dR", "dG",
       "dB",       "dA"};
   const int nch = static_cast<int>(names.size());
-  ImageFormat format{.width = w,
-                     .height = h,
-                     .channel_names = names,
-                     .channels = nch,
-                     .type = PixelType::Float};
-  format.text = {{"compression", static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo
-                                      ? kDiffExrCompression
-                                      : "none"},
-                 {"rastercheck:fixture", result.fixture},
-                 {"rastercheck:pair", result.expected + " vs " + result.actual}};
+  ImageFormat format{
+      .width = w, .height = h, .channel_names = names, .channels = nch, .type = PixelType::Float};
+  format.text = {
+      {"compression",
+       static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo ? kDiffExrCompression : "none"},
+      {"rastercheck:fixture", result.fixture},
+      {"rastercheck:pair", result.expected + " vs " + result.actual}};
   const std::unique_ptr<image_io::RowWriter> out =
       image_io::functions().open_rows(file, format, target);
   constexpr int kBandRows = 32;  // a multiple of every EXR compression's block height

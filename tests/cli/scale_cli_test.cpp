@@ -236,10 +236,9 @@ TEST(CliScale, OnlyCommandsThatTouchImagesLoadOpenImageIO) {
   EXPECT_EQ(list.out.find("libOpenImageIO"), std::string::npos) << "list loaded OpenImageIO";
   EXPECT_EQ(list.out.find("libassimp"), std::string::npos) << "list loaded Assimp";
   const fs::path out = scratch("image_io");
-  const Result render =
-      run("render " + catalog("zbuffer/interpenetrating_ab.json") + " --backend ref --out " +
-              out.string(),
-          "LD_DEBUG=libs");
+  const Result render = run("render " + catalog("zbuffer/interpenetrating_ab.json") +
+                                " --backend ref --out " + out.string(),
+                            "LD_DEBUG=libs");
   EXPECT_EQ(render.code, 0) << render.out;
   EXPECT_NE(render.out.find("rastercheck-image-io.so"), std::string::npos) << render.out;
   EXPECT_NE(render.out.find("libOpenImageIO"), std::string::npos) << render.out;

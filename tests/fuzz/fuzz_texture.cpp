@@ -1,5 +1,5 @@
-// libFuzzer target: texture images through OpenImageIO (image_io_module.cpp). Built by the fuzz preset,
-// run by scripts/fuzz.sh.
+// libFuzzer target: texture images through OpenImageIO (image_io_module.cpp). Built by the fuzz
+// preset, run by scripts/fuzz.sh.
 #include <cstddef>
 #include <cstdint>
 
