@@ -130,7 +130,7 @@ WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
   argv.push_back(nullptr);
   // A spec naming another Mesa's folder needs LD_LIBRARY_PATH from the worker's start (the
   // dynamic loader reads it once), as `render` re-executes itself with it.
-  std::vector<std::string> extra;
+  std::vector<std::string> extra = options_.environment;
   const BackendSpec backend = parseBackendSpec(spec);
   if (backend.kind == BackendSpec::Kind::Gl)
     for (const auto& [name, value] : startupEnvironment(backend.gl))

@@ -65,16 +65,6 @@ Lab linearToLab(const double rgb[3]) {
   return {116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)};
 }
 
-// color.png's byte of a frame channel (DESIGN.md: clamp to [0, 1], NaN as 0, round to
-// nearest, halves up), as fixtures/frame_io.cpp writes it and compare/flip.cpp reads it.
-std::uint8_t unorm8(float v) {
-  v = v > 0.0f ? v : 0.0f;
-  v = v < 1.0f ? v : 1.0f;
-  const float x = v * 255.0f;
-  const auto q = static_cast<int>(x);
-  return static_cast<std::uint8_t>(q + (x - static_cast<float>(q) >= 0.5f ? 1 : 0));
-}
-
 // The linear value of each 8-bit sRGB code (frames are read as 8-bit pictures).
 const std::array<double, 256>& decodeTable() {
   static const std::array<double, 256> table = [] {
@@ -87,8 +77,8 @@ const std::array<double, 256>& decodeTable() {
 
 // A pixel's 8-bit R, G, B as one key, and the CIELAB of a key.
 std::uint32_t rgbKey(const float* rgba) {
-  return static_cast<std::uint32_t>(unorm8(rgba[0])) << 16 |
-         static_cast<std::uint32_t>(unorm8(rgba[1])) << 8 | unorm8(rgba[2]);
+  return static_cast<std::uint32_t>(colorByte(rgba[0])) << 16 |
+         static_cast<std::uint32_t>(colorByte(rgba[1])) << 8 | colorByte(rgba[2]);
 }
 Lab keyLab(std::uint32_t key) {
   const std::array<double, 256>& decode = decodeTable();

@@ -15,8 +15,8 @@
 #include <fmt/format.h>
 
 #include "compare/cube_root.h"
+#include "compare/pair_images.h"
 #include "fixtures/errors.h"
-#include "fixtures/image_io.h"
 
 namespace rc {
 namespace {
@@ -500,21 +500,12 @@ FlipStats flipFrames(const Frame& expected, const Frame& actual, const Tolerance
 }
 
 std::vector<std::uint8_t> flipHeatRgb(const std::vector<float>& error) {
-  static const std::vector<std::uint8_t> lut = [] {
-    constexpr int kCount = 256;
-    std::vector<float> ramp(kCount);
-    for (int i = 0; i < kCount; ++i) ramp[i] = static_cast<float>(i) / (kCount - 1);
-    const std::vector<float> rgb = image_io::functions().color_map(ramp, kFlipColorMap);
-    std::vector<std::uint8_t> out(std::size_t{3} * kCount);
-    for (int i = 0; i < 3 * kCount; ++i)
-      out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i], 0.0f, 1.0f) * 255.0f));
-    return out;
-  }();
+  static const std::vector<Rgb8> lut = colorStops(256, kFlipColorMap);
   std::vector<std::uint8_t> out(3 * error.size());
   for (std::size_t i = 0; i < error.size(); ++i) {
     const float e = std::isnan(error[i]) ? 1.0f : std::clamp(error[i], 0.0f, 1.0f);
     const auto k = static_cast<std::size_t>(std::lround(e * 255.0f));
-    for (int c = 0; c < 3; ++c) out[3 * i + c] = lut[3 * k + c];
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = lut[k][c];
   }
   return out;
 }

@@ -222,11 +222,11 @@ float heatPosition(float value, double scale) {
   return static_cast<float>(std::clamp(t, 0.0, 1.0));
 }
 
-std::vector<Rgb8> heatColorStops(int count) {
+std::vector<Rgb8> colorStops(int count, const char* map) {
   count = std::max(count, 2);
   std::vector<float> ramp(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) ramp[i] = static_cast<float>(i) / static_cast<float>(count - 1);
-  const std::vector<float> rgb = image_io::functions().color_map(ramp, kHeatColorMap);
+  const std::vector<float> rgb = image_io::functions().color_map(ramp, map);
   std::vector<Rgb8> stops(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i)
     for (int c = 0; c < 3; ++c)
@@ -234,6 +234,8 @@ std::vector<Rgb8> heatColorStops(int count) {
           static_cast<std::uint8_t>(std::lround(std::clamp(rgb[i * 3 + c], 0.0f, 1.0f) * 255.0f));
   return stops;
 }
+
+std::vector<Rgb8> heatColorStops(int count) { return colorStops(count, kHeatColorMap); }
 
 void setHeatScales(PairResult& result) {
   result.depth_heat_scale = std::max({result.depth.max_steps, result.tolerances.depth.fail, 1.0});

@@ -27,7 +27,11 @@ Rgb8 classColor(PixelClass c);
 inline constexpr Rgb8 kNotComparedColor = {40, 44, 52};
 inline constexpr Rgb8 kNonFiniteColor = {0, 255, 255};
 
-// `count` evenly spaced colours of the heat colour map from 0 to 1, for legends.
+// `count` evenly spaced colours of OpenImageIO's colour map `map` from 0 to 1 (entry i is
+// the map at i / (count - 1), each channel rounded to 8 bits).
+std::vector<Rgb8> colorStops(int count, const char* map);
+
+// The same for the heat colour map, for legends.
 std::vector<Rgb8> heatColorStops(int count);
 
 // Where a heat map value v lands on the colour map: log2(1 + v) / log2(1 + scale), in

@@ -42,8 +42,8 @@ std::string readText(const fs::path& p) {
 
 // pass, warn, fail (with images written under dir) and error rows from synthetic frames.
 std::vector<PairResult> sampleRows(const fs::path& dir) {
-  constexpr int kW = 64, kH = 48;
-  const Frame ref = testing::renderRects(kW, kH, testing::defaultRects(kW, kH));
+  constexpr int kRowW = 64, kRowH = 48;
+  const Frame ref = testing::renderRects(kRowW, kRowH, testing::defaultRects(kRowW, kRowH));
   const Tolerances tol = tolerancesForFrames(ref, ref);
   std::vector<PairResult> rows;
   auto add = [&](Frame actual, const std::string& fixture, bool images) {

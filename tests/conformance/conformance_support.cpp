@@ -71,7 +71,7 @@ std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& s
   // `rastercheck worker` processes, as `run` keeps them (app/worker_pool.h): the frame comes
   // back through a pipe, so neither side encodes or decodes an image (and neither loads
   // OpenImageIO for it: fixtures/image_io.h), and the renders of one test with the same
-  // environment share one worker. One pool per environment, whose workers inherit it.
+  // `env` share one worker: one pool per `env`.
   (void)scratchRoot();  // made first, so that it outlives the pools (their logs are in it)
   static std::map<std::string, std::unique_ptr<WorkerPool>> pools;
   std::unique_ptr<WorkerPool>& pool = pools[env];
@@ -79,24 +79,10 @@ std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& s
     WorkerPool::Options options;
     options.log_dir = scratchRoot() / fmt::format("workers{}", pools.size());
     options.program = RC_EXE;
+    if (!env.empty()) options.environment.push_back(env);
     pool = std::make_unique<WorkerPool>(options);
   }
-  std::string name;
-  std::optional<std::string> before;
-  if (!env.empty()) {
-    const std::size_t eq = env.find('=');
-    name = env.substr(0, eq);
-    if (const char* old = std::getenv(name.c_str())) before = old;
-    ::setenv(name.c_str(), eq == std::string::npos ? "" : env.substr(eq + 1).c_str(), 1);
-  }
   RenderOutcome outcome = pool->renderAll({RenderRequest{fs::absolute(fixture), spec}}).front();
-  if (!name.empty()) {
-    if (before) {
-      ::setenv(name.c_str(), before->c_str(), 1);
-    } else {
-      ::unsetenv(name.c_str());
-    }
-  }
   if (outcome.ok) {
     exit_code = 0;
     return std::move(outcome.frame);
