@@ -118,7 +118,7 @@ AccuracyPair readPair(const ReportReader& r, const json& j, const std::string& a
 // --- writing -------------------------------------------------------------------------
 
 // Short numbers for tables: 3 significant digits, no exponent below 1e6.
-std::string num(double v) {
+std::string shortNumber(double v) {
   if (v == 0.0) return "0";
   if (std::abs(v) >= 1000.0) return fmt::format("{:.0f}", v);
   return fmt::format("{:.3g}", v);
@@ -181,9 +181,9 @@ std::string verdictCell(const AccuracyPair& p) {
     parts.push_back(
         fmt::format("visibility {} hard px{}", p.hard, at(p.visibility_worst, p.height)));
   if (p.depth_status != Status::Pass)
-    parts.push_back(fmt::format("depth {} steps{}", num(p.depth_max), at(p.depth_worst, p.height)));
+    parts.push_back(fmt::format("depth {} steps{}", shortNumber(p.depth_max), at(p.depth_worst, p.height)));
   if (p.shading_status != Status::Pass)
-    parts.push_back(fmt::format("shading {}{}", num(p.shading_max), at(p.shading_worst, p.height)));
+    parts.push_back(fmt::format("shading {}{}", shortNumber(p.shading_max), at(p.shading_worst, p.height)));
   std::string out = toString(p.status);
   for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? "; " : ": ") + parts[i];
   return out;
@@ -224,11 +224,11 @@ std::vector<std::string> differenceSummary(const std::vector<const AccuracyPair*
     out.push_back(
         fmt::format("Stored depth differs in {} fixtures, by up to {} steps "
                     "(`{}`{}).",
-                    depth_fx, num(depth_worst->depth_max), depth_worst->fixture,
+                    depth_fx, shortNumber(depth_worst->depth_max), depth_worst->fixture,
                     at(depth_worst->depth_worst, depth_worst->height)));
   if (shading_worst && shading_worst->shading_max > 0.0)
     out.push_back(fmt::format("Colour differs in {} fixtures, by up to {} 8-bit units (`{}`{}).",
-                              shading_fx, num(shading_worst->shading_max), shading_worst->fixture,
+                              shading_fx, shortNumber(shading_worst->shading_max), shading_worst->fixture,
                               at(shading_worst->shading_worst, shading_worst->height)));
   return out;
 }
@@ -391,7 +391,7 @@ void perceptualTable(const std::map<Group, std::vector<const AccuracyPair*>>& gr
     }
     if (n == 0) continue;
     line(fmt::format("| `{}` | `{}` | {} | {} | {} (`{}`) | {} |", g.second, g.first, n,
-                     num(sum / static_cast<double>(n)), num(worst), worst_fixture, num(max)));
+                     shortNumber(sum / static_cast<double>(n)), shortNumber(worst), worst_fixture, shortNumber(max)));
   }
 }
 
@@ -452,8 +452,8 @@ void transparencySection(const AccuracyData& data, Line& line) {
   line("|---|---|---|---|---|---|---|---|");
   for (const AccuracyPair* p : rows)
     line(fmt::format("| `{}` | `{}` | {} | {} | {} | {} | {} | {} |", p->fixture, p->actual,
-                     p->oit_blended, p->oit_unsorted, p->oit_pixels, num(p->oit_max_abs),
-                     num(p->oit_mean_abs), p->oit_pairs));
+                     p->oit_blended, p->oit_unsorted, p->oit_pixels, shortNumber(p->oit_max_abs),
+                     shortNumber(p->oit_mean_abs), p->oit_pairs));
 }
 
 std::string accuracyMarkdown(const AccuracyData& data, const std::string& command) {
@@ -495,9 +495,9 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
       Totals t;
       for (const AccuracyPair* p : groups[g]) t.add(*p);
       line(fmt::format("| `{}` | `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} |", g.second,
-                       g.first, t.pairs, t.verdicts(), t.hard, t.ambiguous, num(t.depth_max),
-                       num(t.depth_p99), num(t.shading_max), num(t.shadingMean()),
-                       t.psnr_min ? num(*t.psnr_min) : "identical"));
+                       g.first, t.pairs, t.verdicts(), t.hard, t.ambiguous, shortNumber(t.depth_max),
+                       shortNumber(t.depth_p99), shortNumber(t.shading_max), shortNumber(t.shadingMean()),
+                       t.psnr_min ? shortNumber(*t.psnr_min) : "identical"));
     }
 
     variantsSection(data, line);
@@ -523,8 +523,8 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
       line("|---|---|---|---|---|---|---|---|---|---|---|");
       for (const auto& [tag, t] : per_tag)
         line(fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |", cell(tag), t.pairs,
-                         t.verdicts(), t.hard, t.ambiguous, num(t.depth_max), num(t.shading_max),
-                         num(t.shadingMean())));
+                         t.verdicts(), t.hard, t.ambiguous, shortNumber(t.depth_max), shortNumber(t.shading_max),
+                         shortNumber(t.shadingMean())));
     }
 
     line();
@@ -582,7 +582,7 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
     line(fmt::format(
         "Visibility: {} hard and {} ambiguous pixels in all; depth up to {} "
         "steps; shading up to {} (mean {}).",
-        t.hard, t.ambiguous, num(t.depth_max), num(t.shading_max), num(t.shadingMean())));
+        t.hard, t.ambiguous, shortNumber(t.depth_max), shortNumber(t.shading_max), shortNumber(t.shadingMean())));
     line();
     line("What differs:");
     line();
@@ -600,8 +600,8 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
       if (p->mismatched == 0 && p->depth_max == 0.0 && p->shading_max == 0.0) continue;
       line(fmt::format("| `{}` | {} | {} / {} ({}){} | {}, {}{} | {}, {}{} |", p->fixture,
                        toString(p->status), p->hard, p->ambiguous, p->ambiguous_by_depth_gap,
-                       at(p->visibility_worst, p->height), num(p->depth_max), num(p->depth_p99),
-                       at(p->depth_worst, p->height), num(p->shading_max), num(p->shading_mean),
+                       at(p->visibility_worst, p->height), shortNumber(p->depth_max), shortNumber(p->depth_p99),
+                       at(p->depth_worst, p->height), shortNumber(p->shading_max), shortNumber(p->shading_mean),
                        at(p->shading_worst, p->height)));
     }
     line();

@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "compare/colour_space.h"
 #include "compare/cube_root.h"
 
 namespace rc {
@@ -34,12 +35,6 @@ double hueAngle(double b, double a_prime) {
   const double h = std::atan2(b, a_prime);
   return h >= 0.0 ? h : h + 2.0 * kPi;
 }
-
-// sRGB primaries and D65 white (IEC 61966-2-1): linear RGB to CIE XYZ, the same matrix
-// compare/flip.cpp uses.
-constexpr double kRgbToXyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
-                                    {0.2126729, 0.7151522, 0.0721750},
-                                    {0.0193339, 0.1191920, 0.9503041}};
 
 double srgbDecode(double c) {
   return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);

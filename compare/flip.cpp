@@ -9,19 +9,19 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <numeric>
 #include <thread>
 
 #include <fmt/format.h>
 
+#include "compare/colour_space.h"
 #include "compare/cube_root.h"
 #include "compare/pair_images.h"
 #include "fixtures/errors.h"
 
 namespace rc {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The paper's constants.
 constexpr double kQc = 0.7;                 // exponent of the HyAB colour distance
@@ -45,16 +45,12 @@ constexpr double kCsfMaxB = 0.04;  // the largest b: sets the filter radius for 
 // The radius of the CSF filters (3 standard deviations of the widest Gaussian term) and of
 // the feature detectors (3 sigma), px.
 int csfRadius(double ppd) {
-  return static_cast<int>(std::ceil(3.0 * std::sqrt(kCsfMaxB / (2.0 * kPi * kPi)) * ppd));
+  return static_cast<int>(
+      std::ceil(3.0 * std::sqrt(kCsfMaxB / (2.0 * std::numbers::pi * std::numbers::pi)) * ppd));
 }
 int featureRadius(double ppd) {
   return static_cast<int>(std::ceil(3.0 * 0.5 * kFeatureWidthDeg * ppd));
 }
-
-// Linear sRGB (D65 white) to CIE XYZ, IEC 61966-2-1.
-constexpr double kRgbToXyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
-                                    {0.2126729, 0.7151522, 0.0721750},
-                                    {0.0193339, 0.1191920, 0.9503041}};
 
 struct Vec3 {
   double v[3];
@@ -193,12 +189,12 @@ void csfFilter(Plane& channel, int w, int h, const Csf& c, double ppd, int r) {
     std::vector<double> g(n);
     for (int i = -r; i <= r; ++i) {
       const double x = i / ppd;  // degrees
-      g[i + r] = std::exp(-kPi * kPi * x * x / b[term]);
+      g[i + r] = std::exp(-std::numbers::pi * std::numbers::pi * x * x / b[term]);
     }
     const double sum = std::accumulate(g.begin(), g.end(), 0.0);
     for (double& v : g) v /= sum;
     // The term's share of the 2D kernel's sum.
-    weight[term] = a[term] * std::sqrt(kPi / b[term]) * sum * sum;
+    weight[term] = a[term] * std::sqrt(std::numbers::pi / b[term]) * sum * sum;
     // Taps below 1e-15 of the centre change no result in double (the narrow achromatic and
     // red-green kernels need 9 of the 21): dropped, the rest kept as they are.
     std::size_t cut = 0;
@@ -358,7 +354,7 @@ constexpr int kTile = 64;  // px; the halo (10 px at 67 ppd) must not exceed it
 }  // namespace
 
 double FlipViewing::pixelsPerDegree() const {
-  return distance_m * (monitor_width_px / monitor_width_m) * kPi / 180.0;
+  return distance_m * (monitor_width_px / monitor_width_m) * std::numbers::pi / 180.0;
 }
 
 std::vector<float> flipError(const FlipImage& reference, const FlipImage& test,
