@@ -23,6 +23,7 @@
 #include "app/debug_support.h"
 #include "app/paths.h"
 #include "app/report_support.h"
+#include "app/worker_pool.h"
 #include "compare/atomic_file.h"
 #include "compare/compare.h"
 #include "compare/report.h"
@@ -96,7 +97,9 @@ class MutationStudy {
       runRange(first, last);
     }
     status_.clear();
+    pool_.reset();  // the workers end before their folder goes
     const int code = writeReport();
+    if (!interrupt_.interrupted()) folder_.removeWork();
     if (interrupt_.interrupted()) {
       status_.note(fmt::format(
           "interrupted after {}: kept {} of {} scenes; run the same command again to continue",
@@ -180,142 +183,109 @@ class MutationStudy {
                              scenes_.size(), first, last, stage, done, total, eta));
   }
 
-  bool runStage(std::vector<Job>& jobs, std::uint64_t first, std::uint64_t last,
-                const char* stage) {
+  // Renders every request through the workers; nullopt when interrupted (a worker that
+  // the same Ctrl-C ended has no result worth keeping).
+  std::optional<std::vector<RenderOutcome>> renderStage(const std::vector<RenderRequest>& requests,
+                                                        std::uint64_t first, std::uint64_t last,
+                                                        const char* stage) {
+    std::map<std::size_t, std::size_t> index;  // ticket -> request
+    for (std::size_t k = 0; k < requests.size(); ++k) index[pool_->submit(requests[k])] = k;
+    std::vector<RenderOutcome> out(requests.size());
     std::size_t finished = 0;
-    auto tick = [&] { showProgress(first, last, stage, finished, jobs.size()); };
-    tick();
-    runCampaignJobs(jobs, jobs_, interrupt_, tick, [&](std::size_t) { ++finished; });
-    return !interrupt_.interrupted();
+    while (finished < requests.size()) {
+      showProgress(first, last, stage, finished, requests.size());
+      if (interrupt_.interrupted()) return std::nullopt;
+      for (auto& [ticket, outcome] : pool_->poll(200)) {
+        out[index.at(ticket)] = std::move(outcome);
+        ++finished;
+      }
+    }
+    if (interrupt_.interrupted()) return std::nullopt;
+    return out;
   }
 
-  void runRange(std::uint64_t first, std::uint64_t last) {
-    const auto start = Clock::now();
-    const fs::path work = folder_.work() / fmt::format("{:05}-{:05}", first, last);
-    std::error_code ec;
-    fs::remove_all(work, ec);
-    auto sceneDir = [&](std::uint64_t i) { return work / fmt::format("{:05}", i); };
-    auto backendDir = [&](std::uint64_t i, const std::string& b) {
-      return sceneDir(i) / fixtureSlug(b);
-    };
+  // One scene: the reference and each backend without fault, then each backend once per
+  // fault (set for what its clean frame shows), then the three comparisons of each
+  // (backend, fault). Frames stay in memory, one scene's at a time. False when interrupted.
+  bool runScene(std::uint64_t i, std::uint64_t first, std::uint64_t last,
+                std::vector<MutationResult>& results) {
+    const fs::path& file = scenes_[i].file;
+    std::vector<RenderRequest> requests{{file, "ref"}};
+    for (const std::string& b : args_.backends) requests.push_back({file, b});
+    std::optional<std::vector<RenderOutcome>> clean = renderStage(requests, first, last, "clean");
+    if (!clean) return false;
+    const RenderOutcome& ref = clean->front();
 
-    // Stage 1: the reference and every backend without fault.
-    std::vector<Job> jobs;
-    for (std::uint64_t i = first; i <= last; ++i) {
-      fs::create_directories(sceneDir(i), ec);
-      jobs.push_back(renderJob(scenes_[i].file, "ref", sceneDir(i) / "ref"));
-      for (const std::string& b : args_.backends) {
-        fs::create_directories(backendDir(i, b), ec);
-        jobs.push_back(renderJob(scenes_[i].file, b, backendDir(i, b) / "clean"));
-      }
-    }
-    for (Job& j : jobs) j.env = folder_.childEnv();
-    if (!runStage(jobs, first, last, "clean renders")) return;
-    auto ok = [&](const fs::path& dir) {
-      return fs::exists(dir / "frame.json", ec) && fs::exists(dir / "frame.exr", ec);
-    };
-
-    // Stage 2: each fault, set for what the clean frame shows.
+    const Scene scene = loadScene(file);
+    MutationScene facts = sceneFacts(scene);
     struct Planned {
-      std::uint64_t scene;
       std::string backend;
+      const RenderOutcome* clean;
       const MutationFault* fault;
       std::string setting;
+      std::optional<std::size_t> render;  // index into the faulted renders
     };
     std::vector<Planned> planned;
-    std::vector<Job> faulted;
-    std::map<std::uint64_t, Scene> loaded;
-    for (std::uint64_t i = first; i <= last; ++i) {
-      loaded.emplace(i, loadScene(scenes_[i].file));
-      MutationScene facts = sceneFacts(loaded.at(i));
-      for (const std::string& b : args_.backends) {
-        const fs::path clean = backendDir(i, b) / "clean";
-        facts.visible_ids.clear();
-        try {
-          if (ok(clean)) facts.visible_ids = visibleIds(readFrameDir(clean));
-        } catch (const InputError&) {
-          // An unreadable frame: the comparison below reports it as an error.
+    std::vector<RenderRequest> faulted;
+    for (std::size_t k = 0; k < args_.backends.size(); ++k) {
+      const RenderOutcome& c = (*clean)[k + 1];
+      facts.visible_ids = c.ok ? visibleIds(c.frame) : std::vector<std::uint32_t>{};
+      for (const MutationFault* f : faults_) {
+        Planned p{args_.backends[k], &c, f,
+                  c.ok ? faultSetting(*f, facts, scene_options_.seed, i) : "", std::nullopt};
+        if (!p.setting.empty() && ref.ok) {
+          p.render = faulted.size();
+          faulted.push_back({file, p.backend, p.setting});
         }
-        for (const MutationFault* f : faults_) {
-          Planned p{i, b, f, ok(clean) ? faultSetting(*f, facts, scene_options_.seed, i) : ""};
-          if (!p.setting.empty() && ok(sceneDir(i) / "ref")) {
-            Job job = renderJob(scenes_[i].file, b, backendDir(i, b) / f->name);
-            job.env = folder_.childEnv();
-            job.env.push_back(std::string(gl::testing::kFaultVariable) + "=" + p.setting);
-            faulted.push_back(std::move(job));
-          }
-          planned.push_back(std::move(p));
-        }
+        planned.push_back(std::move(p));
       }
     }
-    if (!runStage(faulted, first, last, "faulted renders")) return;
+    std::optional<std::vector<RenderOutcome>> bad = renderStage(faulted, first, last, "faulted");
+    if (!bad) return false;
 
-    // The three comparisons of each (scene, backend, fault).
-    std::vector<MutationResult> results;
-    std::map<std::pair<std::uint64_t, std::string>, std::optional<Frame>> clean_frames;
-    std::map<std::uint64_t, std::optional<Frame>> refs;
-    std::map<std::pair<std::uint64_t, std::string>, std::set<std::string>> controls;
-    // A frame that is missing or cannot be read is nullopt: its rows are errors.
-    auto readIf = [&](const fs::path& dir) -> std::optional<Frame> {
-      if (!ok(dir)) return std::nullopt;
-      try {
-        return readFrameDir(dir);
-      } catch (const InputError&) {
-        return std::nullopt;
-      }
-    };
-    auto failure = [&](const fs::path& dir, const std::string& what) {
-      fs::path log = dir;
-      log += ".log";
-      return fmt::format("{} did not render: {}", what, lastLogLine(log));
+    std::map<std::string, std::set<std::string>> controls;  // per backend
+    auto failure = [](const RenderOutcome& o, const std::string& what) {
+      return fmt::format("{} did not render: {}", what, o.error);
     };
     for (const Planned& p : planned) {
       MutationResult r;
-      r.fixture = scenes_[p.scene].name;
-      r.fixture_file = scenes_[p.scene].file.string();
+      r.fixture = scenes_[i].name;
+      r.fixture_file = file.string();
       r.backend = p.backend;
       r.fault = p.fault->name;
       r.setting = p.setting;
-      const Scene& scene = loaded.at(p.scene);
-      if (!refs.contains(p.scene)) refs[p.scene] = readIf(sceneDir(p.scene) / "ref");
-      const auto key = std::make_pair(p.scene, p.backend);
-      if (!clean_frames.contains(key))
-        clean_frames[key] = readIf(backendDir(p.scene, p.backend) / "clean");
-      const std::optional<Frame>& ref = refs[p.scene];
-      const std::optional<Frame>& clean = clean_frames[key];
       try {
-        if (!ref) {
+        if (!ref.ok) {
           r.verdict = MutationVerdict::Error;
-          r.note = failure(sceneDir(p.scene) / "ref", "the reference");
-        } else if (!clean) {
+          r.note = failure(ref, "the reference");
+        } else if (!p.clean->ok) {
           r.verdict = MutationVerdict::Error;
-          r.note = failure(backendDir(p.scene, p.backend) / "clean", p.backend);
+          r.note = failure(*p.clean, p.backend);
         } else if (p.setting.empty()) {
           r.verdict = MutationVerdict::NotApplicable;
+        } else if (const RenderOutcome& b = (*bad)[*p.render]; !b.ok) {
+          r.verdict = MutationVerdict::Error;
+          r.note = failure(b, p.backend + " with " + p.setting);
         } else {
-          const fs::path faulted_dir = backendDir(p.scene, p.backend) / p.fault->name;
-          const std::optional<Frame> bad = readIf(faulted_dir);
-          if (!bad) {
-            r.verdict = MutationVerdict::Error;
-            r.note = failure(faulted_dir, p.backend + " with " + p.setting);
-          } else {
-            if (!controls.contains(key))
-              controls[key] = failingClasses(compareFrames(
-                  *ref, *clean, *ref, pairTolerances(*ref, *clean, scene.tolerance, cli_)));
-            r.control_fails = controls[key];
-            r.effect_fails = failingClasses(compareFrames(
-                *clean, *bad, *ref, pairTolerances(*clean, *bad, scene.tolerance, cli_)));
-            PairResult detected =
-                compareFrames(*ref, *bad, *ref, pairTolerances(*ref, *bad, scene.tolerance, cli_));
-            r.detected_fails = failingClasses(detected);
-            r.verdict =
-                judgeMutation(p.fault->cls, r.control_fails, r.effect_fails, r.detected_fails);
-            if (r.verdict == MutationVerdict::Missed) {
-              detected.fixture = r.fixture;
-              detected.expected = "ref";
-              detected.actual = p.backend + " with " + p.setting;
-              r.note = describe(detected);
-            }
+          const Frame& good = p.clean->frame;
+          if (!controls.contains(p.backend))
+            controls[p.backend] = failingClasses(
+                compareFrames(ref.frame, good, ref.frame,
+                              pairTolerances(ref.frame, good, scene.tolerance, cli_)));
+          r.control_fails = controls[p.backend];
+          r.effect_fails = failingClasses(compareFrames(
+              good, b.frame, ref.frame, pairTolerances(good, b.frame, scene.tolerance, cli_)));
+          PairResult detected =
+              compareFrames(ref.frame, b.frame, ref.frame,
+                            pairTolerances(ref.frame, b.frame, scene.tolerance, cli_));
+          r.detected_fails = failingClasses(detected);
+          r.verdict =
+              judgeMutation(p.fault->cls, r.control_fails, r.effect_fails, r.detected_fails);
+          if (r.verdict == MutationVerdict::Missed) {
+            detected.fixture = r.fixture;
+            detected.expected = "ref";
+            detected.actual = p.backend + " with " + p.setting;
+            r.note = describe(detected);
           }
         }
       } catch (const InputError& e) {
@@ -324,11 +294,27 @@ class MutationStudy {
       }
       results.push_back(std::move(r));
     }
+    return true;
+  }
+
+  void runRange(std::uint64_t first, std::uint64_t last) {
+    const auto start = Clock::now();
+    if (!pool_) {
+      WorkerPool::Options options;
+      options.max_busy = jobs_;
+      options.log_dir = folder_.work() / "workers";
+      options.environment = folder_.childEnv();
+      std::error_code ec;
+      fs::create_directories(folder_.work() / "tmp", ec);
+      pool_.emplace(options);
+    }
+    std::vector<MutationResult> results;
+    for (std::uint64_t i = first; i <= last; ++i)
+      if (!runScene(i, first, last, results)) return;
     json doc = json::array();
     for (const MutationResult& r : results) doc.push_back(toJson(r));
     writeFileAtomically(resultsDir() / fmt::format("{:05}-{:05}.json", first, last),
                         doc.dump(1) + "\n");
-    fs::remove_all(work, ec);
     results_.insert(results_.end(), results.begin(), results.end());
     finished_.emplace_back(first, last);
     measured_scenes_ += last - first + 1;
@@ -390,6 +376,7 @@ class MutationStudy {
   std::vector<CampaignScene> scenes_;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> finished_;
   std::vector<MutationResult> results_;
+  std::optional<WorkerPool> pool_;  // one worker per backend and job, for the whole study
   std::uint64_t measured_scenes_ = 0;
   double measured_seconds_ = 0.0;
 };

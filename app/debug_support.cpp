@@ -11,7 +11,6 @@
 #include "app/paths.h"
 #include "app/worker_pool.h"
 #include "fixtures/errors.h"
-#include "fixtures/frame_io.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -42,21 +41,39 @@ std::string childFailure(const Job& job, const std::vector<std::string>& also_st
   return last.empty() ? fmt::format("exited with code {}", job.exit_code) : last;
 }
 
-Frame renderInChild(const fs::path& scene_file, const std::string& spec, const fs::path& out_dir) {
-  std::vector<Job> jobs{renderJob(scene_file, spec, out_dir)};
-  runJobs(jobs, 1);
-  if (jobs[0].exit_code != 0) {
-    const std::string why = childFailure(jobs[0]);
-    // The child's own message usually names the spec already.
-    throw BackendError(why.find(spec) != std::string::npos ? why : spec + ": " + why);
-  }
-  return readFrameDir(out_dir);
-}
+namespace {
 
-Frame renderBackend(const BackendSpec& backend, const Scene& scene, const fs::path& scene_file,
-                    const fs::path& out_dir) {
+// The GL renders of one command (`reduce` tries dozens of candidates, `explain` renders
+// each backend once): one `rastercheck worker` per spec, started on first use and kept
+// until the process exits, so the driver is loaded and its context created once, and
+// frames come back through a pipe instead of frame.exr (a child `render` per candidate
+// cost ~0.8 s of start-up, image encoding and decoding for a 48x36 scene). A crash or
+// exit of the worker costs that render, as a child's did; the next render starts a new one.
+class GlWorkers {
+ public:
+  Frame render(const fs::path& scene_file, const std::string& spec) {
+    RenderOutcome outcome =
+        std::move(pool_.renderAll({RenderRequest{fs::absolute(scene_file), spec}}).front());
+    if (!outcome.ok) {
+      // The worker's message usually names the spec already.
+      throw BackendError(outcome.error.find(spec) != std::string::npos
+                             ? outcome.error
+                             : spec + ": " + outcome.error);
+    }
+    return std::move(outcome.frame);
+  }
+
+ private:
+  ScratchDir logs_{"workers"};
+  WorkerPool pool_{WorkerPool::Options{.log_dir = logs_.path()}};
+};
+
+}  // namespace
+
+Frame renderBackend(const BackendSpec& backend, const Scene& scene, const fs::path& scene_file) {
   if (backend.kind == BackendSpec::Kind::Reference) return renderWith(backend, scene);
-  return renderInChild(scene_file, backend.text, out_dir);
+  static GlWorkers workers;
+  return workers.render(scene_file, backend.text);
 }
 
 }  // namespace rc

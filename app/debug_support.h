@@ -1,7 +1,7 @@
-// What `explain`, `reduce` and the variant probes share: scratch folders, rendering a
-// fixture file with a backend in a child process (`rastercheck render`, as `run` does,
-// so a driver crash costs one render and each child picks its own GL driver), and why
-// such a child failed.
+// What `explain`, `reduce`, the variant probes and the campaigns share: scratch folders,
+// rendering a fixture file with a GL backend in another process (a `rastercheck worker`
+// or a `rastercheck render` child, as `run` does, so a driver crash costs one render and
+// each process picks its own GL driver), and why such a child failed.
 #pragma once
 
 #include <filesystem>
@@ -43,14 +43,10 @@ Job renderJob(const std::filesystem::path& scene_file, const std::string& spec,
 // already names), or how it died.
 std::string childFailure(const Job& job, const std::vector<std::string>& also_strip = {});
 
-// Renders in a child process and reads the frame back. Throws BackendError (one line,
-// naming the spec) when the child fails.
-Frame renderInChild(const std::filesystem::path& scene_file, const std::string& spec,
-                    const std::filesystem::path& out_dir);
-
-// Renders `scene` with `backend`: the reference in this process, GL in a child process
-// that reads `scene_file` (which must hold the same scene). Throws BackendError.
+// Renders `scene` with `backend`: the reference in this process, GL in a worker process
+// (`rastercheck worker`, one per spec, kept for the rest of this process) that reads
+// `scene_file` (which must hold the same scene). Throws BackendError.
 Frame renderBackend(const BackendSpec& backend, const Scene& scene,
-                    const std::filesystem::path& scene_file, const std::filesystem::path& out_dir);
+                    const std::filesystem::path& scene_file);
 
 }  // namespace rc

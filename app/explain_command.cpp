@@ -79,16 +79,14 @@ int explainCommand(const ExplainArgs& args) {
   });
   Json doc = pixelHistory(scene, query, frame);
 
-  // Each backend renders its own frame (GL in a child process) and is compared with the
+  // Each backend renders its own frame (GL in a worker process) and is compared with the
   // reference frame as `compare` would.
   Json out_backends = Json::object();
   bool backend_failed = false;
   if (!backends.empty()) {
-    ScratchDir scratch("explain");
     for (std::size_t b = 0; b < backends.size(); ++b) {
       try {
-        const Frame other = renderBackend(backends[b], scene, fs::absolute(args.scene),
-                                          scratch.path() / fmt::format("backend{}", b));
+        const Frame other = renderBackend(backends[b], scene, fs::absolute(args.scene));
         checkSameSize(frame, other, args.scene, backends[b].text);
         out_backends[backends[b].text] = backendPixel(
             backends[b].text, frame, other, pairTolerances(frame, other, scene.tolerance, cli), i);

@@ -64,8 +64,8 @@ class Reducer {
         file = dir / "scene.json";
         writeSceneFile(scene, file);
       }
-      const Frame expected = renderBackend(expected_, scene, file, dir / "expected");
-      const Frame actual = renderBackend(actual_, scene, file, dir / "actual");
+      const Frame expected = renderBackend(expected_, scene, file);
+      const Frame actual = renderBackend(actual_, scene, file);
       checkSameSize(expected, actual, args_.expected, args_.actual);
       Frame third;
       const Frame* uncertainty = &expected;

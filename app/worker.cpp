@@ -16,6 +16,7 @@
 #include "fixtures/errors.h"
 #include "fixtures/frame_stream.h"
 #include "fixtures/loader.h"
+#include "gl_backend/gl_testing.h"
 
 namespace rc::worker {
 namespace {
@@ -66,6 +67,17 @@ int workerCommand(const std::string& spec) {
     std::string payload;
     try {
       const Scene scene = loadScene(request["fixture"].get<std::string>());
+      // A test-only fault for this render alone (the mutation study): set in the hooks,
+      // which take precedence over RASTERCHECK_GL_FAULT, and cleared after the render.
+      struct FaultScope {
+        explicit FaultScope(const nlohmann::json& r) {
+          if (r.contains("fault") && r["fault"].is_string())
+            gl::testing::hooks().faults = gl::testing::parseFaults(r["fault"].get<std::string>());
+        }
+        ~FaultScope() { gl::testing::hooks().faults = {}; }
+        FaultScope(const FaultScope&) = delete;
+        FaultScope& operator=(const FaultScope&) = delete;
+      } fault(request);
       payload = encodeFrame(renderWith(backend, scene));
     } catch (const InputError& e) {
       kind = ReplyKind::InputError;

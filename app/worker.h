@@ -2,7 +2,9 @@
 // backend (app/worker_pool.h), and the wire protocol between the two. A worker loads its
 // backend once (GL driver and context on the first render) and renders fixture after
 // fixture:
-//   request, parent -> worker on stdin: one JSON line {"id": N, "fixture": "/abs/f.json"}
+//   request, parent -> worker on stdin: one JSON line {"id": N, "fixture": "/abs/f.json"},
+//   with "fault": "SETTING" (test-only) to render this fixture alone with that
+//   RASTERCHECK_GL_FAULT setting (gl_backend/gl_testing.h)
 //   reply, worker -> parent on fd 3: a ReplyHeader, then `length` bytes: the frame as
 //   encodeFrame() gives it (kind Frame), or a one-line message (the other kinds).
 // Its stdout and stderr (driver chatter, warnings) go to a log file the parent reads.

@@ -158,10 +158,10 @@ WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
 }
 
 bool WorkerPool::send(Worker& w, const Task& task) {
+  nlohmann::json request{{"id", task.ticket}, {"fixture", task.request.fixture.string()}};
+  if (!task.request.fault.empty()) request["fault"] = task.request.fault;
   const std::string line =
-      nlohmann::json{{"id", task.ticket}, {"fixture", task.request.fixture.string()}}.dump(
-          -1, ' ', false, nlohmann::json::error_handler_t::replace) +
-      "\n";
+      request.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   std::error_code ec;
   w.log_start = fs::file_size(w.log, ec);
   if (ec) w.log_start = 0;

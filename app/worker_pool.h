@@ -24,6 +24,9 @@ namespace rc {
 struct RenderRequest {
   std::filesystem::path fixture;  // absolute
   std::string spec;
+  // Test-only: a RASTERCHECK_GL_FAULT setting for this render alone (gl_backend/gl_testing.h),
+  // so that the mutation study's faulted renders share the clean renders' workers.
+  std::string fault;
 };
 
 struct RenderOutcome {

@@ -67,22 +67,20 @@ fs::path scratchRoot() {
 }
 
 std::optional<Frame> renderInChild(const fs::path& fixture, const std::string& spec,
-                                   std::string& error, int& exit_code, const std::string& env) {
+                                   std::string& error, int& exit_code, const std::string& fault) {
   // `rastercheck worker` processes, as `run` keeps them (app/worker_pool.h): the frame comes
   // back through a pipe, so neither side encodes or decodes an image (and neither loads
-  // OpenImageIO for it: fixtures/image_io.h), and the renders of one test with the same
-  // `env` share one worker: one pool per `env`.
-  (void)scratchRoot();  // made first, so that it outlives the pools (their logs are in it)
-  static std::map<std::string, std::unique_ptr<WorkerPool>> pools;
-  std::unique_ptr<WorkerPool>& pool = pools[env];
-  if (!pool) {
+  // OpenImageIO for it: fixtures/image_io.h), and every render of a test process with one
+  // backend, faulted or not, shares one worker (the fault travels with the request).
+  (void)scratchRoot();  // made first, so that it outlives the pool (its logs are in it)
+  static WorkerPool pool([] {
     WorkerPool::Options options;
-    options.log_dir = scratchRoot() / fmt::format("workers{}", pools.size());
+    options.log_dir = scratchRoot() / "workers";
     options.program = RC_EXE;
-    if (!env.empty()) options.environment.push_back(env);
-    pool = std::make_unique<WorkerPool>(options);
-  }
-  RenderOutcome outcome = pool->renderAll({RenderRequest{fs::absolute(fixture), spec}}).front();
+    return options;
+  }());
+  RenderOutcome outcome =
+      pool.renderAll({RenderRequest{fs::absolute(fixture), spec, fault}}).front();
   if (outcome.ok) {
     exit_code = 0;
     return std::move(outcome.frame);
@@ -131,9 +129,9 @@ bool backendStarts(const std::string& spec, std::string& why) {
 }
 
 BackendRender renderWithBackend(const fs::path& fixture, const std::string& spec,
-                                const std::string& env) {
+                                const std::string& fault) {
   BackendRender r;
-  r.frame = renderInChild(fixture, spec, r.error, r.exit_code, env);
+  r.frame = renderInChild(fixture, spec, r.error, r.exit_code, fault);
   if (!r.frame && r.exit_code == 3) {
     std::string why;
     if (!backendStarts(spec, why)) {

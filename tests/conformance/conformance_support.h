@@ -28,13 +28,14 @@ std::vector<std::string> knownBackends();
 std::filesystem::path scratchRoot();
 
 // Renders `fixture` with `spec` in a `rastercheck worker` process (the path `run` takes;
-// the frame comes back through a pipe) and returns the frame. `env` (e.g.
-// "RASTERCHECK_GL_FAULT=shift_x=0.5") is set for the worker only; renders with the same
-// `env` reuse this process's worker of that backend. On failure returns nullopt and sets
+// the frame comes back through a pipe) and returns the frame. `fault` (e.g. "shift_x=0.5",
+// a RASTERCHECK_GL_FAULT setting) applies to this render only; every render of a backend
+// in this process reuses its worker. On failure returns nullopt and sets
 // `error` to the one-line reason and `exit_code` to what `rastercheck render` exits with
 // (2 bad fixture, 3 the backend could not render).
 std::optional<Frame> renderInChild(const std::filesystem::path& fixture, const std::string& spec,
-                                   std::string& error, int& exit_code, const std::string& env = "");
+                                   std::string& error, int& exit_code,
+                                   const std::string& fault = "");
 
 // The reference render of a fixture, in this process (the same code path as
 // `rastercheck render --backend ref`, without a child process: the reference is plain
@@ -56,7 +57,7 @@ struct BackendRender {
   int exit_code = 0;
 };
 BackendRender renderWithBackend(const std::filesystem::path& fixture, const std::string& spec,
-                                const std::string& env = "");
+                                const std::string& fault = "");
 
 // The classes ("visibility", "depth", "shading") whose status is fail in `result`.
 std::set<std::string> failingClasses(const PairResult& result);

@@ -76,10 +76,9 @@ class MutationTest : public testing::Test {
       GTEST_SKIP() << backend_ << " cannot start on this machine: " << control.error;
     }
     ASSERT_TRUE(control.frame) << backend_ << " failed on " << m_.original << ": " << control.error;
-    const BackendRender mutant =
-        m_.gl_fault.empty() ? renderWithBackend(m_.mutant, backend_)
-                            : renderWithBackend(m_.original, backend_,
-                                                fmt::format("{}={}", kFaultVariable, m_.gl_fault));
+    const BackendRender mutant = m_.gl_fault.empty()
+                                     ? renderWithBackend(m_.mutant, backend_)
+                                     : renderWithBackend(m_.original, backend_, m_.gl_fault);
     ASSERT_TRUE(mutant.frame) << backend_ << " failed on the mutant: " << mutant.error;
     // The test-only fault hook must have run: a backend that ignored the variable would
     // render the original and the self-test would prove nothing.

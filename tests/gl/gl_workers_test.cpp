@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "app/worker_pool.h"
 #include "tests/support/command.h"
 
 namespace fs = std::filesystem;
@@ -140,6 +141,42 @@ TEST(GlWorkers, TheFaultsHangAndCrashARenderOnTheirOwn) {
                                " --backend gl:egl:llvmpipe --out " + (dir / "g").string(),
                            std::string("RASTERCHECK_GL_FAULT=crash=") + kVictim);
   EXPECT_EQ(other.code, 0) << other.out;
+  fs::remove_all(dir);
+}
+
+// A request's own fault (the mutation study's faulted renders) applies to that render
+// alone: one worker renders clean, faulted, clean, and the two clean frames are the same
+// to the bit while the faulted one differs and says it was faulted.
+TEST(GlWorkers, ARequestsFaultAppliesToThatRenderAlone) {
+  const fs::path dir = scratch("request_fault");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  rc::WorkerPool::Options options;
+  options.log_dir = dir / "workers";
+  options.program = RC_EXE;
+  rc::WorkerPool pool(options);
+  const fs::path fixture = catalog("shading/sphere_gouraud_low.json");
+  auto render = [&](const std::string& fault) {
+    rc::RenderOutcome o = pool.renderAll({{fixture, "gl:egl:llvmpipe", fault}}).front();
+    EXPECT_TRUE(o.ok) << o.error;
+    return o.frame;
+  };
+  const rc::Frame before = render("");
+  const rc::Frame faulted = render("light_scale=1.5");
+  const rc::Frame after = render("");
+  EXPECT_EQ(pool.workersStarted(), 1);
+  EXPECT_FALSE(before.meta.contains("fault_injected"));
+  EXPECT_TRUE(faulted.meta.contains("fault_injected")) << faulted.meta.dump();
+  EXPECT_FALSE(after.meta.contains("fault_injected"));
+  EXPECT_NE(faulted.color, before.color) << "every light 50 % brighter changed nothing";
+  EXPECT_EQ(after.color, before.color);
+  EXPECT_EQ(after.depth, before.depth);
+  EXPECT_EQ(after.id, before.id);
+  // A setting the worker cannot parse is that request's input error, not the worker's end.
+  const rc::RenderOutcome bad = pool.renderAll({{fixture, "gl:egl:llvmpipe", "no_such=1"}}).front();
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.error.find("no_such"), std::string::npos) << bad.error;
+  EXPECT_EQ(render("").color, before.color);
+  EXPECT_EQ(pool.workersStarted(), 1);
   fs::remove_all(dir);
 }
 
