@@ -11,6 +11,7 @@
 #include "compare/compare.h"
 #include "fixtures/errors.h"
 #include "synthetic_frames.h"
+#include "tests/support/printers.h"
 
 namespace rc {
 namespace {

@@ -41,6 +41,9 @@ struct Case {
   std::string reference = "ref";
 };
 
+// The case's fixture and reference, not its bytes, in the test's listing (and ctest name).
+void PrintTo(const Case& c, std::ostream* os) { *os << c.fixture << " against " << c.reference; }
+
 class ExplainAddsUp : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ExplainAddsUp, TermsAddUpAndFinalIsTheFrame) {

@@ -143,6 +143,9 @@ struct AgreementCase {
   std::function<void(Scene&)> edit;
 };
 
+// The case's name, not its bytes, in the test's listing (and so in its ctest name).
+void PrintTo(const AgreementCase& c, std::ostream* os) { *os << c.name; }
+
 const AgreementCase kCases[] = {
     {"phong_blinn", [](Scene&) {}},
     {"phong_phong_inverse",

@@ -11,6 +11,7 @@
 
 #include "gl_backend/gl_testing.h"
 #include "tests/gl/gl_test_util.h"
+#include "tests/support/printers.h"
 
 namespace rc::gltest {
 namespace {

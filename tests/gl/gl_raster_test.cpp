@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gl/gl_test_util.h"
+#include "tests/support/printers.h"
 
 namespace rc::gltest {
 namespace {
