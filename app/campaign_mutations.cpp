@@ -273,8 +273,9 @@ class MutationStudy {
                 compareFrames(ref.frame, good, ref.frame,
                               pairTolerances(ref.frame, good, scene.tolerance, cli_)));
           r.control_fails = controls[p.backend];
+          const Frame seen = effectFrame(good, b.frame, ref.frame);
           r.effect_fails = failingClasses(compareFrames(
-              good, b.frame, ref.frame, pairTolerances(good, b.frame, scene.tolerance, cli_)));
+              good, seen, ref.frame, pairTolerances(good, seen, scene.tolerance, cli_)));
           PairResult detected =
               compareFrames(ref.frame, b.frame, ref.frame,
                             pairTolerances(ref.frame, b.frame, scene.tolerance, cli_));

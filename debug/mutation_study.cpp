@@ -108,6 +108,27 @@ MutationVerdict mutationVerdictFromString(const std::string& text) {
   throw InputError(fmt::format("unknown mutation verdict \"{}\"", text));
 }
 
+Frame effectFrame(const Frame& clean, const Frame& faulted, const Frame& reference) {
+  for (const Frame* f : {&faulted, &reference}) {
+    if (f->width != clean.width || f->height != clean.height || f->samples != clean.samples)
+      throw InputError(fmt::format("mutation study: frames of {}x{} ({} samples) and {}x{} ({})",
+                                   clean.width, clean.height, clean.samples, f->width, f->height,
+                                   f->samples));
+  }
+  Frame out = faulted;
+  const std::size_t n = clean.pixelCount();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (reference.id[i] == clean.id[i]) continue;
+    out.depth[i] = clean.depth[i];
+    for (int c = 0; c < 4; ++c) out.color[4 * i + c] = clean.color[4 * i + c];
+    if (clean.multisampled()) {
+      for (int s = 0; s < clean.samples; ++s)
+        out.sample_depth[clean.sampleIndex(s, i)] = clean.sample_depth[clean.sampleIndex(s, i)];
+    }
+  }
+  return out;
+}
+
 MutationVerdict judgeMutation(const std::string& cls, const std::set<std::string>& control_fails,
                               const std::set<std::string>& effect_fails,
                               const std::set<std::string>& detected_fails) {

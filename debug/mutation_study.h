@@ -10,6 +10,8 @@
 //   control  = compare(REF, CLEAN)                      (what the harness sees without fault)
 //   effect   = compare(CLEAN, FAULTED, uncertainty REF) (what the fault did to the driver)
 //   detected = compare(REF, FAULTED)                    (what the harness sees with it)
+// `effect` sees FAULTED through effectFrame(): only at the pixels a comparison with REF
+// judges in depth and shading (REF shows the primitive CLEAN shows).
 // The fault changes some pixel beyond its allowance when `effect` fails in the fault's
 // class; the scene counts for that fault only then, and only when `control` does not fail
 // in that class (else a failure would prove nothing). It is caught when `detected` fails
@@ -24,6 +26,8 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "fixtures/frame.h"
 
 namespace rc {
 
@@ -68,6 +72,18 @@ const char* toString(MutationVerdict v);
 MutationVerdict mutationVerdictFromString(const std::string& text);  // throws InputError
 
 // The verdict from the classes each comparison fails in.
+// The faulted frame as the effect comparison sees it: at every pixel where the reference
+// shows another primitive (or the background) than the clean driver frame, depth and
+// colour (and each sample's depth, multisampled) are the clean frame's. No comparison with
+// the reference judges depth or colour at such a pixel (its visibility differs), and the
+// reference's uncertainty channels there describe the other primitive, so an allowance
+// read from them means nothing for this one (zero at a steep edge: seed 20261213 scene 3
+// on softpipe counted a depth bias of 64 d24 steps as an effect at one such pixel, where
+// every pixel the reference judges allows more than 64). Ids are kept: visibility effects
+// are judged everywhere, as the comparison with the reference judges visibility. Throws
+// InputError when the three frames differ in size or sample count.
+Frame effectFrame(const Frame& clean, const Frame& faulted, const Frame& reference);
+
 MutationVerdict judgeMutation(const std::string& cls, const std::set<std::string>& control_fails,
                               const std::set<std::string>& effect_fails,
                               const std::set<std::string>& detected_fails);

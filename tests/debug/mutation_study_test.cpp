@@ -115,5 +115,34 @@ TEST(MutationStudy, TalliesCountOnlyScenesWithAnEffect) {
   EXPECT_THROW(mutationResultFromJson(bad, "x"), InputError);
 }
 
+// The effect comparison sees the faulted frame only where the reference shows the clean
+// frame's primitive: elsewhere depth and colour are the clean frame's, ids are the faulted.
+TEST(MutationStudy, TheEffectFrameKeepsOnlyWhatTheReferenceJudges) {
+  const float clear[4] = {0, 0, 0, 1};
+  Frame ref, clean, faulted;
+  ref.allocate(4, 1, clear, 1.0f, true);
+  clean.allocate(4, 1, clear, 1.0f, false);
+  faulted.allocate(4, 1, clear, 1.0f, false);
+  ref.id = {1, 1, 2, 0};    // pixel 2: another primitive; pixel 3: background
+  clean.id = {1, 1, 1, 1};  // the driver covers all four with primitive 1
+  faulted.id = {1, 3, 1, 1};
+  for (std::size_t i = 0; i < 4; ++i) {
+    clean.depth[i] = 0.5f;
+    faulted.depth[i] = 0.5f + 0.1f * static_cast<float>(i + 1);
+    clean.color[4 * i] = 0.25f;
+    faulted.color[4 * i] = 0.75f;
+  }
+  const Frame seen = effectFrame(clean, faulted, ref);
+  EXPECT_EQ(seen.id, faulted.id);
+  EXPECT_EQ(seen.depth, (std::vector<float>{faulted.depth[0], faulted.depth[1], 0.5f, 0.5f}));
+  EXPECT_EQ(seen.color[0], 0.75f);
+  EXPECT_EQ(seen.color[4], 0.75f);
+  EXPECT_EQ(seen.color[8], 0.25f);
+  EXPECT_EQ(seen.color[12], 0.25f);
+  Frame small;
+  small.allocate(2, 1, clear, 1.0f, false);
+  EXPECT_THROW(effectFrame(clean, small, ref), InputError);
+}
+
 }  // namespace
 }  // namespace rc
