@@ -7,7 +7,13 @@
 # kept out with SKIP_UNITY_BUILD_INCLUSION where its target is defined.
 # Not for the reference renderer (rc_reference, 9 files, 32 s): what GCC inlines across its
 # files is tuned against bench/reference, and a batch would change it.
+# RASTERCHECK_UNITY_BUILD=OFF compiles file by file: compile_commands.json then names each
+# source file (clang-tidy, clangd); the dev preset sets it.
+option(RASTERCHECK_UNITY_BUILD "Compile targets as unity batches of 8 files" ON)
 function(rc_unity_build)
+  if(NOT RASTERCHECK_UNITY_BUILD)
+    return()
+  endif()
   foreach(target IN LISTS ARGN)
     set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
   endforeach()
