@@ -737,11 +737,34 @@ class Comparator {
                2.0 * (tol_.depth.fail + depthAllowance(i, u_.blend_slope[i]));
   }
 
+  // The pixel whose uncertainty channels describe the expected frame's fragment at pixel
+  // (x, y), index i: i itself, unless the uncertainty frame is another frame (driver
+  // against driver) that shows another primitive there. Then a neighbour (8-connected)
+  // where it shows the expected primitive: a primitive's depth slope is one plane's
+  // gradient, the same at every pixel it covers, and its vertices' reach changes by a
+  // fraction of a step across a pixel. i when no neighbour shows it (no allowance is known).
+  std::size_t describing(int x, int y, std::size_t i) const {
+    if (&u_ == &e_ || u_.id[i] == e_.id[i]) return i;
+    const std::uint32_t want = e_.id[i];
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nx = x + dx;
+        const int ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= e_.width || ny >= e_.height) continue;
+        const std::size_t j =
+            static_cast<std::size_t>(ny) * static_cast<std::size_t>(e_.width) + nx;
+        if (u_.id[j] == want) return j;
+      }
+    }
+    return i;
+  }
+
   // dz is over warn: check it against the pixel's slope allowance.
-  __attribute__((noinline)) void depthOverBase(int, int, std::size_t i, double dz) {
+  __attribute__((noinline)) void depthOverBase(int x, int y, std::size_t i, double dz) {
     DepthStats& d = r_.depth;
-    const double slope = depthSlope(i);  // NaN excuses nothing
-    const double allow = depthAllowance(i, slope);
+    const std::size_t k = have_uncertainty_ ? describing(x, y, i) : i;
+    const double slope = depthSlope(k);  // NaN excuses nothing
+    const double allow = depthAllowance(k, slope);
     const Thresholds at = tol_.depth.raisedBy(allow);
     if (maps_) maps_->depth_tolerance[i] = static_cast<float>(at.warn);
     d.max_slope = std::max(d.max_slope, slope);

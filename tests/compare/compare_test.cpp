@@ -806,6 +806,45 @@ TEST(DepthSlope, TheAllowanceIsTheReferencesSlopeAtThePixel) {
   EXPECT_EQ(off(std::ceil(tol.depth.fail + allowance) + 1.0).depth.over_fail, 1u);
 }
 
+// Driver against driver with the reference as the uncertainty frame: where both drivers
+// cover a pixel with primitive 7 but the reference shows primitive 9 there (an edge the
+// reference snapped the other way), primitive 7's slope comes from the neighbour where the
+// reference shows 7; with no such neighbour nothing is excused.
+TEST(DepthSlope, DriverAgainstDriverTakesThePrimitivesSlopeFromANeighbour) {
+  const float clear[4] = {0, 0, 0, 0};
+  Frame ref;
+  ref.allocate(64, 16, clear, 1.0f, true);
+  ref.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
+  Frame gl;
+  gl.allocate(64, 16, clear, 1.0f, false);
+  gl.meta = {{"backend", "gl:egl:llvmpipe"}, {"subpixel_bits", 8}};
+  const double slope = 40000.0;  // steps/px
+  auto depthAt = [](int x) { return static_cast<float>(std::nearbyint(2e6 + 40000.0 * x) / kD24); };
+  for (int x = 2; x <= 60; ++x) {
+    const std::size_t i = ref.index(x, 7);
+    gl.id[i] = 7;
+    gl.depth[i] = depthAt(x);
+    gl.color[i * 4 + 3] = 1.0f;
+    ref.id[i] = x < 60 ? 7 : 9;  // the reference shows another primitive at x = 60
+    ref.depth[i] = gl.depth[i];
+    ref.color[i * 4 + 3] = 1.0f;
+    ref.depth_slope[i] = x < 60 ? static_cast<float>(slope) : 0.0f;
+  }
+  const Tolerances tol = tolerancesForFrames(gl, gl);
+  const double band = compareFrames(gl, gl, ref, tol).depth.band_px;
+  const double allowance = slope * band;
+  ASSERT_GT(allowance, tol.depth.fail + 2.0) << "the test needs a slope allowance to show";
+  Frame other = gl;
+  const std::size_t probe = ref.index(60, 7);
+  other.depth[probe] = static_cast<float>(
+      (std::nearbyint(gl.depth[probe] * kD24) + std::floor(tol.depth.warn + allowance)) / kD24);
+  const PairResult within = compareFrames(gl, other, ref, tol);
+  EXPECT_EQ(within.depth.status, Status::Pass) << "allowance " << allowance;
+  // The same pixel alone, no neighbour where the reference shows primitive 7: strict.
+  for (int x = 2; x < 60; ++x) ref.id[ref.index(x, 7)] = 9;
+  EXPECT_EQ(compareFrames(gl, other, ref, tol).depth.over_fail, 1u);
+}
+
 // Missing and extra pixels near the clear depth: the reference's clear_gap says how close
 // the fragment's test against the clear depth came to flipping.
 TEST_F(CompareTest, ClearGapExcusesMissingOnlyWithinOneDepthTolerance) {
