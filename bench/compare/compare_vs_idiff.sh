@@ -11,7 +11,8 @@
 # (e.g. main's) in the same rounds. Each command's CPU time (user + sys) is printed too.
 # RC_EXR_COMPRESSION=LIST re-encodes the two frame.exr files with oiiotool before timing,
 # one measurement per entry ("asis" keeps what `render` wrote), e.g. "asis zip none".
-# Rounds alternate the two commands so that both see the same machine load; the medians
+# Rounds alternate the commands, each round starting with the next one, so that all see the
+# same machine load and none is always first; the medians
 # and minimums are printed. Wall-clock seconds.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
@@ -67,12 +68,21 @@ for comp in $compressions; do
   compare_times=()
   baseline_times=()
   idiff_times=()
+  # Each round starts with another command (the first of a round measured ~0.15 s slower
+  # than the same binary second: an order effect, not a difference of the programs).
+  run_one() {
+    case $1 in
+      compare) compare_times+=("$(seconds "$exe" compare "$dir/ref" "$dir/gl" --out "$work/report-$comp" "${compare_args[@]}")") ;;
+      baseline)
+        if [[ -n ${RC_BASELINE:-} ]]; then
+          baseline_times+=("$(seconds "$RC_BASELINE" compare "$dir/ref" "$dir/gl" --out "$work/baseline-$comp")")
+        fi ;;
+      idiff) idiff_times+=("$(seconds idiff "$dir/ref/color.png" "$dir/gl/color.png")") ;;
+    esac
+  }
+  order=(compare baseline idiff)
   for ((i = 0; i < rounds; ++i)); do
-    compare_times+=("$(seconds "$exe" compare "$dir/ref" "$dir/gl" --out "$work/report-$comp" "${compare_args[@]}")")
-    if [[ -n ${RC_BASELINE:-} ]]; then
-      baseline_times+=("$(seconds "$RC_BASELINE" compare "$dir/ref" "$dir/gl" --out "$work/baseline-$comp")")
-    fi
-    idiff_times+=("$(seconds idiff "$dir/ref/color.png" "$dir/gl/color.png")")
+    for ((k = 0; k < 3; ++k)); do run_one "${order[(i + k) % 3]}"; done
   done
   echo "frame.exr $comp (${exr_size} KiB), $rounds rounds:"
   echo "  rastercheck compare ${RC_COMPARE_ARGS:-}: $(stats "${compare_times[@]}")"
