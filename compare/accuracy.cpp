@@ -181,9 +181,11 @@ std::string verdictCell(const AccuracyPair& p) {
     parts.push_back(
         fmt::format("visibility {} hard px{}", p.hard, at(p.visibility_worst, p.height)));
   if (p.depth_status != Status::Pass)
-    parts.push_back(fmt::format("depth {} steps{}", shortNumber(p.depth_max), at(p.depth_worst, p.height)));
+    parts.push_back(
+        fmt::format("depth {} steps{}", shortNumber(p.depth_max), at(p.depth_worst, p.height)));
   if (p.shading_status != Status::Pass)
-    parts.push_back(fmt::format("shading {}{}", shortNumber(p.shading_max), at(p.shading_worst, p.height)));
+    parts.push_back(
+        fmt::format("shading {}{}", shortNumber(p.shading_max), at(p.shading_worst, p.height)));
   std::string out = toString(p.status);
   for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? "; " : ": ") + parts[i];
   return out;
@@ -228,7 +230,8 @@ std::vector<std::string> differenceSummary(const std::vector<const AccuracyPair*
                     at(depth_worst->depth_worst, depth_worst->height)));
   if (shading_worst && shading_worst->shading_max > 0.0)
     out.push_back(fmt::format("Colour differs in {} fixtures, by up to {} 8-bit units (`{}`{}).",
-                              shading_fx, shortNumber(shading_worst->shading_max), shading_worst->fixture,
+                              shading_fx, shortNumber(shading_worst->shading_max),
+                              shading_worst->fixture,
                               at(shading_worst->shading_worst, shading_worst->height)));
   return out;
 }
@@ -391,7 +394,8 @@ void perceptualTable(const std::map<Group, std::vector<const AccuracyPair*>>& gr
     }
     if (n == 0) continue;
     line(fmt::format("| `{}` | `{}` | {} | {} | {} (`{}`) | {} |", g.second, g.first, n,
-                     shortNumber(sum / static_cast<double>(n)), shortNumber(worst), worst_fixture, shortNumber(max)));
+                     shortNumber(sum / static_cast<double>(n)), shortNumber(worst), worst_fixture,
+                     shortNumber(max)));
   }
 }
 
@@ -495,8 +499,9 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
       Totals t;
       for (const AccuracyPair* p : groups[g]) t.add(*p);
       line(fmt::format("| `{}` | `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} |", g.second,
-                       g.first, t.pairs, t.verdicts(), t.hard, t.ambiguous, shortNumber(t.depth_max),
-                       shortNumber(t.depth_p99), shortNumber(t.shading_max), shortNumber(t.shadingMean()),
+                       g.first, t.pairs, t.verdicts(), t.hard, t.ambiguous,
+                       shortNumber(t.depth_max), shortNumber(t.depth_p99),
+                       shortNumber(t.shading_max), shortNumber(t.shadingMean()),
                        t.psnr_min ? shortNumber(*t.psnr_min) : "identical"));
     }
 
@@ -523,8 +528,8 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
       line("|---|---|---|---|---|---|---|---|---|---|---|");
       for (const auto& [tag, t] : per_tag)
         line(fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |", cell(tag), t.pairs,
-                         t.verdicts(), t.hard, t.ambiguous, shortNumber(t.depth_max), shortNumber(t.shading_max),
-                         shortNumber(t.shadingMean())));
+                         t.verdicts(), t.hard, t.ambiguous, shortNumber(t.depth_max),
+                         shortNumber(t.shading_max), shortNumber(t.shadingMean())));
     }
 
     line();
@@ -579,10 +584,11 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
     for (const auto& [a, b] : bits)
       if (a > 0 && b > 0)
         line(fmt::format("Subpixel bits: `{}` {}, `{}` {}.", g.first, a, g.second, b));
-    line(fmt::format(
-        "Visibility: {} hard and {} ambiguous pixels in all; depth up to {} "
-        "steps; shading up to {} (mean {}).",
-        t.hard, t.ambiguous, shortNumber(t.depth_max), shortNumber(t.shading_max), shortNumber(t.shadingMean())));
+    line(
+        fmt::format("Visibility: {} hard and {} ambiguous pixels in all; depth up to {} "
+                    "steps; shading up to {} (mean {}).",
+                    t.hard, t.ambiguous, shortNumber(t.depth_max), shortNumber(t.shading_max),
+                    shortNumber(t.shadingMean())));
     line();
     line("What differs:");
     line();
@@ -600,8 +606,9 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
       if (p->mismatched == 0 && p->depth_max == 0.0 && p->shading_max == 0.0) continue;
       line(fmt::format("| `{}` | {} | {} / {} ({}){} | {}, {}{} | {}, {}{} |", p->fixture,
                        toString(p->status), p->hard, p->ambiguous, p->ambiguous_by_depth_gap,
-                       at(p->visibility_worst, p->height), shortNumber(p->depth_max), shortNumber(p->depth_p99),
-                       at(p->depth_worst, p->height), shortNumber(p->shading_max), shortNumber(p->shading_mean),
+                       at(p->visibility_worst, p->height), shortNumber(p->depth_max),
+                       shortNumber(p->depth_p99), at(p->depth_worst, p->height),
+                       shortNumber(p->shading_max), shortNumber(p->shading_mean),
                        at(p->shading_worst, p->height)));
     }
     line();
