@@ -1,9 +1,10 @@
 // `rastercheck campaign --mutations --seed S --count N --backends SPEC,... --out DIR`: the
-// mutation study (debug/mutation_study.h). Per batch of random scenes, child `rastercheck
-// render` processes draw the reference and each GL backend without fault, then each GL
-// backend once per fault with RASTERCHECK_GL_FAULT set (the primitive a fault needs is
-// drawn from what the clean frame shows); the three comparisons of each (scene, backend,
-// fault) are made here with the comparator, exactly as `compare` makes them. Results go to
+// mutation study (debug/mutation_study.h). Per scene, `rastercheck worker` processes kept
+// for the study draw the reference and each GL backend without fault, then each GL backend
+// once per fault, the request carrying the RASTERCHECK_GL_FAULT setting (the primitive a
+// fault needs is drawn from what the clean frame shows); the three comparisons of each
+// (scene, backend, fault) are made here with the comparator, exactly as `compare` makes
+// them. Results go to
 // DIR/mutations/<first>-<last>.json per batch, renamed into place when complete, and
 // DIR/mutations.md and mutations.json are written from all of them: interruptible and
 // resumable like the failure campaign.
@@ -20,7 +21,6 @@
 #include "app/backends.h"
 #include "app/campaign_support.h"
 #include "app/commands.h"
-#include "app/debug_support.h"
 #include "app/paths.h"
 #include "app/report_support.h"
 #include "app/worker_pool.h"
@@ -30,9 +30,7 @@
 #include "debug/mutation_study.h"
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
-#include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
-#include "gl_backend/gl_testing.h"
 
 namespace rc {
 namespace fs = std::filesystem;

@@ -1,16 +1,13 @@
-// What `explain`, `reduce`, the variant probes and the campaigns share: scratch folders,
-// rendering a fixture file with a GL backend in another process (a `rastercheck worker`
-// or a `rastercheck render` child, as `run` does, so a driver crash costs one render and
-// each process picks its own GL driver), and why such a child failed.
+// What `explain` and `reduce` share: scratch folders, and rendering a fixture file with a
+// GL backend in a `rastercheck worker` process kept for the command (as `run` does, so a
+// driver crash costs one render and each process picks its own GL driver).
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include "app/backends.h"
-#include "app/subprocess.h"
 #include "fixtures/frame.h"
 #include "fixtures/output_folder.h"
 #include "fixtures/scene.h"
@@ -33,15 +30,6 @@ class ScratchDir {
   ScratchFolder folder_;
   std::filesystem::path path_;
 };
-
-// The job that renders `scene_file` with `spec` into `out_dir` (log beside it).
-Job renderJob(const std::filesystem::path& scene_file, const std::string& spec,
-              const std::filesystem::path& out_dir);
-
-// Why a finished job failed, in one line: the child's last error line without our
-// prefixes (and then without `also_strip`, e.g. the "<fixture>: <spec>: " a report row
-// already names), or how it died.
-std::string childFailure(const Job& job, const std::vector<std::string>& also_strip = {});
 
 // Renders `scene` with `backend`: the reference in this process, GL in a worker process
 // (`rastercheck worker`, one per spec, kept for the rest of this process) that reads

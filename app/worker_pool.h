@@ -46,7 +46,8 @@ class WorkerPool {
     // The program started in worker mode: empty for this one (`run`); a test names
     // rastercheck.
     std::filesystem::path program;
-    // NAME=VALUE entries added to the workers' environment (a test's injected GL fault).
+    // NAME=VALUE entries added to the workers' environment (e.g. the mutation study's
+    // TMPDIR under its campaign folder).
     std::vector<std::string> environment;
   };
   explicit WorkerPool(Options options);

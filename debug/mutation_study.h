@@ -75,13 +75,12 @@ MutationVerdict mutationVerdictFromString(const std::string& text);  // throws I
 // The faulted frame as the effect comparison sees it: at every pixel where the reference
 // shows another primitive (or the background) than the clean driver frame, depth and
 // colour (and each sample's depth, multisampled) are the clean frame's. No comparison with
-// the reference judges depth or colour at such a pixel (its visibility differs), and the
-// reference's uncertainty channels there describe the other primitive, so an allowance
-// read from them means nothing for this one (zero at a steep edge: seed 20261213 scene 3
-// on softpipe counted a depth bias of 64 d24 steps as an effect at one such pixel, where
-// every pixel the reference judges allows more than 64). Ids are kept: visibility effects
-// are judged everywhere, as the comparison with the reference judges visibility. Throws
-// InputError when the three frames differ in size or sample count.
+// the reference judges depth or colour at such a pixel (its visibility differs), so a
+// fault's effect there can never be caught and must not count (seed 20261213 scene 3 on
+// softpipe counted a 64-step d24 depth bias as an effect at one such edge pixel only).
+// Ids are kept: visibility effects are judged everywhere, as the comparison with the
+// reference judges visibility. Throws InputError when the three frames differ in size or
+// sample count.
 Frame effectFrame(const Frame& clean, const Frame& faulted, const Frame& reference);
 
 MutationVerdict judgeMutation(const std::string& cls, const std::set<std::string>& control_fails,
