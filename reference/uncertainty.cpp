@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "reference/fragment_ops.h"
+#include "reference/lanes.h"
 
 namespace rc::ref {
 
@@ -131,8 +132,120 @@ void lowerRow(float* row, int first, int last, double cy, const Point& a, const 
   }
 }
 
-void addSegment(const Point& a, const Point& b, const PixelRect& clip, int width, int height,
-                float* edge_dist, double reach) {
+// Lane4 values stay inside addSegment() (everything it calls on them is inlined): -Wpsabi's
+// note on passing 32-byte vectors without AVX does not apply (for the rest of the file: GCC
+// also gives it at the end of the translation unit).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+// std::max(x, 0.0) per lane: (x < 0) ? 0 : x (NaN and -0 stay as they are).
+[[gnu::always_inline]] inline Lane4 maxWithZero4(Lane4 x) {
+  return x < splat4(0.0) ? splat4(0.0) : x;
+}
+
+// lowerRow() four pixel centres at a time, for a segment with a finite len2 > 0 (the
+// callers send others to lowerRow()): in each lane the scalar code's operations on the same
+// operands ((py - a.y) * dy is the same product in every lane, computed once per row), its
+// branches as per-lane selects; a lane that needs hypot gets the scalar code's hypot step
+// on that lane's qx, qy and cur. So every pixel ends with the bits lowerRow() gives.
+// Lanes past `last` are read and written back unchanged where the row has them (`width`
+// floats), so that four pixels load and store as one vector.
+class SegmentLanes {
+ public:
+  SegmentLanes(const Point& a, const Point& b, double reach)
+      : a_(a),
+        dx_(b.x - a.x),
+        dy_(b.y - a.y),
+        len2_(dx_ * dx_ + dy_ * dy_),
+        reach_(reach),
+        vdx_(splat4(dx_)),
+        vdy_(splat4(dy_)),
+        vlen2_(splat4(len2_)),
+        ax_(splat4(a.x)),
+        ay_(splat4(a.y)),
+        vreach_(splat4(reach)) {}
+  bool usable() const { return len2_ > 0.0 && std::isfinite(len2_); }
+
+  [[gnu::always_inline]] void lowerRow(float* row, int first, int last, int width,
+                                       double cy) const {
+    using Float4 = float __attribute__((vector_size(16)));
+    const Lane4 along_y = splat4((cy - a_.y) * dy_);
+    const Lane4 vcy = splat4(cy);
+    for (int px = first; px < last; px += 4) {
+      const int n = std::min(4, last - px);
+      const bool whole = px + 4 <= width;  // four floats of the row to load and store
+      const double c0 = px + 0.5;
+      const Lane4 cx = {c0, c0 + 1.0, c0 + 2.0, c0 + 3.0};  // exact: small integers + 0.5
+      const Lane4 num = (cx - ax_) * vdx_ + along_y;
+      const Lane4 t = num >= vlen2_ ? splat4(1.0) : num <= splat4(0.0) ? splat4(0.0) : num / vlen2_;
+      const Lane4 qx = cx - (ax_ + t * vdx_);
+      const Lane4 qy = vcy - (ay_ + t * vdy_);
+      Float4 cur_f = {1.0f, 1.0f, 1.0f, 1.0f};
+      if (whole) {
+        __builtin_memcpy(&cur_f, row + px, sizeof cur_f);
+      } else {
+        for (int k = 0; k < n; ++k) cur_f[k] = row[px + k];
+      }
+      const Lane4 cur = __builtin_convertvector(cur_f, Lane4);
+      const Lane4 limit = cur + vreach_;
+      const Lane4 sum = qx * qx + qy * qy;
+      // Lanes the scalar code does not skip at its first test (NaN sums included).
+      const Mask4 in_range = Mask4{0, 1, 2, 3} < Mask4{n, n, n, n};
+      const Mask4 open = in_range & ~(sum >= limit * limit * splat4(1.0 + 0x1p-40));
+      if ((open[0] | open[1] | open[2] | open[3]) == 0) continue;
+      const Mask4 interval = (sum >= splat4(0x1p-1000)) & (sum < splat4(kInfinity));
+      const Lane4 root = sqrt4(sum);
+      const Lane4 lo = root * splat4(1.0 - 0x1p-48) - vreach_;
+      const Lane4 hi = root * splat4(1.0 + 0x1p-48) - vreach_;
+      const Mask4 lowers = lo < cur;
+      const Float4 stored = __builtin_convertvector(maxWithZero4(lo), Float4);
+      const Float4 stored_hi = __builtin_convertvector(maxWithZero4(hi), Float4);
+      const Mask4 same = __builtin_convertvector(stored == stored_hi, Mask4);
+      const Mask4 decided = open & interval & lowers & (hi < cur) & same;
+      // Lanes that need hypot: open, and the interval decides neither "no change" nor
+      // the stored value.
+      const Mask4 slow = open & ~(interval & (~lowers | decided));
+      const auto decided_f = __builtin_convertvector(decided, Float4Mask);
+      const Float4 out = decided_f ? stored : cur_f;
+      if (whole) {
+        __builtin_memcpy(row + px, &out, sizeof out);
+      } else {
+        for (int k = 0; k < n; ++k) row[px + k] = out[k];
+      }
+      if ((slow[0] | slow[1] | slow[2] | slow[3]) == 0) continue;
+      for (int k = 0; k < n; ++k) {
+        if (!slow[k]) continue;
+        const double d = std::hypot(qx[k], qy[k]) - reach_;
+        if (d < cur[k]) row[px + k] = static_cast<float>(std::max(d, 0.0));
+      }
+    }
+  }
+
+ private:
+  using Float4Mask = std::int32_t __attribute__((vector_size(16)));
+  Point a_;
+  double dx_;
+  double dy_;
+  double len2_;
+  double reach_;
+  Lane4 vdx_;
+  Lane4 vdy_;
+  Lane4 vlen2_;
+  Lane4 ax_;
+  Lane4 ay_;
+  Lane4 vreach_;
+};
+
+// Segments this short across (px, in x or y) visit the columns of their bounding box,
+// widened by the band, on every row: a superset of the per-row band that costs no
+// division per row (visiting more centres changes nothing, lowerRow()'s comment).
+constexpr double kBoxSegmentPx = 4.0;
+
+// Compiled twice, for x86-64's baseline and for AVX2 (no FMA), picked at load time; the
+// bits are the same either way.
+__attribute__((target_clones("avx2", "default"))) void addSegment(const Point& a, const Point& b,
+                                                                  const PixelRect& clip, int width,
+                                                                  int height, float* edge_dist,
+                                                                  double reach) {
   // Centres farther than 1 + reach from the segment keep their value (<= 1).
   const double band = 1.0 + reach;
   int row_first = 0;
@@ -140,6 +253,25 @@ void addSegment(const Point& a, const Point& b, const PixelRect& clip, int width
   if (!centreRange(std::min(a.y, b.y) - band, std::max(a.y, b.y) + band, clip.y0, clip.y1,
                    row_first, row_end))
     return;
+  const SegmentLanes lanes(a, b, reach);
+  const bool finite = std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(b.x) &&
+                      std::isfinite(b.y) && std::isfinite(band);
+  if (finite && std::min(std::fabs(b.x - a.x), std::fabs(b.y - a.y)) <= kBoxSegmentPx) {
+    int col_first = 0;
+    int col_end = 0;
+    if (!centreRange(std::min(a.x, b.x) - band, std::max(a.x, b.x) + band, clip.x0, clip.x1,
+                     col_first, col_end))
+      return;
+    for (int py = row_first; py < row_end; ++py) {
+      float* row = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
+      if (lanes.usable()) {
+        lanes.lowerRow(row, col_first, col_end, width, py + 0.5);
+      } else {
+        lowerRow(row, col_first, col_end, py + 0.5, a, b, reach);
+      }
+    }
+    return;
+  }
   for (int py = row_first; py < row_end; ++py) {
     const double cy = py + 0.5;
     // The part of the segment within one pixel of this row's centre line bounds the
@@ -161,8 +293,12 @@ void addSegment(const Point& a, const Point& b, const PixelRect& clip, int width
     if (!centreRange(std::min(xa, xb) - band, std::max(xa, xb) + band, clip.x0, clip.x1, col_first,
                      col_end))
       continue;
-    lowerRow(edge_dist + static_cast<std::size_t>(height - 1 - py) * width, col_first, col_end, cy,
-             a, b, reach);
+    float* row = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
+    if (lanes.usable()) {
+      lanes.lowerRow(row, col_first, col_end, width, cy);
+    } else {
+      lowerRow(row, col_first, col_end, cy, a, b, reach);
+    }
   }
 }
 

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <limits>
 #include <random>
@@ -328,6 +330,87 @@ TEST(EdgeDist, DistanceToEdgeSegmentsCappedAtOne) {
   EXPECT_FLOAT_EQ(at(0, 0), 1.0f);
   const Frame none = renderReference(s, ReferenceOptions{8, false, false});
   EXPECT_FALSE(none.hasUncertainty());
+}
+
+// addEdgeDistances() and EdgeDistanceBatch against their definition evaluated at every
+// pixel of the image for every segment (no band, no interval shortcut, no lanes): each
+// visit leaves min(cur, float(max(hypot(q) - reach, 0))) with q from the segment point
+// nearest the centre. Bit for bit, on random segments from a fraction of a pixel to longer
+// than the image (the short ones take the bounding-box rows, the long ones the per-row
+// band), in an image whose width is not a multiple of four (rows end inside a group of
+// four lanes), with and without reach, points on the segments and zero-length segments.
+TEST(EdgeDist, EqualsItsDefinitionAtEveryPixelBitForBit) {
+  constexpr int kW = 37;
+  constexpr int kH = 23;
+  const ref::PixelRect clip{0, 0, kW, kH};
+  auto oracle = [&](std::vector<float>& dist, const ref::WindowVertex* poly, int count,
+                    const double* reach) {
+    for (int i = 0; i < count; ++i) {
+      const ref::WindowVertex& a = poly[i];
+      const ref::WindowVertex& b = poly[(i + 1) % count];
+      const double r = std::max(reach[i], reach[(i + 1) % count]);
+      const double dx = b.x - a.x;
+      const double dy = b.y - a.y;
+      const double len2 = dx * dx + dy * dy;
+      for (int py = 0; py < kH; ++py) {
+        for (int px = 0; px < kW; ++px) {
+          const double cx = px + 0.5;
+          const double cy = py + 0.5;
+          double t = 0.0;
+          if (len2 > 0.0) {
+            const double num = (cx - a.x) * dx + (cy - a.y) * dy;
+            t = num >= len2 ? 1.0 : num <= 0.0 ? 0.0 : num / len2;
+          }
+          const double d = std::hypot(cx - (a.x + t * dx), cy - (a.y + t * dy)) - r;
+          float& cur = dist[static_cast<std::size_t>(kH - 1 - py) * kW + px];
+          cur = std::min(cur, static_cast<float>(std::max(d, 0.0)));
+        }
+      }
+    }
+  };
+  std::mt19937_64 rng(20261202);
+  std::uniform_real_distribution<double> pos(-4.0, kW + 4.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int lowered = 0;
+  for (int scene = 0; scene < 300; ++scene) {
+    std::vector<float> want(static_cast<std::size_t>(kW) * kH, 1.0f);
+    std::vector<float> got = want;
+    std::vector<float> batched = want;
+    ref::EdgeDistanceBatch batch;
+    for (int polygon = 0; polygon < 4; ++polygon) {
+      ref::WindowVertex v[3] = {};
+      // Sizes from a tenth of a pixel to the whole image.
+      const double size = std::pow(10.0, -1.0 + 2.5 * unit(rng));
+      v[0].x = pos(rng);
+      v[0].y = pos(rng);
+      for (int k = 1; k < 3; ++k) {
+        v[k].x = v[0].x + size * (2.0 * unit(rng) - 1.0);
+        v[k].y = v[0].y + size * (2.0 * unit(rng) - 1.0);
+      }
+      if (polygon == 1) v[1] = v[0];  // a zero-length segment
+      if (polygon == 2) {             // a vertex on a pixel centre, an edge through centres
+        v[0].x = std::floor(v[0].x) + 0.5;
+        v[0].y = std::floor(v[0].y) + 0.5;
+        v[1].y = v[0].y;
+      }
+      double reach[3] = {0.0, 0.0, 0.0};
+      if (scene % 2 == 1)
+        for (double& r : reach) r = 0.3 * unit(rng) * unit(rng);
+      oracle(want, v, 3, reach);
+      ref::addEdgeDistances(v, 3, clip, kW, kH, got.data(), reach);
+      batch.add(v, 3, reach);
+    }
+    batch.apply(clip, kW, kH, batched.data());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(got[i]), std::bit_cast<std::uint32_t>(want[i]))
+          << "scene " << scene << " pixel " << i % kW << "," << i / kW << ": " << got[i] << " want "
+          << want[i];
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(batched[i]), std::bit_cast<std::uint32_t>(want[i]))
+          << "batched, scene " << scene << " pixel " << i;
+      lowered += want[i] < 1.0f;
+    }
+  }
+  EXPECT_GT(lowered, 5000);  // the segments came near many centres
 }
 
 // A triangle cut by the near plane becomes a quadrilateral drawn as a fan; edge_dist
