@@ -793,7 +793,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
   std::uint32_t* const depth = depth_.data();
   std::uint32_t* const ids = frame_.id.data();
   ++triangles_drawn_;
-  coverage.forEachSpan([&](int py, int x_begin, int x_end) __attribute__((always_inline)) {
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
     fragments_ += static_cast<std::uint64_t>(x_end - x_begin);
     const double cy = py + 0.5;  // pixel centres
     const FragmentInterpolator::Row row = kBarycentrics ? interp.row(cy) : interp.depthRow(cy);
