@@ -770,7 +770,7 @@ class Comparator {
     d.max_slope = std::max(d.max_slope, slope);
     const double excess = dz - at.warn;
     if (excess <= 0.0) return;
-    if (blendUncertain(i)) {
+    if (blendUncertain(i) || (k != i && blendUncertain(k))) {
       ++d.blend_uncertain;
       return;
     }
@@ -801,7 +801,20 @@ class Comparator {
     const float* pa = &e_.color[i * 4];
     const float* pb = &a_.color[i * 4];
     detail::ColourNeighbourhood around;
-    if (neighbourhood) around = detail::colourNeighbourhood(e_, x, y);
+    if (neighbourhood) {
+      around = detail::colourNeighbourhood(e_, x, y);
+      // Driver against driver: the surface's colour gradient is also what the uncertainty
+      // frame (the reference) shows around the pixel, where it shows the same primitive.
+      // A driver's own neighbourhood can miss it: where its ids differ from the reference's
+      // around the pixel (legal, ambiguous edges), it finds fewer same-primitive neighbours
+      // and a flatter gradient, so an allowance the comparison with the reference gives
+      // would be missing here. The larger of the two per channel.
+      if (have_uncertainty_ && &u_ != &e_ && u_.id[i] == e_.id[i] && !u_.color.empty()) {
+        const detail::ColourNeighbourhood reference = detail::colourNeighbourhood(u_, x, y);
+        for (int c = 0; c < 4; ++c)
+          around.gradient[c] = std::max(around.gradient[c], reference.gradient[c]);
+      }
+    }
     ShadingExcess out;
     // What the reference knows at the pixel: with nearest filtering, a sample within the
     // band of a texel boundary may take the texel across it (texel_alt, RGB only); in
@@ -862,7 +875,11 @@ class Comparator {
       if (s.excess_without_texel > warn) ++r_.shading.texel_choice;
       return;
     }
-    if (blendUncertain(i)) {
+    // Driver against driver where the reference shows another primitive: its channels at
+    // the pixel describe that primitive's fragments, not the blend under the expected one;
+    // a neighbour where it shows the expected primitive does (describing()).
+    const std::size_t k = have_uncertainty_ ? describing(x, y, i) : i;
+    if (blendUncertain(i) || (k != i && blendUncertain(k))) {
       ++r_.shading.blend_uncertain;
       return;
     }

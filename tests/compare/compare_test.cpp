@@ -845,6 +845,96 @@ TEST(DepthSlope, DriverAgainstDriverTakesThePrimitivesSlopeFromANeighbour) {
   EXPECT_EQ(compareFrames(gl, other, ref, tol).depth.over_fail, 1u);
 }
 
+// Driver against driver with the reference as the uncertainty frame: at a pixel both
+// drivers and the reference show as primitive 7, whose neighbours the expected driver frame
+// shows as another primitive (edges that went the other way there, legally) while the
+// reference shows one of them as 7 with a colour gradient, the shading allowance includes
+// that gradient, as the comparison with the reference would (without the rule the first
+// comparison fails); where the reference is flat as well, nothing is excused.
+TEST(ShadingSlope, DriverAgainstDriverTakesTheGradientTheReferenceShows) {
+  const float clear[4] = {0, 0, 0, 0};
+  Frame ref;
+  ref.allocate(16, 16, clear, 1.0f, true);
+  ref.meta = {{"backend", "ref"}, {"subpixel_bits", 4}};
+  Frame gl;
+  gl.allocate(16, 16, clear, 1.0f, false);
+  gl.meta = {{"backend", "gl:egl:llvmpipe"}, {"subpixel_bits", 4}};
+  const int px = 7;
+  const int py = 7;
+  const double gradient = 200.0;  // 8-bit units per px, the reference's, to the right
+  for (int y = py - 1; y <= py + 1; ++y) {
+    for (int x = px - 1; x <= px + 1; ++x) {
+      const std::size_t i = gl.index(x, y);
+      const bool centre = x == px && y == py;
+      gl.id[i] = centre ? 7 : 8;
+      ref.id[i] = centre || (x == px + 1 && y == py) ? 7 : 8;
+      for (Frame* f : {&gl, &ref}) {
+        f->depth[i] = 0.5f;
+        for (int c = 0; c < 3; ++c) f->color[i * 4 + c] = 0.2f;
+        f->color[i * 4 + 3] = 1.0f;
+      }
+    }
+  }
+  ref.color[ref.index(px + 1, py) * 4] = static_cast<float>(0.2 + gradient / 255.0);
+  const Tolerances tol = tolerancesForFrames(gl, gl);
+  const double band = compareFrames(gl, gl, ref, tol).depth.band_px;
+  const double allowance = tol.shading_slope_factor * gradient * band;
+  ASSERT_GT(allowance, 1.0) << "the test needs a gradient allowance to show";
+  Frame other = gl;
+  other.color[other.index(px, py) * 4] =
+      static_cast<float>(0.2 + (tol.shading.fail + 0.5 * allowance) / 255.0);
+  const PairResult with = compareFrames(gl, other, ref, tol);
+  EXPECT_EQ(with.shading.over_fail, 0u) << "allowance " << allowance;
+  EXPECT_NEAR(with.shading.worst_allowance, allowance, 0.01 * allowance + 0.1);
+  // Where the reference is flat too, nothing is excused.
+  ref.color[ref.index(px + 1, py) * 4] = 0.2f;
+  EXPECT_EQ(compareFrames(gl, other, ref, tol).shading.over_fail, 1u);
+}
+
+// Driver against driver where both drivers show a transparent primitive 5 over a pixel
+// whose reference shows the opaque primitive 3 (a depth tie the drivers broke the other
+// way): what each driver blended there is described by the reference's blend channels at a
+// neighbour where it shows primitive 5 (describing()); when its blend test there was within
+// tolerance of flipping, the colours may legally differ (blend_uncertain), as at any
+// blend-uncertain pixel. With the neighbour's blend decided (a large blend_gap) the same
+// difference fails.
+TEST(BlendUncertain, DriverAgainstDriverReadsTheBlendOfTheExpectedPrimitiveNextDoor) {
+  const float clear[4] = {0, 0, 0, 0};
+  Frame ref;
+  ref.allocate(16, 16, clear, 1.0f, true);
+  ref.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
+  Frame gl;
+  gl.allocate(16, 16, clear, 1.0f, false);
+  gl.meta = {{"backend", "gl:egl:llvmpipe"}, {"subpixel_bits", 8}};
+  for (int y = 6; y <= 8; ++y) {
+    for (int x = 6; x <= 8; ++x) {
+      const std::size_t i = gl.index(x, y);
+      gl.id[i] = 5;
+      ref.id[i] = 5;
+      for (Frame* f : {&gl, &ref}) {
+        f->depth[i] = 0.5f;
+        for (int c = 0; c < 3; ++c) f->color[i * 4 + c] = 0.4f;
+        f->color[i * 4 + 3] = 0.8f;
+      }
+      ref.blend_count[i] = 1.0f;
+      ref.blend_gap[i] = 0.25f;  // steps: within tolerance of flipping
+    }
+  }
+  const std::size_t probe = ref.index(7, 7);
+  ref.id[probe] = 3;  // the reference drew no blend here
+  ref.blend_count[probe] = 0.0f;
+  ref.blend_gap[probe] = std::numeric_limits<float>::infinity();
+  const Tolerances tol = tolerancesForFrames(gl, gl);
+  Frame other = gl;
+  other.color[probe * 4] = 0.4f + 12.0f / 255.0f;  // one more layer blended: 12 units
+  const PairResult excused = compareFrames(gl, other, ref, tol);
+  EXPECT_EQ(excused.shading.over_fail, 0u);
+  EXPECT_EQ(excused.shading.blend_uncertain, 1u);
+  for (int y = 6; y <= 8; ++y)
+    for (int x = 6; x <= 8; ++x) ref.blend_gap[ref.index(x, y)] = 1e6f;
+  EXPECT_EQ(compareFrames(gl, other, ref, tol).shading.over_fail, 1u);
+}
+
 // Missing and extra pixels near the clear depth: the reference's clear_gap says how close
 // the fragment's test against the clear depth came to flipping.
 TEST_F(CompareTest, ClearGapExcusesMissingOnlyWithinOneDepthTolerance) {
