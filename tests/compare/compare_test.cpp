@@ -806,18 +806,29 @@ TEST(DepthSlope, TheAllowanceIsTheReferencesSlopeAtThePixel) {
   EXPECT_EQ(off(std::ceil(tol.depth.fail + allowance) + 1.0).depth.over_fail, 1u);
 }
 
+// A reference frame with its uncertainty channels and an llvmpipe frame, w x h, cleared to
+// transparent black at depth 1: the two sides of a driver-against-driver comparison whose
+// uncertainty frame is the reference.
+struct DriverPairFrames {
+  Frame ref;
+  Frame gl;
+};
+DriverPairFrames driverPairFrames(int w, int h, int subpixel_bits) {
+  const float clear[4] = {0, 0, 0, 0};
+  DriverPairFrames f;
+  f.ref.allocate(w, h, clear, 1.0f, true);
+  f.ref.meta = {{"backend", "ref"}, {"subpixel_bits", subpixel_bits}};
+  f.gl.allocate(w, h, clear, 1.0f, false);
+  f.gl.meta = {{"backend", "gl:egl:llvmpipe"}, {"subpixel_bits", subpixel_bits}};
+  return f;
+}
+
 // Driver against driver with the reference as the uncertainty frame: where both drivers
 // cover a pixel with primitive 7 but the reference shows primitive 9 there (an edge the
 // reference snapped the other way), primitive 7's slope comes from the neighbour where the
 // reference shows 7; with no such neighbour nothing is excused.
 TEST(DepthSlope, DriverAgainstDriverTakesThePrimitivesSlopeFromANeighbour) {
-  const float clear[4] = {0, 0, 0, 0};
-  Frame ref;
-  ref.allocate(64, 16, clear, 1.0f, true);
-  ref.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
-  Frame gl;
-  gl.allocate(64, 16, clear, 1.0f, false);
-  gl.meta = {{"backend", "gl:egl:llvmpipe"}, {"subpixel_bits", 8}};
+  auto [ref, gl] = driverPairFrames(64, 16, 8);
   const double slope = 40000.0;  // steps/px
   auto depthAt = [](int x) { return static_cast<float>(std::nearbyint(2e6 + 40000.0 * x) / kD24); };
   for (int x = 2; x <= 60; ++x) {
@@ -852,13 +863,7 @@ TEST(DepthSlope, DriverAgainstDriverTakesThePrimitivesSlopeFromANeighbour) {
 // that gradient, as the comparison with the reference would (without the rule the first
 // comparison fails); where the reference is flat as well, nothing is excused.
 TEST(ShadingSlope, DriverAgainstDriverTakesTheGradientTheReferenceShows) {
-  const float clear[4] = {0, 0, 0, 0};
-  Frame ref;
-  ref.allocate(16, 16, clear, 1.0f, true);
-  ref.meta = {{"backend", "ref"}, {"subpixel_bits", 4}};
-  Frame gl;
-  gl.allocate(16, 16, clear, 1.0f, false);
-  gl.meta = {{"backend", "gl:egl:llvmpipe"}, {"subpixel_bits", 4}};
+  auto [ref, gl] = driverPairFrames(16, 16, 4);
   const int px = 7;
   const int py = 7;
   const double gradient = 200.0;  // 8-bit units per px, the reference's, to the right
@@ -899,13 +904,7 @@ TEST(ShadingSlope, DriverAgainstDriverTakesTheGradientTheReferenceShows) {
 // blend-uncertain pixel. With the neighbour's blend decided (a large blend_gap) the same
 // difference fails.
 TEST(BlendUncertain, DriverAgainstDriverReadsTheBlendOfTheExpectedPrimitiveNextDoor) {
-  const float clear[4] = {0, 0, 0, 0};
-  Frame ref;
-  ref.allocate(16, 16, clear, 1.0f, true);
-  ref.meta = {{"backend", "ref"}, {"subpixel_bits", 8}};
-  Frame gl;
-  gl.allocate(16, 16, clear, 1.0f, false);
-  gl.meta = {{"backend", "gl:egl:llvmpipe"}, {"subpixel_bits", 8}};
+  auto [ref, gl] = driverPairFrames(16, 16, 8);
   for (int y = 6; y <= 8; ++y) {
     for (int x = 6; x <= 8; ++x) {
       const std::size_t i = gl.index(x, y);
