@@ -729,8 +729,14 @@ class Comparator {
   // Whether the fragments blended under the top one at pixel i may legally differ: a
   // blended pixel near a polygon edge (another fragment may or may not cover it) or with
   // a blended fragment's depth test within the tolerance of flipping. Its depth and colour
-  // are then not held to their tolerances (docs/tolerances.md, "Blended pixels").
-  bool blendUncertain(std::size_t i) const {
+  // are then not held to their tolerances (docs/tolerances.md, "Blended pixels"). `k` is
+  // describing(x, y, i): driver against driver, where the reference shows another
+  // primitive at i, its channels there describe that primitive's fragments, not the blend
+  // under the expected one; those at k, where it shows the expected primitive, do.
+  bool blendUncertain(std::size_t i, std::size_t k) const {
+    return blendUncertainAt(i) || (k != i && blendUncertainAt(k));
+  }
+  bool blendUncertainAt(std::size_t i) const {
     if (!have_uncertainty_ || !(u_.blend_count[i] > 0.0f)) return false;
     return static_cast<double>(u_.edge_dist[i]) <= band_ ||
            static_cast<double>(u_.blend_gap[i]) <=
@@ -744,25 +750,21 @@ class Comparator {
   // gradient, the same at every pixel it covers, and its vertices' reach changes by a
   // fraction of a step across a pixel. i when no neighbour shows it (no allowance is known).
   std::size_t describing(int x, int y, std::size_t i) const {
-    if (&u_ == &e_ || u_.id[i] == e_.id[i]) return i;
+    if (!have_uncertainty_ || &u_ == &e_ || u_.id[i] == e_.id[i]) return i;
     const std::uint32_t want = e_.id[i];
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int nx = x + dx;
-        const int ny = y + dy;
-        if (nx < 0 || ny < 0 || nx >= e_.width || ny >= e_.height) continue;
-        const std::size_t j =
-            static_cast<std::size_t>(ny) * static_cast<std::size_t>(e_.width) + nx;
-        if (u_.id[j] == want) return j;
-      }
-    }
-    return i;
+    std::size_t found = i;
+    detail::forEachNeighbour(e_, x, y, [&](std::size_t j, int, int) {
+      if (u_.id[j] != want) return true;
+      found = j;
+      return false;
+    });
+    return found;
   }
 
   // dz is over warn: check it against the pixel's slope allowance.
   __attribute__((noinline)) void depthOverBase(int x, int y, std::size_t i, double dz) {
     DepthStats& d = r_.depth;
-    const std::size_t k = have_uncertainty_ ? describing(x, y, i) : i;
+    const std::size_t k = describing(x, y, i);
     const double slope = depthSlope(k);  // NaN excuses nothing
     const double allow = depthAllowance(k, slope);
     const Thresholds at = tol_.depth.raisedBy(allow);
@@ -770,7 +772,7 @@ class Comparator {
     d.max_slope = std::max(d.max_slope, slope);
     const double excess = dz - at.warn;
     if (excess <= 0.0) return;
-    if (blendUncertain(i) || (k != i && blendUncertain(k))) {
+    if (blendUncertain(i, k)) {
       ++d.blend_uncertain;
       return;
     }
@@ -875,11 +877,7 @@ class Comparator {
       if (s.excess_without_texel > warn) ++r_.shading.texel_choice;
       return;
     }
-    // Driver against driver where the reference shows another primitive: its channels at
-    // the pixel describe that primitive's fragments, not the blend under the expected one;
-    // a neighbour where it shows the expected primitive does (describing()).
-    const std::size_t k = have_uncertainty_ ? describing(x, y, i) : i;
-    if (blendUncertain(i) || (k != i && blendUncertain(k))) {
+    if (blendUncertain(i, describing(x, y, i))) {
       ++r_.shading.blend_uncertain;
       return;
     }

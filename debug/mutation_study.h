@@ -71,7 +71,6 @@ enum class MutationVerdict {
 const char* toString(MutationVerdict v);
 MutationVerdict mutationVerdictFromString(const std::string& text);  // throws InputError
 
-// The verdict from the classes each comparison fails in.
 // The faulted frame as the effect comparison sees it: at every pixel where the reference
 // shows another primitive (or the background) than the clean driver frame, depth and
 // colour (and each sample's depth, multisampled) are the clean frame's. No comparison with
@@ -83,6 +82,7 @@ MutationVerdict mutationVerdictFromString(const std::string& text);  // throws I
 // sample count.
 Frame effectFrame(const Frame& clean, const Frame& faulted, const Frame& reference);
 
+// The verdict from the classes each comparison fails in.
 MutationVerdict judgeMutation(const std::string& cls, const std::set<std::string>& control_fails,
                               const std::set<std::string>& effect_fails,
                               const std::set<std::string>& detected_fails);

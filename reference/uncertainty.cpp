@@ -142,17 +142,17 @@ void lowerRow(float* row, int first, int last, double cy, const Point& a, const 
   return x < splat4(0.0) ? splat4(0.0) : x;
 }
 
-// lowerRow() four pixel centres at a time, for a segment with a finite len2 > 0 (the
-// callers send others to lowerRow()): in each lane the scalar code's operations on the same
-// operands ((py - a.y) * dy is the same product in every lane, computed once per row), its
-// branches as per-lane selects; a lane that needs hypot gets the scalar code's hypot step
-// on that lane's qx, qy and cur. So every pixel ends with the bits lowerRow() gives.
-// Lanes past `last` are read and written back unchanged where the row has them (`width`
-// floats), so that four pixels load and store as one vector.
+// lowerRow() four pixel centres at a time (a segment without a finite len2 > 0 goes to
+// lowerRow() itself): in each lane the scalar code's operations on the same operands ((py - a.y) *
+// dy is the same product in every lane, computed once per row), its branches as per-lane selects; a
+// lane that needs hypot gets the scalar code's hypot step on that lane's qx, qy and cur. So every
+// pixel ends with the bits lowerRow() gives. Lanes past `last` are read and written back unchanged
+// where the row has them (`width` floats), so that four pixels load and store as one vector.
 class SegmentLanes {
  public:
   SegmentLanes(const Point& a, const Point& b, double reach)
       : a_(a),
+        b_(b),
         dx_(b.x - a.x),
         dy_(b.y - a.y),
         len2_(dx_ * dx_ + dy_ * dy_),
@@ -163,10 +163,12 @@ class SegmentLanes {
         ax_(splat4(a.x)),
         ay_(splat4(a.y)),
         vreach_(splat4(reach)) {}
-  bool usable() const { return len2_ > 0.0 && std::isfinite(len2_); }
-
   [[gnu::always_inline]] void lowerRow(float* row, int first, int last, int width,
                                        double cy) const {
+    if (!(len2_ > 0.0 && std::isfinite(len2_))) {
+      rc::ref::lowerRow(row, first, last, cy, a_, b_, reach_);
+      return;
+    }
     using Float4 = float __attribute__((vector_size(16)));
     const Lane4 along_y = splat4((cy - a_.y) * dy_);
     const Lane4 vcy = splat4(cy);
@@ -223,6 +225,7 @@ class SegmentLanes {
  private:
   using Float4Mask = std::int32_t __attribute__((vector_size(16)));
   Point a_;
+  Point b_;
   double dx_;
   double dy_;
   double len2_;
@@ -254,6 +257,9 @@ __attribute__((target_clones("avx2", "default"))) void addSegment(const Point& a
                    row_first, row_end))
     return;
   const SegmentLanes lanes(a, b, reach);
+  auto rowOf = [&](int py) {
+    return edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
+  };
   const bool finite = std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(b.x) &&
                       std::isfinite(b.y) && std::isfinite(band);
   if (finite && std::min(std::fabs(b.x - a.x), std::fabs(b.y - a.y)) <= kBoxSegmentPx) {
@@ -262,14 +268,8 @@ __attribute__((target_clones("avx2", "default"))) void addSegment(const Point& a
     if (!centreRange(std::min(a.x, b.x) - band, std::max(a.x, b.x) + band, clip.x0, clip.x1,
                      col_first, col_end))
       return;
-    for (int py = row_first; py < row_end; ++py) {
-      float* row = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
-      if (lanes.usable()) {
-        lanes.lowerRow(row, col_first, col_end, width, py + 0.5);
-      } else {
-        lowerRow(row, col_first, col_end, py + 0.5, a, b, reach);
-      }
-    }
+    for (int py = row_first; py < row_end; ++py)
+      lanes.lowerRow(rowOf(py), col_first, col_end, width, py + 0.5);
     return;
   }
   for (int py = row_first; py < row_end; ++py) {
@@ -293,12 +293,7 @@ __attribute__((target_clones("avx2", "default"))) void addSegment(const Point& a
     if (!centreRange(std::min(xa, xb) - band, std::max(xa, xb) + band, clip.x0, clip.x1, col_first,
                      col_end))
       continue;
-    float* row = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
-    if (lanes.usable()) {
-      lanes.lowerRow(row, col_first, col_end, width, cy);
-    } else {
-      lowerRow(row, col_first, col_end, cy, a, b, reach);
-    }
+    lanes.lowerRow(rowOf(py), col_first, col_end, width, cy);
   }
 }
 
