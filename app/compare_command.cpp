@@ -26,6 +26,17 @@ int compareCommand(const CompareArgs& args) {
     Tolerances check;  // a bad threshold is refused before anything is read
     applyOverrides(check, cli);
   }
+  // Loading the image module (OpenImageIO and its ~260 libraries) keeps one core busy for
+  // a good part of the whole command; meanwhile the other allocates and touches the frames'
+  // buffers (fresh pages are the largest cost of reading a 1080p pair: perf record,
+  // docs/performance.md). A hint only: the reads below use them where the sizes match.
+  auto reserve = [](const fs::path& dir) {
+    return std::async(std::launch::async, [dir] { return reserveFrame(dir); });
+  };
+  std::future<Frame> expected_storage = reserve(args.expected);
+  std::future<Frame> actual_storage = reserve(args.actual);
+  std::future<Frame> third_storage;
+  if (!args.uncertainty.empty()) third_storage = reserve(args.uncertainty);
   // The frames' memory within the limit before either is read (fixtures/resource_estimate.h).
   for (const fs::path& dir : {args.expected, args.actual}) {
     const auto [width, height] = readFrameSize(dir);
@@ -36,20 +47,23 @@ int compareCommand(const CompareArgs& args) {
   struct Read {
     Frame frame;
     fs::path picture;
+    ClassMaps maps;  // reserved by the actual frame's reader (it usually finishes first)
   };
-  auto read = [](const fs::path& dir, bool picture) {
-    return std::async(std::launch::async, [dir, picture] {
-      Read r{readFrameDir(dir), {}};
-      if (picture) r.picture = readyPicture(dir, r.frame);
-      return r;
-    });
+  auto read = [](const fs::path& dir, bool picture, std::future<Frame>& storage, bool maps) {
+    return std::async(std::launch::async,
+                      [dir, picture, maps, storage = std::move(storage)]() mutable {
+                        Read r{readFrameDir(dir, storage.get()), {}};
+                        if (picture) r.picture = readyPicture(dir, r.frame);
+                        if (maps) reserveMaps(r.maps, r.frame.width, r.frame.height);
+                        return r;
+                      });
   };
-  std::future<Read> expected_f = read(args.expected, true);
-  std::future<Read> actual_f = read(args.actual, true);
+  std::future<Read> expected_f = read(args.expected, true, expected_storage, false);
+  std::future<Read> actual_f = read(args.actual, true, actual_storage, true);
   std::future<Read> third_f;
-  if (!args.uncertainty.empty()) third_f = read(args.uncertainty, false);
+  if (!args.uncertainty.empty()) third_f = read(args.uncertainty, false, third_storage, false);
   const Read expected_read = expected_f.get();
-  const Read actual_read = actual_f.get();
+  Read actual_read = actual_f.get();
   const Frame& expected = expected_read.frame;
   const Frame& actual = actual_read.frame;
   checkSameSize(expected, actual, args.expected, args.actual);
@@ -71,7 +85,7 @@ int compareCommand(const CompareArgs& args) {
   report.command = "compare";
   const PairPictures pictures{expected_read.picture, actual_read.picture};
   report.results.push_back(comparePair(expected, actual, *uncertainty, tolerances, folder, pictures,
-                                       args.diff_exr, args.flip));
+                                       args.diff_exr, args.flip, std::move(actual_read.maps)));
   folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);

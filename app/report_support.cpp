@@ -73,8 +73,8 @@ PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame&
 
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, ReportFolder& folder,
-                       const PairPictures& pictures, bool diff_exr_when_passing, bool flip) {
-  ClassMaps maps;
+                       const PairPictures& pictures, bool diff_exr_when_passing, bool flip,
+                       ClassMaps&& maps) {
   maps.want_flip = flip;
   PairResult result = compareNamed(expected, actual, uncertainty, tolerances, &maps);
   writePairImages(expected, actual, maps, folder.pairDirectory(result), result, pictures,

@@ -39,10 +39,11 @@ PairResult compareNamed(const Frame& expected, const Frame& actual, const Frame&
 // Compares and writes the pair's images into the report folder (a folder of its own for
 // every pair: ReportFolder::pairDirectory); diff.exr only when the pair does not pass,
 // unless diff_exr_when_passing; LDR-FLIP and flip_heat.png when flip (or a FLIP threshold).
+// `maps`: buffers for the comparison's maps (reserveMaps()), or none.
 PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& uncertainty,
                        const Tolerances& tolerances, ReportFolder& folder,
                        const PairPictures& pictures = {}, bool diff_exr_when_passing = true,
-                       bool flip = false);
+                       bool flip = false, ClassMaps&& maps = ClassMaps{});
 
 // A report row for a pair whose render failed with `message`: status not_supported when
 // the message says the backend does not support the fixture, else error.

@@ -273,16 +273,7 @@ class Comparator {
       finish();
       return;
     }
-    if (maps) {
-      const std::size_t n = e_.pixelCount();
-      maps->width = e_.width;
-      maps->height = e_.height;
-      assignBig(maps->pixel_class, n, PixelClass::Background);
-      assignBig(maps->depth_steps, n, 0.0f);
-      assignBig(maps->depth_tolerance, n, 0.0f);
-      assignBig(maps->shading_abs, n, 0.0f);
-      assignBig(maps->shading_tolerance, n, 0.0f);
-    }
+    allocateMaps();
     for (int y = 0; y < e_.height; ++y) {
       if (maps) {
         scale_.quantized ? (quantized_color_ ? runRowFast<true, true, true>(y)
@@ -541,14 +532,9 @@ class Comparator {
 
   void allocateMaps() {
     if (!maps_) return;
-    const std::size_t n = e_.pixelCount();
     maps_->width = e_.width;
     maps_->height = e_.height;
-    assignBig(maps_->pixel_class, n, PixelClass::Background);
-    assignBig(maps_->depth_steps, n, 0.0f);
-    assignBig(maps_->depth_tolerance, n, 0.0f);
-    assignBig(maps_->shading_abs, n, 0.0f);
-    assignBig(maps_->shading_tolerance, n, 0.0f);
+    reserveMaps(*maps_, e_.width, e_.height);
   }
 
   // Whether sample s of pixel i may legally belong to another primitive (ids a, b).
@@ -1051,6 +1037,15 @@ Thresholds heldTo(const Thresholds& base, const std::vector<float>& recorded, st
   return base.raisedBy(warn_at - base.warn);
 }
 }  // namespace
+
+void reserveMaps(ClassMaps& maps, int width, int height) {
+  const std::size_t n = static_cast<std::size_t>(std::max(width, 0)) * std::max(height, 0);
+  assignBig(maps.pixel_class, n, PixelClass::Background);
+  assignBig(maps.depth_steps, n, 0.0f);
+  assignBig(maps.depth_tolerance, n, 0.0f);
+  assignBig(maps.shading_abs, n, 0.0f);
+  assignBig(maps.shading_tolerance, n, 0.0f);
+}
 
 Thresholds depthThresholdsAt(const ClassMaps& maps, std::size_t i, const Tolerances& tolerances) {
   return heldTo(tolerances.depth, maps.depth_tolerance, i);

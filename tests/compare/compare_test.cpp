@@ -443,6 +443,28 @@ TEST_F(CompareTest, ClassMapsHoldThePerPixelResults) {
   EXPECT_EQ(maps.shading_tolerance[gl_.index(kBackBlock.x0, kBackBlock.y0)], 0.0f);
 }
 
+// Maps reserved ahead (reserveMaps(), as `compare` does while it reads) hold what it left
+// there, here garbage; the comparison's maps must be the same as from empty buffers.
+TEST_F(CompareTest, ReservedMapsGiveTheSameMaps) {
+  gl_.id[gl_.index(kBackBlock.x0 - 5, kBackBlock.y0)] = 0;
+  gl_.color[gl_.index(60, 60) * 4 + 2] += 2.0f / 255.0f;
+  ClassMaps fresh;
+  compare(&fresh);
+  ClassMaps reserved;
+  reserveMaps(reserved, kW, kH);
+  ASSERT_EQ(reserved.pixel_class.size(), static_cast<std::size_t>(kW * kH));
+  std::fill(reserved.pixel_class.begin(), reserved.pixel_class.end(), PixelClass::ExtraHard);
+  for (auto* m : {&reserved.depth_steps, &reserved.depth_tolerance, &reserved.shading_abs,
+                  &reserved.shading_tolerance})
+    std::fill(m->begin(), m->end(), 1234.5f);
+  compare(&reserved);
+  EXPECT_EQ(reserved.pixel_class, fresh.pixel_class);
+  EXPECT_EQ(reserved.depth_steps, fresh.depth_steps);
+  EXPECT_EQ(reserved.depth_tolerance, fresh.depth_tolerance);
+  EXPECT_EQ(reserved.shading_abs, fresh.shading_abs);
+  EXPECT_EQ(reserved.shading_tolerance, fresh.shading_tolerance);
+}
+
 TEST_F(CompareTest, SizeMismatchIsAnInputErrorNamingBothSides) {
   Frame small = testing::renderRects(128, 128, testing::defaultRects(128, 128));
   small.meta["backend"] = "gl:small";

@@ -1,6 +1,7 @@
 // Frame directories: exact round trip of every channel (ids as real uint32, not float),
 // the EXR's channel names and types as DESIGN.md fixes them, byte-identical files, and
 // all-or-nothing writes (also when a rename fails midway).
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -386,6 +387,95 @@ TEST(FrameIo, RoundTripsMultisampledFrames) {
 // The typed facts are frame.json's contract keys (DESIGN.md: depth format beside the
 // backend); a frame that does not say keeps them unset, and a wrong value is refused on
 // reading with the file and the key.
+// reserveFrame(): buffers sized from frame.json and the file's size; reading into them,
+// whatever they hold, gives what reading without them gives.
+TEST(FrameIo, ReservedBuffersChangeNothingThatIsRead) {
+  const fs::path dir = tempDir("reserve");
+  rc::Frame in = makeFrame(true);
+  in.meta["width"] = in.width;  // as `render` writes them (app/backends.cpp)
+  in.meta["height"] = in.height;
+  rc::writeFrameDir(in, dir);
+  rc::Frame storage = rc::reserveFrame(dir);
+  const std::size_t n = in.pixelCount();
+  ASSERT_EQ(storage.color.size(), n * 4);
+  ASSERT_EQ(storage.id.size(), n);
+  ASSERT_EQ(storage.edge_dist.size(), n);  // an uncompressed file with every channel
+  for (float& v : storage.color) v = 99.0f;
+  for (std::uint32_t& v : storage.id) v = 99u;
+  for (std::vector<float>* c : storage.uncertainty()) std::fill(c->begin(), c->end(), -7.0f);
+  const float* reserved_color = storage.color.data();
+  const rc::Frame plain = rc::readFrameDir(dir);
+  const rc::Frame out = rc::readFrameDir(dir, std::move(storage));
+  EXPECT_EQ(out.color.data(), reserved_color);  // the reserved buffer was used
+  EXPECT_TRUE(std::isnan(out.color[0]));
+  EXPECT_TRUE(std::equal(plain.color.begin() + 1, plain.color.end(), out.color.begin() + 1));
+  EXPECT_EQ(out.depth, plain.depth);
+  EXPECT_EQ(out.id, plain.id);
+  for (int c = 0; c < rc::kUncertaintyChannels; ++c)
+    EXPECT_EQ(*out.uncertainty()[c], *plain.uncertainty()[c]) << c;
+  EXPECT_EQ(out.meta, plain.meta);
+
+  // A frame without the uncertainty channels read into buffers that have them has none.
+  rc::Frame gl = makeFrame(false);
+  gl.meta = in.meta;
+  rc::writeFrameDir(gl, dir);
+  EXPECT_TRUE(rc::reserveFrame(dir).edge_dist.empty());  // the file is too small for them
+  rc::Frame spare;
+  const float clear[4] = {0.f, 0.f, 0.f, 0.f};
+  spare.allocate(in.width, in.height, clear, 1.0f, true);
+  const rc::Frame read_gl = rc::readFrameDir(dir, std::move(spare));
+  EXPECT_FALSE(read_gl.hasUncertainty());
+  EXPECT_EQ(read_gl.id, gl.id);
+  // Buffers of another size are not used.
+  rc::Frame small;
+  small.allocate(2, 2, clear, 1.0f, true);
+  EXPECT_EQ(rc::readFrameDir(dir, std::move(small)).id, gl.id);
+  fs::remove_all(dir);
+}
+
+// A hint, never an error: anything unusable gives no buffers (the read says what is wrong).
+TEST(FrameIo, ReserveFrameIsOnlyAHint) {
+  const fs::path dir = tempDir("reserve_hint");
+  EXPECT_TRUE(rc::reserveFrame(dir).color.empty());  // no directory
+  rc::Frame in = makeFrame(true);
+  in.meta["width"] = in.width;
+  in.meta["height"] = in.height;
+  rc::writeFrameDir(in, dir);
+  ASSERT_FALSE(rc::reserveFrame(dir).color.empty());
+  const nlohmann::json good = readJson(dir / "frame.json");
+  const std::vector<std::pair<std::string, nlohmann::json>> bad = {
+      {"width", 1 << 20}, {"height", 1 << 20},  // 2^40 pixels
+      {"width", 70},      {"height", 50},       // more than the file holds
+      {"width", -7},      {"height", 0},       {"width", "seven"}, {"height", 2.5}};
+  for (const auto& [key, value] : bad) {
+    nlohmann::json doc = good;
+    doc[key] = value;
+    std::ofstream(dir / "frame.json") << doc.dump();
+    EXPECT_TRUE(rc::reserveFrame(dir).color.empty()) << key << " " << value.dump();
+  }
+  std::ofstream(dir / "frame.json") << "[1, 2";
+  EXPECT_TRUE(rc::reserveFrame(dir).color.empty());
+  std::ofstream(dir / "frame.json") << good.dump();
+  // Over the comparison's memory limit (fixtures/resource_estimate.h).
+  ::setenv("RASTERCHECK_MAX_MEMORY", "1K", 1);
+  EXPECT_TRUE(rc::reserveFrame(dir).color.empty());
+  ::unsetenv("RASTERCHECK_MAX_MEMORY");
+  ASSERT_FALSE(rc::reserveFrame(dir).color.empty());
+  fs::remove(dir / "frame.json");
+  EXPECT_TRUE(rc::reserveFrame(dir).color.empty());
+
+  // A compressed file is smaller than its pixels: how many channels it has is not known.
+  rc::Frame flat;
+  const float grey[4] = {0.5f, 0.5f, 0.5f, 1.0f};
+  flat.allocate(256, 128, grey, 1.0f, true);
+  flat.meta = {{"width", 256}, {"height", 128}};
+  rc::writeFrameDir(flat, dir, rc::FrameEncoding{"zip", 1, 8});
+  EXPECT_TRUE(rc::reserveFrame(dir).color.empty());
+  rc::writeFrameDir(flat, dir);
+  EXPECT_EQ(rc::reserveFrame(dir).edge_dist.size(), flat.pixelCount());
+  fs::remove_all(dir);
+}
+
 TEST(FrameIo, DrawFactsAreFrameJsonKeys) {
   const fs::path dir = tempDir("facts");
   rc::writeFrameDir(makeFrame(false), dir);
