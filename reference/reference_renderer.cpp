@@ -99,6 +99,13 @@ struct ReachPlane {
     const double r = at0 + ddx * (x - x0) + ddy * (y - y0);
     return static_cast<float>(std::clamp(r, lo, hi));
   }
+  // Adds e steps everywhere (the plane set-up's error, planeSetupError()); +inf stays.
+  void widen(double e) {
+    if (!(e >= 0.0)) e = std::numeric_limits<double>::infinity();  // NaN too
+    at0 += e;
+    lo += e;
+    hi += e;
+  }
 };
 
 struct TriangleContext {
@@ -116,7 +123,8 @@ struct TriangleContext {
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
   float depth_slope = 0.0f;       // |grad z| in depth-format steps per px
-  ReachPlane depth_reach;         // steps: its vertices' float32 window-depth reach, interpolated
+  ReachPlane depth_reach;         // steps: its vertices' float32 window-depth reach, interpolated,
+                                  // plus the float32 set-up of its depth plane (planeSetupError())
   bool texel_choice = false;      // textured: record the texel channels
   glm::dvec2 uq_max{0.0};         // largest |u / w|, |v / w| over its three vertices
   glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
@@ -235,7 +243,7 @@ class Renderer {
   void transformVertices();
   void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
   void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
-                   int count);
+                   int count, bool clipped);
   void prepareTriangle(TriangleContext& t) const;
   __attribute__((noinline)) void addSampleEdgeDistances(const WindowVertex* wv, int count,
                                                         const double* reach);
@@ -426,7 +434,7 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
       const ClipVertex whole[3] = {{c0, {1.0, 0.0, 0.0}, verts[tri[0]].clip_err},
                                    {c1, {0.0, 1.0, 0.0}, verts[tri[1]].clip_err},
                                    {c2, {0.0, 0.0, 1.0}, verts[tri[2]].clip_err}};
-      drawPolygon(prim, pass, whole, 3);
+      drawPolygon(prim, pass, whole, 3, false);
       return;
     }
     case ClipClass::Cut: {
@@ -434,7 +442,7 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
       const glm::dvec4 errors[3] = {verts[tri[0]].clip_err, verts[tri[1]].clip_err,
                                     verts[tri[2]].clip_err};
       if (clipTriangle(c0, c1, c2, volume_, poly, errors))
-        drawPolygon(prim, pass, poly.v.data(), poly.count);
+        drawPolygon(prim, pass, poly.v.data(), poly.count, true);
       return;
     }
   }
@@ -443,7 +451,7 @@ void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
 // Draws the (clipped) polygon of one original triangle: window coordinates, snapping,
 // culling, the uncertainty channels, then each fan triangle's coverage and fragments.
 void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
-                           int count) {
+                           int count, bool clipped) {
   WindowVertex wv[kMaxClipVertices];
   FixedVertex fv[kMaxClipVertices];
   for (int i = 0; i < count; ++i) {
@@ -513,6 +521,10 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
       t.depth_slope = static_cast<float>(interp.depthSlope() * depth_steps_);
       t.depth_reach.setup(wv[0], wv[i], wv[i + 1], depth_reach[0], depth_reach[i],
                           depth_reach[i + 1]);
+      // Not for the pieces of a clipped triangle: their clip vertices can lie 10^5 px away
+      // (a near-plane cut), where the first-order bound grows to a tenth of the depth range
+      // (docs/tolerances.md "Plane set-up": what is left uncovered there).
+      if (!clipped) t.depth_reach.widen(planeSetupError(wv[0], wv[i], wv[i + 1]) * depth_steps_);
       t.texel_choice = t.texture != nullptr;
       if (t.texel_choice && scene_.state.texture_filter == TextureFilter::Linear)
         t.texture_range = textureRangeOf(t.texture);

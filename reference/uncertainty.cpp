@@ -336,4 +336,51 @@ void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, floa
   clear();
 }
 
+double planeSetupError(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2) {
+  constexpr double u = 0x1p-24;  // float32 unit roundoff
+  // The area and the gradient are the same whichever vertex is the reference (their
+  // float32 errors are not): computed once, from v0.
+  const double area = (v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y);
+  const double gx = ((v1.z - v0.z) * (v2.y - v0.y) - (v2.z - v0.z) * (v1.y - v0.y)) / area;
+  const double gy = ((v1.x - v0.x) * (v2.z - v0.z) - (v2.x - v0.x) * (v1.z - v0.z)) / area;
+  const double inv_area = 1.0 / std::fabs(area);
+  const double agx = std::fabs(gx);
+  const double agy = std::fabs(gy);
+  if (!std::isfinite(inv_area) || !std::isfinite(agx) || !std::isfinite(agy))
+    return std::numeric_limits<double>::infinity();
+  const WindowVertex* v[3] = {&v0, &v1, &v2};
+  double worst = 0.0;
+  double slack = 0.0;
+  for (int k = 0; k < 3; ++k) {  // the implementation's reference vertex a
+    const WindowVertex& a = *v[k];
+    const WindowVertex& b = *v[k == 2 ? 0 : k + 1];
+    const WindowVertex& c = *v[k == 0 ? 2 : k - 1];
+    const double ux = b.x - a.x;
+    const double uy = b.y - a.y;
+    const double uz = b.z - a.z;
+    const double vx = c.x - a.x;
+    const double vy = c.y - a.y;
+    const double vz = c.z - a.z;
+    // Each product of two rounded differences carries 3 roundings, each sum and the
+    // quotient one more: |d gx| <= u (3 (|uz vy| + |vz uy|) + 3 |gx| (|ux vy| + |vx uy|))
+    // / |area| + 3 u |gx| (the numerator's error, the area's error times gx, the rest).
+    const double cross = std::fabs(ux * vy) + std::fabs(vx * uy);
+    const double ex =
+        3.0 * u * ((std::fabs(uz * vy) + std::fabs(vz * uy) + agx * cross) * inv_area + agx);
+    const double ey =
+        3.0 * u * ((std::fabs(ux * vz) + std::fabs(vx * uz) + agy * cross) * inv_area + agy);
+    // At (x, y): the gradient's error times the distance from a, and the evaluation's own
+    // roundings (two products, two sums). Convex in (x, y): over the triangle it is
+    // largest at a vertex (at a itself, u |z_a|); 1 px further in x and y adds `step`.
+    const double fx = ex + 2.0 * u * agx;
+    const double fy = ey + 2.0 * u * agy;
+    const double za = u * std::fabs(a.z);
+    worst = std::max({worst, za + fx * std::fabs(ux) + fy * std::fabs(uy),
+                      za + fx * std::fabs(vx) + fy * std::fabs(vy)});
+    slack = std::max(slack, fx + fy);
+  }
+  const double e = worst + slack;
+  return std::isfinite(e) ? e : std::numeric_limits<double>::infinity();
+}
+
 }  // namespace rc::ref

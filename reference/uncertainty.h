@@ -276,6 +276,18 @@ inline constexpr double kSnapDisagreementPx = 1.0 / 16.0;
 // d * |v(i+1) - v(i-1)| <= d * (|e(i-1)| + |e(i)|).
 bool cullCouldFlip(const WindowVertex* polygon, int count, double extra_px = 0.0);
 
+// How far (window-z units) a float32 implementation's set-up of a triangle's depth plane
+// may move the depth it interpolates at any point within 1 px (in x and in y) of the
+// triangle, to first order in the float32 unit roundoff: docs/tolerances.md, "Plane
+// set-up". GL implementations compute the plane from the window vertices as
+// z = z_a + gx (x - x_a) + gy (y - y_a), the gradient from the edge vectors u = b - a and
+// v = c - a over the cross product u x v; which vertex is `a` is theirs to choose, so the
+// bound is the largest over the three choices. Small for ordinary triangles (about
+// 13 u |z range|), large for slivers, where u x v cancels: a triangle 78 px long and 0.05 px
+// wide seen edge-on put llvmpipe's depth 144 d24 steps from the plane (campaign s20261226).
+// +inf when the unsnapped area is zero or anything is not finite.
+double planeSetupError(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2);
+
 // Lowers edge_dist (image order, top row first, width * height floats initialised to 1)
 // to the distance from each pixel centre in `clip` to the polygon's boundary segments,
 // less each segment's reach: how far a float32 implementation may put it beyond snapping

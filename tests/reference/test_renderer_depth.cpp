@@ -616,5 +616,112 @@ TEST(DepthReach, IsInterpolatedAcrossTheTriangleNotItsLargestVertex) {
   std::cout << "depth_reach on the floor: " << lo << " to " << hi << " d24 steps\n";
 }
 
+// planeSetupError() against an independent float32 set-up of the depth plane, as a GL
+// implementation computes it from its window vertices: edge vectors from a reference vertex
+// a (any of the three, either winding), the cross products, the quotient by the area, then
+// z = z_a + gx (x - x_a) + gy (y - y_a), every operation in float. Ordinary triangles and
+// slivers down to 1e-4 of their length wide, up to 2048 px, z from the whole range to
+// near-constant, evaluated at pixel centres inside or within a pixel: the float32 depth
+// must be within the bound of the exact plane (plus two float32 ulps of the result: its
+// last roundings, which the base thresholds cover), and the bound must not be loose by
+// more than a factor of 50. The sliver of campaign s20261226 (78 px long, 0.045 px wide,
+// seen edge-on), where llvmpipe stored depth 144 d24 steps from the exact plane and the
+// slope and vertex terms allowed 119, gets a bound above it.
+TEST(DepthReach, PlaneSetUpBoundsAFloat32SetUpFromAnyVertex) {
+  auto exactAt = [](const ref::WindowVertex* v, double x, double y) {
+    const double det =
+        (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y);
+    const double gx =
+        ((v[1].z - v[0].z) * (v[2].y - v[0].y) - (v[2].z - v[0].z) * (v[1].y - v[0].y)) / det;
+    const double gy =
+        ((v[1].x - v[0].x) * (v[2].z - v[0].z) - (v[2].x - v[0].x) * (v[1].z - v[0].z)) / det;
+    return v[0].z + gx * (x - v[0].x) + gy * (y - v[0].y);
+  };
+  auto float32At = [](const ref::WindowVertex& a, const ref::WindowVertex& b,
+                      const ref::WindowVertex& c, double x, double y) {
+    const float ax = static_cast<float>(a.x), ay = static_cast<float>(a.y);
+    const float az = static_cast<float>(a.z);
+    const float ux = static_cast<float>(b.x) - ax, uy = static_cast<float>(b.y) - ay;
+    const float uz = static_cast<float>(b.z) - az;
+    const float vx = static_cast<float>(c.x) - ax, vy = static_cast<float>(c.y) - ay;
+    const float vz = static_cast<float>(c.z) - az;
+    const float area = ux * vy - vx * uy;
+    const float gx = (uz * vy - vz * uy) / area;
+    const float gy = (ux * vz - vx * uz) / area;
+    return static_cast<double>(az + gx * (static_cast<float>(x) - ax) +
+                               gy * (static_cast<float>(y) - ay));
+  };
+  auto vertex = [](double x, double y, double z) {
+    // float32 positions: what a driver sets up from (their own rounding is a vertex move)
+    return ref::WindowVertex{static_cast<float>(x), static_cast<float>(y), static_cast<float>(z),
+                             1.0, glm::dvec3(0.0)};
+  };
+  std::mt19937 rng(20261226);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  double worst_ratio = 0.0;
+  int checks = 0;
+  for (int t = 0; t < 4000; ++t) {
+    const double x0 = 2048.0 * uni(rng), y0 = 2048.0 * uni(rng);
+    double x1, y1, x2, y2;
+    if (t % 2 == 0) {  // a sliver: c near the line a-b
+      const double len = std::pow(10.0, 3.3 * uni(rng));
+      const double ang = 6.283185307179586 * uni(rng);
+      const double width = len * std::pow(10.0, -4.0 * uni(rng));
+      const double along = -0.5 + 2.0 * uni(rng);
+      x1 = x0 + len * std::cos(ang);
+      y1 = y0 + len * std::sin(ang);
+      x2 = x0 + along * len * std::cos(ang) - width * std::sin(ang);
+      y2 = y0 + along * len * std::sin(ang) + width * std::cos(ang);
+    } else {
+      x1 = 2048.0 * uni(rng), y1 = 2048.0 * uni(rng), x2 = 2048.0 * uni(rng),
+      y2 = 2048.0 * uni(rng);
+    }
+    double z[3] = {uni(rng), uni(rng), uni(rng)};
+    if (t % 3 == 0)
+      for (double& zi : z) zi = z[0] + 1e-4 * (uni(rng) - 0.5);  // nearly flat
+    const ref::WindowVertex v[3] = {vertex(x0, y0, z[0]), vertex(x1, y1, z[1]),
+                                    vertex(x2, y2, z[2])};
+    const double bound = ref::planeSetupError(v[0], v[1], v[2]);
+    const double det =
+        (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y);
+    if (det == 0.0) {
+      EXPECT_EQ(bound, std::numeric_limits<double>::infinity());
+      continue;
+    }
+    ASSERT_TRUE(std::isfinite(bound)) << t;
+    for (int k = 0; k < 8; ++k) {
+      // A pixel centre near a random point of the triangle (barycentrics in [0, 1]).
+      const double l1 = uni(rng), l2 = (1.0 - l1) * uni(rng), l0 = 1.0 - l1 - l2;
+      const double x = std::floor(l0 * v[0].x + l1 * v[1].x + l2 * v[2].x) + 0.5;
+      const double y = std::floor(l0 * v[0].y + l1 * v[1].y + l2 * v[2].y) + 0.5;
+      const double exact = exactAt(v, x, y);
+      for (int a = 0; a < 3; ++a) {
+        const ref::WindowVertex& p = v[a];
+        const ref::WindowVertex& q = v[(a + 1) % 3];
+        const ref::WindowVertex& r = v[(a + 2) % 3];
+        for (const double z32 : {float32At(p, q, r, x, y), float32At(p, r, q, x, y)}) {
+          const double err = std::fabs(z32 - exact) - 2.0 * 0x1p-24;  // its last roundings
+          ASSERT_LE(err, bound) << "triangle " << t << " at " << x << "," << y;
+          worst_ratio = std::max(worst_ratio, err / bound);
+          ++checks;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checks, 100000);
+  EXPECT_GT(worst_ratio, 0.02) << "the bound is far looser than float32 set-ups get";
+  std::cout << "worst error / bound: " << worst_ratio << "\n";
+
+  const ref::WindowVertex sliver[3] = {vertex(95.871534, 65.310913, 0.944722694),
+                                       vertex(141.584338, 128.654394, 0.866853385),
+                                       vertex(141.625944, 128.635161, 0.866872035)};
+  constexpr double kD24Steps = 16777215.0;
+  const double setup_err = std::fabs(float32At(sliver[0], sliver[1], sliver[2], 141.5, 128.5) -
+                                     exactAt(sliver, 141.5, 128.5)) *
+                           kD24Steps;
+  EXPECT_GT(setup_err, 144.0 - 119.0) << "the set-up alone exceeds what the other terms allowed";
+  EXPECT_GT(ref::planeSetupError(sliver[0], sliver[1], sliver[2]) * kD24Steps, setup_err);
+}
+
 }  // namespace
 }  // namespace rc
