@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -117,8 +118,32 @@ Frame effectFrame(const Frame& clean, const Frame& faulted, const Frame& referen
   }
   Frame out = faulted;
   const std::size_t n = clean.pixelCount();
+  // The fault's change of one value, less how far the clean driver already is from the
+  // reference there: what is left shows against the reference whichever way the two go.
+  auto net = [](float c, float f, float r) {
+    const float m = std::fabs(c - r);
+    const float d = f - c;
+    if (!(std::fabs(d) > m)) return c;  // NaN: unchanged as well
+    return d > 0.0f ? f - m : f + m;
+  };
+  const bool sample_ref =
+      clean.multisampled() && reference.sample_depth.size() == clean.sample_depth.size();
   for (std::size_t i = 0; i < n; ++i) {
-    if (reference.id[i] == clean.id[i]) continue;
+    if (reference.id[i] == clean.id[i]) {
+      out.depth[i] = net(clean.depth[i], faulted.depth[i], reference.depth[i]);
+      for (int c = 0; c < 4; ++c) {
+        const std::size_t k = 4 * i + static_cast<std::size_t>(c);
+        out.color[k] = net(clean.color[k], faulted.color[k], reference.color[k]);
+      }
+      if (sample_ref) {
+        for (int s = 0; s < clean.samples; ++s) {
+          const std::size_t k = clean.sampleIndex(s, i);
+          out.sample_depth[k] =
+              net(clean.sample_depth[k], faulted.sample_depth[k], reference.sample_depth[k]);
+        }
+      }
+      continue;
+    }
     out.depth[i] = clean.depth[i];
     for (int c = 0; c < 4; ++c) out.color[4 * i + c] = clean.color[4 * i + c];
     if (clean.multisampled()) {

@@ -11,7 +11,9 @@
 //   effect   = compare(CLEAN, FAULTED, uncertainty REF) (what the fault did to the driver)
 //   detected = compare(REF, FAULTED)                    (what the harness sees with it)
 // `effect` sees FAULTED through effectFrame(): only at the pixels a comparison with REF
-// judges in depth and shading (REF shows the primitive CLEAN shows).
+// judges in depth and shading (REF shows the primitive CLEAN shows), and there each value's
+// change less the clean driver's own distance from REF (what then exceeds the allowance
+// shows against REF whichever way the clean driver deviates).
 // The fault changes some pixel beyond its allowance when `effect` fails in the fault's
 // class; the scene counts for that fault only then, and only when `control` does not fail
 // in that class (else a failure would prove nothing). It is caught when `detected` fails

@@ -127,9 +127,9 @@ TEST(MutationStudy, TheEffectFrameKeepsOnlyWhatTheReferenceJudges) {
   clean.id = {1, 1, 1, 1};  // the driver covers all four with primitive 1
   faulted.id = {1, 3, 1, 1};
   for (std::size_t i = 0; i < 4; ++i) {
-    clean.depth[i] = 0.5f;
+    ref.depth[i] = clean.depth[i] = 0.5f;
     faulted.depth[i] = 0.5f + 0.1f * static_cast<float>(i + 1);
-    clean.color[4 * i] = 0.25f;
+    ref.color[4 * i] = clean.color[4 * i] = 0.25f;
     faulted.color[4 * i] = 0.75f;
   }
   const Frame seen = effectFrame(clean, faulted, ref);
@@ -142,6 +142,42 @@ TEST(MutationStudy, TheEffectFrameKeepsOnlyWhatTheReferenceJudges) {
   Frame small;
   small.allocate(2, 1, clear, 1.0f, false);
   EXPECT_THROW(effectFrame(clean, small, ref), InputError);
+}
+
+// Where the clean driver is already off the reference, the effect is the fault's change
+// less that distance, towards the clean value: what is left is at least as far from the
+// reference (scene 00048 of s20261227: reference 236, clean 235, faulted 239 counted a
+// 4-unit effect that was 3 units from the reference, inside its allowance).
+TEST(MutationStudy, TheEffectIsNetOfTheCleanDriversOwnDeviation) {
+  const float clear[4] = {0, 0, 0, 1};
+  Frame ref, clean, faulted;
+  ref.allocate(4, 1, clear, 1.0f, true);
+  clean.allocate(4, 1, clear, 1.0f, false);
+  faulted.allocate(4, 1, clear, 1.0f, false);
+  ref.id = clean.id = faulted.id = {1, 1, 1, 1};
+  const float r[4] = {236, 236, 236, 236};
+  const float c[4] = {235, 237, 236, 238};  // off by -1, +1, 0, +2
+  const float f[4] = {239, 239, 233, 239};  // the fault: +4, +2, -3, +1
+  for (std::size_t i = 0; i < 4; ++i) {
+    ref.color[4 * i + 1] = r[i] / 255.0f;
+    clean.color[4 * i + 1] = c[i] / 255.0f;
+    faulted.color[4 * i + 1] = f[i] / 255.0f;
+    ref.depth[i] = 0.5f;
+    clean.depth[i] = 0.5f + 0.01f * static_cast<float>(i);
+    faulted.depth[i] = 0.75f;
+  }
+  const Frame seen = effectFrame(clean, faulted, ref);
+  const float want[4] = {238, 238, 233, 238};  // 235 + (4 - 1), 237 + (2 - 1), 236 - 3, 238
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(seen.color[4 * i + 1] * 255.0f, want[i], 1e-3) << i;
+    // Depth: 0.25 - 0.01 i moved, less the clean driver's 0.01 i off the reference.
+    EXPECT_NEAR(seen.depth[i], 0.75f - 0.01f * static_cast<float>(i), 1e-6) << i;
+    // Never further from the reference than the faulted value (it is the lower bound of
+    // how far the faulted value is).
+    EXPECT_LE(std::fabs(seen.color[4 * i + 1] - ref.color[4 * i + 1]),
+              std::fabs(faulted.color[4 * i + 1] - ref.color[4 * i + 1]) + 1e-6f)
+        << i;
+  }
 }
 
 }  // namespace
