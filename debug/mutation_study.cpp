@@ -120,10 +120,12 @@ Frame effectFrame(const Frame& clean, const Frame& faulted, const Frame& referen
   const std::size_t n = clean.pixelCount();
   // The fault's change of one value, less how far the clean driver already is from the
   // reference there: what is left shows against the reference whichever way the two go.
+  // Anything not finite keeps the faulted value: a NaN the fault made must still count.
   auto net = [](float c, float f, float r) {
     const float m = std::fabs(c - r);
     const float d = f - c;
-    if (!(std::fabs(d) > m)) return c;  // NaN: unchanged as well
+    if (!std::isfinite(m) || !std::isfinite(d)) return f;
+    if (std::fabs(d) <= m) return c;
     return d > 0.0f ? f - m : f + m;
   };
   const bool sample_ref =

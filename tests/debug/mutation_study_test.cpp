@@ -5,6 +5,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "fixtures/errors.h"
 
 namespace rc {
@@ -178,6 +181,9 @@ TEST(MutationStudy, TheEffectIsNetOfTheCleanDriversOwnDeviation) {
               std::fabs(faulted.color[4 * i + 1] - ref.color[4 * i + 1]) + 1e-6f)
         << i;
   }
+  // A NaN the fault made is kept (the comparator counts it), whatever the clean driver did.
+  faulted.color[1] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(effectFrame(clean, faulted, ref).color[1]));
 }
 
 }  // namespace
