@@ -118,14 +118,27 @@ TEST(MutationStudy, TalliesCountOnlyScenesWithAnEffect) {
   EXPECT_THROW(mutationResultFromJson(bad, "x"), InputError);
 }
 
+// Four pixels in a row: the reference (with its uncertainty channels), the clean and the
+// faulted driver frame.
+struct StudyFrames {
+  Frame ref;
+  Frame clean;
+  Frame faulted;
+};
+StudyFrames studyFrames() {
+  const float clear[4] = {0, 0, 0, 1};
+  StudyFrames f;
+  f.ref.allocate(4, 1, clear, 1.0f, true);
+  f.clean.allocate(4, 1, clear, 1.0f, false);
+  f.faulted.allocate(4, 1, clear, 1.0f, false);
+  return f;
+}
+
 // The effect comparison sees the faulted frame only where the reference shows the clean
 // frame's primitive: elsewhere depth and colour are the clean frame's, ids are the faulted.
 TEST(MutationStudy, TheEffectFrameKeepsOnlyWhatTheReferenceJudges) {
-  const float clear[4] = {0, 0, 0, 1};
-  Frame ref, clean, faulted;
-  ref.allocate(4, 1, clear, 1.0f, true);
-  clean.allocate(4, 1, clear, 1.0f, false);
-  faulted.allocate(4, 1, clear, 1.0f, false);
+  StudyFrames frames = studyFrames();
+  auto& [ref, clean, faulted] = frames;
   ref.id = {1, 1, 2, 0};    // pixel 2: another primitive; pixel 3: background
   clean.id = {1, 1, 1, 1};  // the driver covers all four with primitive 1
   faulted.id = {1, 3, 1, 1};
@@ -143,6 +156,7 @@ TEST(MutationStudy, TheEffectFrameKeepsOnlyWhatTheReferenceJudges) {
   EXPECT_EQ(seen.color[8], 0.25f);
   EXPECT_EQ(seen.color[12], 0.25f);
   Frame small;
+  const float clear[4] = {0, 0, 0, 1};
   small.allocate(2, 1, clear, 1.0f, false);
   EXPECT_THROW(effectFrame(clean, small, ref), InputError);
 }
@@ -152,11 +166,8 @@ TEST(MutationStudy, TheEffectFrameKeepsOnlyWhatTheReferenceJudges) {
 // reference (scene 00048 of s20261227: reference 236, clean 235, faulted 239 counted a
 // 4-unit effect that was 3 units from the reference, inside its allowance).
 TEST(MutationStudy, TheEffectIsNetOfTheCleanDriversOwnDeviation) {
-  const float clear[4] = {0, 0, 0, 1};
-  Frame ref, clean, faulted;
-  ref.allocate(4, 1, clear, 1.0f, true);
-  clean.allocate(4, 1, clear, 1.0f, false);
-  faulted.allocate(4, 1, clear, 1.0f, false);
+  StudyFrames frames = studyFrames();
+  auto& [ref, clean, faulted] = frames;
   ref.id = clean.id = faulted.id = {1, 1, 1, 1};
   const float r[4] = {236, 236, 236, 236};
   const float c[4] = {235, 237, 236, 238};  // off by -1, +1, 0, +2
