@@ -531,10 +531,7 @@ class Comparator {
   // colour.
 
   void allocateMaps() {
-    if (!maps_) return;
-    maps_->width = e_.width;
-    maps_->height = e_.height;
-    reserveMaps(*maps_, e_.width, e_.height);
+    if (maps_) reserveMaps(*maps_, e_.width, e_.height);
   }
 
   // Whether sample s of pixel i may legally belong to another primitive (ids a, b).
@@ -1039,6 +1036,8 @@ Thresholds heldTo(const Thresholds& base, const std::vector<float>& recorded, st
 }  // namespace
 
 void reserveMaps(ClassMaps& maps, int width, int height) {
+  maps.width = width;
+  maps.height = height;
   const std::size_t n = static_cast<std::size_t>(std::max(width, 0)) * std::max(height, 0);
   assignBig(maps.pixel_class, n, PixelClass::Background);
   assignBig(maps.depth_steps, n, 0.0f);

@@ -196,9 +196,10 @@ struct ClassMaps {
   bool want_flip = false;
 };
 
-// Allocates and touches the five per-pixel maps of a width x height comparison, so that a
-// caller can pay for the fresh memory while it waits for something else: the comparison
-// reuses buffers that have the size it needs (docs/performance.md, `compare` on a 1080p pair).
+// Sizes the maps for a width x height comparison: allocates and touches the five per-pixel
+// maps with the values the comparison starts from. A caller can so pay for the fresh
+// memory while it waits for something else: the comparison reuses buffers that have the
+// size it needs (docs/performance.md, `compare` on a 1080p pair).
 void reserveMaps(ClassMaps& maps, int width, int height);
 
 // The thresholds compared pixel i (class Match) was held to by the comparison that filled

@@ -99,9 +99,9 @@ struct ReachPlane {
     const double r = at0 + ddx * (x - x0) + ddy * (y - y0);
     return static_cast<float>(std::clamp(r, lo, hi));
   }
-  // Adds e steps everywhere (the plane set-up's error, planeSetupError()); +inf stays.
+  // Adds e >= 0 steps everywhere (the plane set-up's error: planeSetupError() is never NaN;
+  // its +inf stays +inf).
   void widen(double e) {
-    if (!(e >= 0.0)) e = std::numeric_limits<double>::infinity();  // NaN too
     at0 += e;
     lo += e;
     hi += e;
