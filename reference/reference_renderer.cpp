@@ -3,6 +3,7 @@
 #include "reference/reference_renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -25,6 +26,7 @@
 #include "reference/texture_sampling.h"
 #include "reference/uncertainty.h"
 #include "reference/vertex_stage.h"
+#include "reference/vertex_windows.h"
 #include "reference/viewport.h"
 
 namespace rc {
@@ -54,10 +56,6 @@ void validate(const Scene& scene, const ReferenceOptions& options) {
       std::int64_t{scene.width} * scene.height > kMaxImagePixels)
     fail("image " + std::to_string(scene.width) + "x" + std::to_string(scene.height) +
          " outside what the reference renders (1..16384 a side, at most 2^26 pixels)");
-}
-
-bool isFinite(const glm::dvec4& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
 }
 
 // ---- the renderer -----------------------------------------------------------------------
@@ -108,6 +106,11 @@ struct ReachPlane {
   }
 };
 
+// One object serves every triangle of a frame (Renderer::context_): drawWindowed() resets prim,
+// pass and the flags read before they are set (constant, depth_slope, texel_choice);
+// prepareTriangle() writes what its shading mode reads (material to v, gouraud, flat, the
+// constant colour, centroid and face normal where lit or traced), the per-fan set-up the
+// uncertainty fields. The initial values only matter for the first triangle.
 struct TriangleContext {
   const PrimitiveRef* prim = nullptr;
   const DrawPass* pass = nullptr;
@@ -185,6 +188,7 @@ struct Scratch {
   EdgeDistanceBatch edges;  // the polygons' edge_dist work, applied at the end of the frame
   std::vector<std::vector<TransformedVertex>> vertices;  // per object
   std::vector<std::vector<LitColor>> gouraud;            // per object, Gouraud only
+  std::vector<std::vector<VertexWindow>> windows;        // per object, per vertex
 };
 thread_local Scratch t_scratch;
 constexpr std::size_t kMaxKeptScratchPixels = std::size_t{1} << 22;
@@ -230,9 +234,18 @@ class Renderer {
         depth_(t_scratch.depth),
         gaps_(t_scratch.gaps),
         edges_(t_scratch.edges),
+        windows_(t_scratch.windows),
         shift_(shift) {
     shading_.reserve(scene.materials.size());
     for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
+    // prepareTriangle()'s colour of an unlit, untextured, unblended flat triangle: one per
+    // material (the same expressions, computed once instead of per triangle).
+    unlit_stored_.resize(scene.materials.size());
+    for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+      const glm::dvec4 c = finalColor(LitColor{shading_[m].ambient, glm::dvec3(0.0)},
+                                      glm::dvec3(1.0), scene.materials[m].opacity);
+      for (int k = 0; k < 4; ++k) unlit_stored_[m][k] = storeColor(c[k], color_format_);
+    }
   }
 
   Frame run();
@@ -244,6 +257,13 @@ class Renderer {
   void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
   void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
                    int count, bool clipped);
+  bool windowVertexSetup(const ClipVertex& c, WindowVertex& wv, FixedVertex& fv, double& reach,
+                         double& depth_reach) const;
+  void vertexReach(const ClipVertex& c, double& reach, double& depth_reach) const;
+  void setUpWindows(std::size_t object);
+  void drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, const WindowVertex* wv,
+                    const FixedVertex* fv, const double* reach, const double* depth_reach,
+                    int count, bool clipped);
   void prepareTriangle(TriangleContext& t) const;
   __attribute__((noinline)) void addSampleEdgeDistances(const WindowVertex* wv, int count,
                                                         const double* reach);
@@ -289,7 +309,9 @@ class Renderer {
   const CameraTransform camera_;
   const Lighting lighting_;
   const ClipVolume volume_;
-  std::vector<PreparedShading> shading_;  // per material
+  std::vector<PreparedShading> shading_;            // per material
+  std::vector<std::array<float, 4>> unlit_stored_;  // per material (prepareTriangle())
+  TriangleContext context_;  // the triangle being drawn (drawWindowed(): reused, not rebuilt)
 
   std::vector<std::vector<TransformedVertex>>& vertices_;  // per object, scratch
   std::vector<std::vector<LitColor>>& gouraud_;            // per object, Gouraud only, scratch
@@ -297,12 +319,13 @@ class Renderer {
   std::vector<std::uint32_t>& depth_;  // depth keys (fragment_ops.h), scratch
   UncertaintyTracker& gaps_;           // scratch
   EdgeDistanceBatch& edges_;           // scratch
-  const SampleShift shift_;            // multisampling: the sample drawn
-  std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
-  std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
-  std::vector<KeptFragment> kept_;     // A-buffer: blended fragments, in draw order
-  std::uint32_t blend_seq_ = 0;        // triangles of blending passes drawn so far
-  ABufferTally abuffer_;               // A-buffer: what the resolve found
+  std::vector<std::vector<VertexWindow>>& windows_;  // per object, per vertex, scratch
+  const SampleShift shift_;                          // multisampling: the sample drawn
+  std::uint64_t triangles_drawn_ = 0;                // fan triangles that reached the fragment loop
+  std::uint64_t fragments_ = 0;                      // covered pixel centres (depth tested or not)
+  std::vector<KeptFragment> kept_;                   // A-buffer: blended fragments, in draw order
+  std::uint32_t blend_seq_ = 0;                      // triangles of blending passes drawn so far
+  ABufferTally abuffer_;                             // A-buffer: what the resolve found
   // textureRange() of each texture met so far (linear filtering with uncertainty).
   std::vector<std::pair<const Texture*, glm::dvec4>> texture_ranges_;
   const glm::dvec4& textureRangeOf(const Texture* texture);
@@ -316,16 +339,23 @@ const glm::dvec4& Renderer::textureRangeOf(const Texture* texture) {
 }
 
 void Renderer::transformVertices() {
+  // Kept from the last frame (scratch): transformObject() and setUpWindows() rewrite every
+  // vertex they keep.
   vertices_.resize(scene_.objects.size());
-  for (auto& v : vertices_) v.clear();
+  windows_.resize(scene_.objects.size());
   const Shading shading = scene_.state.shading;
   if (shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
   for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
     const Object& obj = scene_.objects[o];
-    if (obj.mesh.triangles.empty()) continue;
+    if (obj.mesh.triangles.empty()) {
+      vertices_[o].clear();
+      windows_[o].clear();
+      continue;
+    }
     // Flat shading lights the face normal: vertex normals would go unused (unless traced).
     transformObject(obj, camera_, vertices_[o], shading != Shading::Flat || trace_ != nullptr,
                     uncertainty_);
+    setUpWindows(o);
     if (shading != Shading::Gouraud) continue;
     // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
     const PreparedShading& prepared = shading_[obj.material];
@@ -412,25 +442,106 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
     t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
   }
   t.constant = t.texture == nullptr && !t.pass->blend;
-  if (t.constant) {
+  if (t.constant && t.shading->lights.empty() && trace_ == nullptr) {
+    const std::array<float, 4>& c = unlit_stored_[obj.material];
+    for (int k = 0; k < 4; ++k) t.constant_stored[k] = c[k];
+  } else if (t.constant) {
     const glm::dvec4 c = finalColor(t.flat, glm::dvec3(1.0), t.material->opacity);
     for (int k = 0; k < 4; ++k) t.constant_stored[k] = storeColor(c[k], color_format_);
+  }
+}
+
+// drawPolygon()'s per-vertex work for one vertex (clip coordinates and error bound in `c`):
+// false where drawPolygon() drops the polygon (w <= 0, only a degenerate camera gets
+// there, or a non-finite window position). reach and depth_reach only with the
+// uncertainty channels.
+inline bool Renderer::windowVertexSetup(const ClipVertex& c, WindowVertex& wv, FixedVertex& fv,
+                                        double& reach, double& depth_reach) const {
+  if (!(c.clip.w > 0.0)) return false;
+  wv = toWindow(c, scene_.width, scene_.height);
+  if (!std::isfinite(wv.x) || !std::isfinite(wv.y) || !std::isfinite(wv.z)) return false;
+  fv = snapVertexScaled(wv.x, wv.y, snap_scale_);
+  if (shift_.active) {  // the sample position lands on the pixel centre
+    fv.x -= shift_.units_x;
+    fv.y -= shift_.units_y;
+  }
+  if (uncertainty_) {
+    vertexReach(c, reach, depth_reach);
+  } else {
+    reach = depth_reach = 0.0;  // not read
+  }
+  return true;
+}
+
+// How far a float32 implementation may put the vertex beyond snapping (its clip
+// coordinates' error through the divide and the viewport): its edges' reach, and the same
+// error in window depth, which the driver interpolates between the vertices (a convex
+// combination: the largest vertex's bounds it).
+inline void Renderer::vertexReach(const ClipVertex& c, double& reach, double& depth_reach) const {
+  reach = windowErrorPx(c, scene_.width, scene_.height);
+  if (!(reach < kMaxVertexReachPx)) reach = kMaxVertexReachPx;  // NaN too
+  const double dz = windowDepthError(c) * depth_steps_;
+  depth_reach = std::isnan(dz) ? std::numeric_limits<double>::infinity() : dz;
+}
+
+void Renderer::setUpWindows(std::size_t object) {
+  const std::vector<TransformedVertex>& verts = vertices_[object];
+  std::vector<VertexWindow>& out = windows_[object];
+  out.resize(verts.size());
+  WindowSetup setup;
+  setup.width = scene_.width;
+  setup.height = scene_.height;
+  setup.snap_scale = snap_scale_;
+  setup.volume = volume_;
+  if (shift_.active) {
+    setup.shift_x = shift_.units_x;
+    setup.shift_y = shift_.units_y;
+  }
+  setUpVertexWindows(verts.data(), verts.size(), setup, out.data());
+  if (!uncertainty_) return;
+  for (std::size_t i = 0; i < verts.size(); ++i) {
+    VertexWindow& w = out[i];
+    if ((w.flags & VertexWindow::kDrawable) == 0) continue;
+    vertexReach(ClipVertex{verts[i].clip, glm::dvec3(0.0), verts[i].clip_err}, w.reach,
+                w.depth_reach);
   }
 }
 
 void Renderer::drawTriangle(const PrimitiveRef& prim, const DrawPass& pass) {
   const Object& obj = scene_.objects[prim.object];
   const auto& tri = obj.mesh.triangles[prim.triangle];
+  const std::vector<VertexWindow>& windows = windows_[prim.object];
+  const VertexWindow* w[3] = {&windows[tri[0]], &windows[tri[1]], &windows[tri[2]]};
+  const unsigned all = w[0]->flags & w[1]->flags & w[2]->flags;
+  if (!(all & VertexWindow::kFinite)) return;  // NaN/Inf geometry: dropped
+  if (all & VertexWindow::kInside) {
+    // classifyTriangle()'s Inside case: the band can still drop it (every vertex beyond
+    // the same side), else drawPolygon() of the whole triangle, with its per-vertex work
+    // done once per vertex (setUpWindows()).
+    if (all >> VertexWindow::kRejectShift) return;
+    if (!(all & VertexWindow::kDrawable)) return;  // where drawPolygon() would return
+    WindowVertex wv[3];
+    FixedVertex fv[3];
+    double reach[3];
+    double depth_reach[3];
+    for (int k = 0; k < 3; ++k) {
+      wv[k] = WindowVertex{w[k]->x, w[k]->y, w[k]->z, w[k]->inv_w, glm::dvec3(0.0)};
+      wv[k].bary[k] = 1.0;
+      fv[k] = w[k]->fixed;
+      reach[k] = w[k]->reach;
+      depth_reach[k] = w[k]->depth_reach;
+    }
+    drawWindowed(prim, pass, wv, fv, reach, depth_reach, 3, false);
+    return;
+  }
   const std::vector<TransformedVertex>& verts = vertices_[prim.object];
   const glm::dvec4& c0 = verts[tri[0]].clip;
   const glm::dvec4& c1 = verts[tri[1]].clip;
   const glm::dvec4& c2 = verts[tri[2]].clip;
-  if (!isFinite(c0) || !isFinite(c1) || !isFinite(c2)) return;  // NaN/Inf geometry: dropped
-
   switch (classifyTriangle(c0, c1, c2, volume_)) {
     case ClipClass::Rejected:
       return;
-    case ClipClass::Inside: {  // what clipTriangle() would return, without its bookkeeping
+    case ClipClass::Inside: {  // not reached: every vertex inside is handled above
       const ClipVertex whole[3] = {{c0, {1.0, 0.0, 0.0}, verts[tri[0]].clip_err},
                                    {c1, {0.0, 1.0, 0.0}, verts[tri[1]].clip_err},
                                    {c2, {0.0, 0.0, 1.0}, verts[tri[2]].clip_err}};
@@ -454,17 +565,18 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
                            int count, bool clipped) {
   WindowVertex wv[kMaxClipVertices];
   FixedVertex fv[kMaxClipVertices];
-  for (int i = 0; i < count; ++i) {
-    if (!(poly[i].clip.w > 0.0)) return;  // only a degenerate camera gets here
-    wv[i] = toWindow(poly[i], scene_.width, scene_.height);
-    if (!std::isfinite(wv[i].x) || !std::isfinite(wv[i].y) || !std::isfinite(wv[i].z)) return;
-    fv[i] = snapVertexScaled(wv[i].x, wv[i].y, snap_scale_);
-    if (shift_.active) {  // the sample position lands on the pixel centre
-      fv[i].x -= shift_.units_x;
-      fv[i].y -= shift_.units_y;
-    }
-  }
+  double reach[kMaxClipVertices];
+  double depth_reach[kMaxClipVertices];
+  for (int i = 0; i < count; ++i)
+    if (!windowVertexSetup(poly[i], wv[i], fv[i], reach[i], depth_reach[i])) return;
+  drawWindowed(prim, pass, wv, fv, reach, depth_reach, count, clipped);
+}
 
+// drawPolygon() from its vertices' window and snapped positions on: culling, the
+// uncertainty channels, then each fan triangle's coverage and fragments.
+void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, const WindowVertex* wv,
+                            const FixedVertex* fv, const double* reach, const double* depth_reach,
+                            int count, bool clipped) {
   const bool ccw_is_front = scene_.state.front_face == FrontFace::CCW;
   const Cull cull = scene_.state.cull;
   auto culled = [&](bool ccw) {
@@ -472,21 +584,9 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     return (cull == Cull::Back && !front) || (cull == Cull::Front && front);
   };
 
-  double depth_reach[kMaxClipVertices] = {};  // steps, per vertex
   if (uncertainty_) {
-    // How far a float32 implementation may put each vertex beyond snapping (its clip
-    // coordinates' error through the divide and the viewport): its edges' reach, and the
-    // same error in window depth, which the driver interpolates between the vertices (a
-    // convex combination: the largest vertex's bounds it).
-    double reach[kMaxClipVertices];
     double max_reach = 0.0;
-    for (int i = 0; i < count; ++i) {
-      reach[i] = windowErrorPx(poly[i], scene_.width, scene_.height);
-      if (!(reach[i] < kMaxVertexReachPx)) reach[i] = kMaxVertexReachPx;  // NaN too
-      max_reach = std::max(max_reach, reach[i]);
-      const double dz = windowDepthError(poly[i]) * depth_steps_;
-      depth_reach[i] = std::isnan(dz) ? std::numeric_limits<double>::infinity() : dz;
-    }
+    for (int i = 0; i < count; ++i) max_reach = std::max(max_reach, reach[i]);
     const double area2 = polygonArea2(wv, count);
     const bool rasterized = area2 != 0.0 && !culled(area2 > 0.0);
     if (rasterized || cullCouldFlip(wv, count, max_reach)) {
@@ -498,9 +598,15 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
     }
   }
 
-  TriangleContext t;
+  // Reused from the last triangle: these are the fields read before prepareTriangle() and
+  // the per-fan set-up below write them; every other field is written before it is read
+  // (see TriangleContext).
+  TriangleContext& t = context_;
   t.prim = &prim;
   t.pass = &pass;
+  t.constant = false;
+  t.depth_slope = 0.0f;
+  t.texel_choice = false;
   bool prepared = false;
   // The clipped polygon is drawn as a fan; each piece is culled by its own snapped area
   // (as GL implementations set up each post-clip triangle).

@@ -2,6 +2,7 @@
 // fixtures/scene_logic.h (never re-derived here). It does not clip, cull or light.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -40,7 +41,22 @@ inline constexpr double kUlp32 = 0x1p-24;  // float32 unit roundoff
 // Transforms every vertex of the object (non-finite input gives non-finite output;
 // the renderer drops such triangles). Without `normals` (flat shading lights the face
 // normal, never a vertex normal) TransformedVertex::normal is left zero.
+// The vertices' world, clip and clip_err are computed four matrix rows a vector, each lane the
+// IEEE operation GLM's mat4 * vec4 does, (m0 x + m1 y) + (m2 z + m3 w): bit for bit
+// worldPosition() and view_projection * (world, 1).
 void transformObject(const Object& object, const CameraTransform& camera,
                      std::vector<TransformedVertex>& out, bool normals = true, bool errors = false);
+
+namespace detail {
+// The two builds transformObject() chooses between for the positions' part (world, clip,
+// clip_err; abs_vp: |view_projection| per entry), for the tests to run each (the AVX2 one
+// only where the CPU has AVX2).
+void transformPositionsBaseline(const glm::dmat4& model, const glm::dmat4& view_projection,
+                                const glm::dmat4& abs_vp, const glm::vec3* positions,
+                                std::size_t count, TransformedVertex* out, bool errors);
+void transformPositionsAvx2(const glm::dmat4& model, const glm::dmat4& view_projection,
+                            const glm::dmat4& abs_vp, const glm::vec3* positions, std::size_t count,
+                            TransformedVertex* out, bool errors);
+}  // namespace detail
 
 }  // namespace rc::ref

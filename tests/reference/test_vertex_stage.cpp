@@ -1,0 +1,254 @@
+// The vertex stage's and the per-vertex window set-up's vector code (reference/vertex_stage.cpp,
+// reference/vertex_windows.cpp) against the scalar functions they stand for, bit for bit,
+// in both builds (x86-64's baseline and AVX2): GLM's mat4 * vec4 for world and clip,
+// the clip error bound's formula, toWindow(), snapVertexScaled() and the per-vertex tests of
+// classifyTriangle(), on random vertices and on every edge the code branches on (NaN and
+// infinite coordinates, w <= 0, -0, points exactly on the clip, guard and reject planes,
+// snapping ties, magnitudes past 2^52 units) and on counts that leave partial vectors.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "fixtures/scene_geometry.h"
+#include "reference/clipper.h"
+#include "reference/rasterizer.h"
+#include "reference/vertex_stage.h"
+#include "reference/vertex_windows.h"
+#include "reference/viewport.h"
+
+namespace rc {
+namespace {
+
+using namespace rc::ref;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool sameBits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+::testing::AssertionResult sameVec(const double* a, const double* b, int n) {
+  for (int k = 0; k < n; ++k)
+    if (!sameBits(a[k], b[k]))
+      return ::testing::AssertionFailure()
+             << "component " << k << ": " << a[k] << " vs " << b[k] << " (bits differ)";
+  return ::testing::AssertionSuccess();
+}
+
+using TransformFn = void (*)(const glm::dmat4&, const glm::dmat4&, const glm::dmat4&,
+                             const glm::vec3*, std::size_t, TransformedVertex*, bool);
+using WindowFn = void (*)(const TransformedVertex*, std::size_t, const WindowSetup&, VertexWindow*);
+
+// The builds this CPU can run.
+std::vector<TransformFn> transformBuilds() {
+  std::vector<TransformFn> fns = {detail::transformPositionsBaseline};
+  if (__builtin_cpu_supports("avx2")) fns.push_back(detail::transformPositionsAvx2);
+  return fns;
+}
+std::vector<WindowFn> windowBuilds() {
+  std::vector<WindowFn> fns = {detail::setUpVertexWindowsBaseline};
+  if (__builtin_cpu_supports("avx2")) fns.push_back(detail::setUpVertexWindowsAvx2);
+  return fns;
+}
+
+glm::dmat4 randomMatrix(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> d(-3.0, 3.0);
+  glm::dmat4 m;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) m[c][r] = d(rng);
+  return m;
+}
+
+TEST(VertexStage, PositionsMatchGlmBitForBit) {
+  std::mt19937_64 rng(20261202);
+  std::uniform_real_distribution<float> pos(-100.0f, 100.0f);
+  for (int round = 0; round < 20; ++round) {
+    const glm::dmat4 model = randomMatrix(rng);
+    const glm::dmat4 vp = randomMatrix(rng);
+    glm::dmat4 abs_vp(0.0);
+    for (int c = 0; c < 4; ++c) abs_vp[c] = glm::abs(vp[c]);
+    std::vector<glm::vec3> positions;
+    for (int i = 0; i < 37; ++i) positions.push_back({pos(rng), pos(rng), pos(rng)});
+    positions.push_back({std::numeric_limits<float>::quiet_NaN(), 1.0f, 2.0f});
+    positions.push_back({std::numeric_limits<float>::infinity(), -0.0f, 0.0f});
+    positions.push_back({-0.0f, -0.0f, -0.0f});
+    positions.push_back({3.0e38f, -3.0e38f, 1.0e-45f});
+    for (const TransformFn fn : transformBuilds()) {
+      for (const bool errors : {false, true}) {
+        std::vector<TransformedVertex> out(positions.size());
+        fn(model, vp, abs_vp, positions.data(), positions.size(), out.data(), errors);
+        for (std::size_t i = 0; i < positions.size(); ++i) {
+          const glm::dvec3 world = worldPosition(model, positions[i]);
+          const glm::dvec4 clip = vp * glm::dvec4(world, 1.0);
+          const glm::dvec4 err =
+              errors ? (kClipRoundingUlps * kUlp32) * (abs_vp * glm::dvec4(glm::abs(world), 1.0))
+                     : glm::dvec4(0.0);
+          EXPECT_TRUE(sameVec(&out[i].world.x, &world.x, 3)) << "vertex " << i;
+          EXPECT_TRUE(sameVec(&out[i].clip.x, &clip.x, 4)) << "vertex " << i;
+          EXPECT_TRUE(sameVec(&out[i].clip_err.x, &err.x, 4)) << "vertex " << i;
+        }
+      }
+    }
+  }
+}
+
+// The scalar statement of one VertexWindow: the tests classifyTriangle() and drawPolygon()
+// make of a vertex, and what it computes for a drawable one.
+struct Expected {
+  std::uint8_t flags = 0;
+  WindowVertex window{};
+  FixedVertex fixed{};
+};
+
+Expected expected(const glm::dvec4& c, const WindowSetup& s) {
+  Expected e;
+  const bool finite =
+      std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w);
+  if (!finite) return e;
+  e.flags = VertexWindow::kFinite;
+  // classifyTriangle() of three copies of the vertex: Inside, or Rejected by the band only
+  // when inside every plane (the other answers mean "not inside").
+  const ClipClass whole = classifyTriangle(c, c, c, s.volume);
+  const bool inside = std::fabs(c.z) <= c.w && std::fabs(c.x) <= s.volume.guard_x * c.w &&
+                      std::fabs(c.y) <= s.volume.guard_y * c.w;
+  if (!inside) return e;
+  e.flags |= VertexWindow::kInside;
+  const unsigned beyond =
+      (c.x > s.volume.reject_x * c.w ? 1u : 0u) | (c.x < -s.volume.reject_x * c.w ? 2u : 0u) |
+      (c.y > s.volume.reject_y * c.w ? 4u : 0u) | (c.y < -s.volume.reject_y * c.w ? 8u : 0u);
+  EXPECT_EQ(whole == ClipClass::Rejected, beyond != 0) << "the band test disagrees";
+  e.flags |= static_cast<std::uint8_t>(beyond << VertexWindow::kRejectShift);
+  if (!(c.w > 0.0)) return e;
+  e.window = toWindow(ClipVertex{c, glm::dvec3(0.0), glm::dvec4(0.0)}, s.width, s.height);
+  if (!std::isfinite(e.window.x) || !std::isfinite(e.window.y) || !std::isfinite(e.window.z))
+    return e;
+  e.flags |= VertexWindow::kDrawable;
+  e.fixed = snapVertexScaled(e.window.x, e.window.y, s.snap_scale);
+  e.fixed.x -= s.shift_x;
+  e.fixed.y -= s.shift_y;
+  return e;
+}
+
+void expectWindowsMatch(const std::vector<glm::dvec4>& clips, const WindowSetup& setup) {
+  std::vector<TransformedVertex> verts(clips.size());
+  for (std::size_t i = 0; i < clips.size(); ++i) verts[i].clip = clips[i];
+  for (const WindowFn fn : windowBuilds()) {
+    // Every count from 0 to 5 past a multiple of four: partial vectors at the end.
+    for (std::size_t count = clips.size() >= 5 ? clips.size() - 5 : 0; count <= clips.size();
+         ++count) {
+      std::vector<VertexWindow> out(clips.size() + 1);
+      out.back().flags = 0xee;  // past the end: must stay as it is
+      fn(verts.data(), count, setup, out.data());
+      EXPECT_EQ(out.back().flags, 0xee);
+      for (std::size_t i = 0; i < count; ++i) {
+        const Expected e = expected(clips[i], setup);
+        const VertexWindow& w = out[i];
+        ASSERT_EQ(w.flags, e.flags)
+            << "vertex " << i << " clip (" << clips[i].x << ", " << clips[i].y << ", " << clips[i].z
+            << ", " << clips[i].w << ")";
+        if ((e.flags & VertexWindow::kDrawable) == 0) continue;
+        EXPECT_TRUE(sameBits(w.x, e.window.x) && sameBits(w.y, e.window.y) &&
+                    sameBits(w.z, e.window.z) && sameBits(w.inv_w, e.window.inv_w))
+            << "vertex " << i;
+        EXPECT_EQ(w.fixed.x, e.fixed.x) << "vertex " << i;
+        EXPECT_EQ(w.fixed.y, e.fixed.y) << "vertex " << i;
+      }
+    }
+  }
+}
+
+WindowSetup setupFor(int width, int height, int bits) {
+  WindowSetup s;
+  s.width = width;
+  s.height = height;
+  s.snap_scale = std::ldexp(1.0, bits);
+  s.volume = clipVolume(width, height, guardLimitPx(bits));
+  return s;
+}
+
+TEST(VertexWindows, RandomVerticesMatchTheScalarStagesBitForBit) {
+  std::mt19937_64 rng(20261203);
+  std::uniform_real_distribution<double> near(-1.5, 1.5);
+  std::uniform_real_distribution<double> far(-3000.0, 3000.0);
+  std::uniform_real_distribution<double> w(-0.5, 4.0);
+  for (const int bits : {0, 4, 8, 12}) {
+    for (const auto& [width, height] : {std::pair{640, 480}, std::pair{1, 1}, {16384, 3}}) {
+      WindowSetup setup = setupFor(width, height, bits);
+      std::vector<glm::dvec4> clips;
+      for (int i = 0; i < 403; ++i) {
+        const double ww = w(rng);
+        auto coord = [&] { return (i % 3 == 0 ? far(rng) : near(rng)) * std::fabs(ww); };
+        clips.push_back({coord(), coord(), near(rng) * ww, ww});
+      }
+      expectWindowsMatch(clips, setup);
+      setup.shift_x = 3;  // a sample shift (multisampling)
+      setup.shift_y = -5;
+      expectWindowsMatch(clips, setup);
+    }
+  }
+}
+
+TEST(VertexWindows, EdgeCasesMatchTheScalarStages) {
+  for (const int bits : {0, 8}) {
+    const WindowSetup setup = setupFor(200, 100, bits);
+    const double gx = setup.volume.guard_x;
+    const double rx = setup.volume.reject_x;
+    const double ry = setup.volume.reject_y;
+    std::vector<glm::dvec4> clips = {
+        {kNaN, 0.0, 0.0, 1.0},
+        {0.0, 0.0, 0.0, kNaN},
+        {kInf, 0.0, 0.0, 1.0},
+        {0.0, -kInf, 0.0, 1.0},
+        {0.0, 0.0, 0.0, 0.0},  // inside every plane at w = 0: not drawable
+        {-0.0, -0.0, -0.0, 0.0},
+        {0.0, 0.0, 0.0, -1.0},  // w < 0
+        {0.0, 0.0, 0.0, 1e-300},
+        {0.0, 0.0, 1.0, 1.0},   // on the far plane
+        {0.0, 0.0, -1.0, 1.0},  // on the near plane
+        {0.0, 0.0, 1.0000001, 1.0},
+        {gx * 2.0, 0.0, 0.0, 2.0},  // on the guard plane
+        {-gx * 2.0, 0.0, 0.0, 2.0},
+        {std::nextafter(gx * 2.0, kInf), 0.0, 0.0, 2.0},
+        {rx * 3.0, 0.0, 0.0, 3.0},  // on the reject band: not beyond
+        {std::nextafter(rx * 3.0, kInf), 0.0, 0.0, 3.0},
+        {-std::nextafter(rx * 3.0, kInf), 0.0, 0.0, 3.0},
+        {0.0, std::nextafter(ry, kInf), 0.0, 1.0},
+        {0.0, -std::nextafter(ry, kInf), 0.0, 1.0},
+        {-0.0, 0.0, -0.0, 1.0},
+        {1e-320, -1e-320, 0.0, 1.0},  // denormals
+        {0.5, 0.25, 0.5, 1e-3},
+    };
+    // Snapping ties: window x - 0.5 exactly half a subpixel unit off the grid, both signs
+    // and both parities; x_window = (x / w * 0.5 + 0.5) * width.
+    const double unit = std::ldexp(1.0, -bits);
+    for (const double px : {0.5 + 0.5 * unit, 0.5 + 1.5 * unit, 0.5 - 0.5 * unit, 0.5 - 1.5 * unit,
+                            100.5 + 2.5 * unit, 0.0, 200.0, -1.0}) {
+      const double x_ndc = (px / 200.0 - 0.5) * 2.0;
+      clips.push_back({x_ndc, x_ndc * 0.5, 0.0, 1.0});
+    }
+    expectWindowsMatch(clips, setup);
+  }
+}
+
+// A vertex far enough beyond the viewport that its snapped magnitude passes 2^52 units:
+// snapping must return the value itself (roundHalfEven()'s large-magnitude branch), in a
+// volume wide enough to call it inside.
+TEST(VertexWindows, HugeSnappedMagnitudesKeepTheirValue) {
+  WindowSetup setup = setupFor(100, 100, 12);
+  setup.volume.guard_x = setup.volume.guard_y = 1e30;
+  setup.volume.reject_x = setup.volume.reject_y = 1e30;
+  const std::vector<glm::dvec4> clips = {{1e14, -1e14, 0.0, 1.0},
+                                         {3e13, 7.0, 0.0, 1.0},
+                                         {-2.5e13, -3e13, 0.5, 1.0},
+                                         {1.0, 1.0, 0.0, 1.0}};
+  expectWindowsMatch(clips, setup);
+}
+
+}  // namespace
+}  // namespace rc
