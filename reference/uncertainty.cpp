@@ -163,63 +163,78 @@ class SegmentLanes {
         ax_(splat4(a.x)),
         ay_(splat4(a.y)),
         vreach_(splat4(reach)) {}
+  using Float4 = float __attribute__((vector_size(16)));
+
+  // Whether the vector path applies (else rc::ref::lowerRow() does the segment).
+  bool vectorised() const { return len2_ > 0.0 && std::isfinite(len2_); }
+  // (cy - a.y) * dy: the part of the projection that is the same along a row.
+  [[gnu::always_inline]] Lane4 alongY(double cy) const { return splat4((cy - a_.y) * dy_); }
+
   [[gnu::always_inline]] void lowerRow(float* row, int first, int last, int width,
                                        double cy) const {
-    if (!(len2_ > 0.0 && std::isfinite(len2_))) {
+    if (!vectorised()) {
       rc::ref::lowerRow(row, first, last, cy, a_, b_, reach_);
       return;
     }
-    using Float4 = float __attribute__((vector_size(16)));
-    const Lane4 along_y = splat4((cy - a_.y) * dy_);
+    const Lane4 along_y = alongY(cy);
     const Lane4 vcy = splat4(cy);
     for (int px = first; px < last; px += 4) {
       const int n = std::min(4, last - px);
       const bool whole = px + 4 <= width;  // four floats of the row to load and store
-      const double c0 = px + 0.5;
-      const Lane4 cx = {c0, c0 + 1.0, c0 + 2.0, c0 + 3.0};  // exact: small integers + 0.5
-      const Lane4 num = (cx - ax_) * vdx_ + along_y;
-      const Lane4 t = num >= vlen2_ ? splat4(1.0) : num <= splat4(0.0) ? splat4(0.0) : num / vlen2_;
-      const Lane4 qx = cx - (ax_ + t * vdx_);
-      const Lane4 qy = vcy - (ay_ + t * vdy_);
       Float4 cur_f = {1.0f, 1.0f, 1.0f, 1.0f};
       if (whole) {
         __builtin_memcpy(&cur_f, row + px, sizeof cur_f);
       } else {
         for (int k = 0; k < n; ++k) cur_f[k] = row[px + k];
       }
-      const Lane4 cur = __builtin_convertvector(cur_f, Lane4);
-      const Lane4 limit = cur + vreach_;
-      const Lane4 sum = qx * qx + qy * qy;
-      // Lanes the scalar code does not skip at its first test (NaN sums included).
-      const Mask4 in_range = Mask4{0, 1, 2, 3} < Mask4{n, n, n, n};
-      const Mask4 open = in_range & ~(sum >= limit * limit * splat4(1.0 + 0x1p-40));
-      if ((open[0] | open[1] | open[2] | open[3]) == 0) continue;
-      const Mask4 interval = (sum >= splat4(0x1p-1000)) & (sum < splat4(kInfinity));
-      const Lane4 root = sqrt4(sum);
-      const Lane4 lo = root * splat4(1.0 - 0x1p-48) - vreach_;
-      const Lane4 hi = root * splat4(1.0 + 0x1p-48) - vreach_;
-      const Mask4 lowers = lo < cur;
-      const Float4 stored = __builtin_convertvector(maxWithZero4(lo), Float4);
-      const Float4 stored_hi = __builtin_convertvector(maxWithZero4(hi), Float4);
-      const Mask4 same = __builtin_convertvector(stored == stored_hi, Mask4);
-      const Mask4 decided = open & interval & lowers & (hi < cur) & same;
-      // Lanes that need hypot: open, and the interval decides neither "no change" nor
-      // the stored value.
-      const Mask4 slow = open & ~(interval & (~lowers | decided));
-      const auto decided_f = __builtin_convertvector(decided, Float4Mask);
-      const Float4 out = decided_f ? stored : cur_f;
+      const Float4 out = lower4(cur_f, px, n, vcy, along_y);
       if (whole) {
         __builtin_memcpy(row + px, &out, sizeof out);
       } else {
         for (int k = 0; k < n; ++k) row[px + k] = out[k];
       }
-      if ((slow[0] | slow[1] | slow[2] | slow[3]) == 0) continue;
-      for (int k = 0; k < n; ++k) {
-        if (!slow[k]) continue;
-        const double d = std::hypot(qx[k], qy[k]) - reach_;
-        if (d < cur[k]) row[px + k] = static_cast<float>(std::max(d, 0.0));
-      }
     }
+  }
+
+  // The pixel centres px .. px + 3 of the row at vcy (along_y = alongY(cy)) whose values are
+  // cur_f: each lowered where the segment is closer, as rc::ref::lowerRow() lowers it; lanes
+  // n .. 3 returned unchanged. Only where vectorised().
+  [[gnu::always_inline]] Float4 lower4(Float4 cur_f, int px, int n, Lane4 vcy,
+                                       Lane4 along_y) const {
+    const double c0 = px + 0.5;
+    const Lane4 cx = {c0, c0 + 1.0, c0 + 2.0, c0 + 3.0};  // exact: small integers + 0.5
+    const Lane4 num = (cx - ax_) * vdx_ + along_y;
+    const Lane4 t = num >= vlen2_ ? splat4(1.0) : num <= splat4(0.0) ? splat4(0.0) : num / vlen2_;
+    const Lane4 qx = cx - (ax_ + t * vdx_);
+    const Lane4 qy = vcy - (ay_ + t * vdy_);
+    const Lane4 cur = __builtin_convertvector(cur_f, Lane4);
+    const Lane4 limit = cur + vreach_;
+    const Lane4 sum = qx * qx + qy * qy;
+    // Lanes the scalar code does not skip at its first test (NaN sums included).
+    const Mask4 in_range = Mask4{0, 1, 2, 3} < Mask4{n, n, n, n};
+    const Mask4 open = in_range & ~(sum >= limit * limit * splat4(1.0 + 0x1p-40));
+    if ((open[0] | open[1] | open[2] | open[3]) == 0) return cur_f;
+    const Mask4 interval = (sum >= splat4(0x1p-1000)) & (sum < splat4(kInfinity));
+    const Lane4 root = sqrt4(sum);
+    const Lane4 lo = root * splat4(1.0 - 0x1p-48) - vreach_;
+    const Lane4 hi = root * splat4(1.0 + 0x1p-48) - vreach_;
+    const Mask4 lowers = lo < cur;
+    const Float4 stored = __builtin_convertvector(maxWithZero4(lo), Float4);
+    const Float4 stored_hi = __builtin_convertvector(maxWithZero4(hi), Float4);
+    const Mask4 same = __builtin_convertvector(stored == stored_hi, Mask4);
+    const Mask4 decided = open & interval & lowers & (hi < cur) & same;
+    // Lanes that need hypot: open, and the interval decides neither "no change" nor
+    // the stored value.
+    const Mask4 slow = open & ~(interval & (~lowers | decided));
+    const auto decided_f = __builtin_convertvector(decided, Float4Mask);
+    Float4 out = decided_f ? stored : cur_f;
+    if ((slow[0] | slow[1] | slow[2] | slow[3]) == 0) return out;
+    for (int k = 0; k < n; ++k) {
+      if (!slow[k]) continue;
+      const double d = std::hypot(qx[k], qy[k]) - reach_;
+      if (d < cur[k]) out[k] = static_cast<float>(std::max(d, 0.0));
+    }
+    return out;
   }
 
  private:
@@ -297,6 +312,61 @@ __attribute__((target_clones("avx2", "default"))) void addSegment(const Point& a
   }
 }
 
+// Triangles at most this many pixels across (in x and in y), with every edge's reach at
+// most kSmallTriangleReachPx, are lowered in one pass over their bounding box widened by the
+// band (EdgeDistanceBatch): each group of four centres loaded once for the three edges.
+constexpr double kSmallTrianglePx = 4.0;
+constexpr double kSmallTriangleReachPx = 1.0;
+
+// The three edges of a small triangle (a -> b -> c -> a, each with its reach) lowered over
+// the triangle's bounding box widened by the band: a superset of each edge's own visits
+// (addSegment()), and visiting more centres changes nothing (lowerRow()), so each pixel
+// ends as addSegment() of the three edges leaves it, whatever the order. Every edge has a
+// finite, non-zero length (EdgeDistanceBatch::add() checks). Built like addSegment().
+__attribute__((target_clones("avx2", "default"))) void addSmallTriangle(
+    const Point& a, const Point& b, const Point& c, const double* reach, const PixelRect& clip,
+    int width, int height, float* edge_dist) {
+  const double band = 1.0 + std::max({reach[0], reach[1], reach[2]});
+  int row_first = 0;
+  int row_end = 0;
+  int col_first = 0;
+  int col_end = 0;
+  if (!centreRange(std::min({a.y, b.y, c.y}) - band, std::max({a.y, b.y, c.y}) + band, clip.y0,
+                   clip.y1, row_first, row_end) ||
+      !centreRange(std::min({a.x, b.x, c.x}) - band, std::max({a.x, b.x, c.x}) + band, clip.x0,
+                   clip.x1, col_first, col_end))
+    return;
+  const SegmentLanes ab(a, b, reach[0]);
+  const SegmentLanes bc(b, c, reach[1]);
+  const SegmentLanes ca(c, a, reach[2]);
+  for (int py = row_first; py < row_end; ++py) {
+    const double cy = py + 0.5;
+    float* row = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
+    const Lane4 vcy = splat4(cy);
+    const Lane4 along_ab = ab.alongY(cy);
+    const Lane4 along_bc = bc.alongY(cy);
+    const Lane4 along_ca = ca.alongY(cy);
+    for (int px = col_first; px < col_end; px += 4) {
+      const int n = std::min(4, col_end - px);
+      const bool whole = px + 4 <= width;  // four floats of the row to load and store
+      SegmentLanes::Float4 cur = {1.0f, 1.0f, 1.0f, 1.0f};
+      if (whole) {
+        __builtin_memcpy(&cur, row + px, sizeof cur);
+      } else {
+        for (int k = 0; k < n; ++k) cur[k] = row[px + k];
+      }
+      cur = ab.lower4(cur, px, n, vcy, along_ab);
+      cur = bc.lower4(cur, px, n, vcy, along_bc);
+      cur = ca.lower4(cur, px, n, vcy, along_ca);
+      if (whole) {
+        __builtin_memcpy(row + px, &cur, sizeof cur);
+      } else {
+        for (int k = 0; k < n; ++k) row[px + k] = cur[k];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& clip, int width,
@@ -310,6 +380,30 @@ void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& c
 }
 
 void EdgeDistanceBatch::add(const WindowVertex* polygon, int count, const double* reach_px) {
+  if (count == 3) {
+    SmallTriangle t{};
+    bool small = true;
+    for (int i = 0; i < 3 && small; ++i) {
+      const int j = i == 2 ? 0 : i + 1;
+      const double dx = polygon[j].x - polygon[i].x;
+      const double dy = polygon[j].y - polygon[i].y;
+      const double len2 = dx * dx + dy * dy;
+      t.x[i] = polygon[i].x;
+      t.y[i] = polygon[i].y;
+      t.reach[i] = std::max(reach_px[i], reach_px[j]);
+      // The vector path of every edge (a finite, non-zero length), a small box (finite
+      // coordinates: their differences are finite), a narrow band.
+      small = len2 > 0.0 && std::isfinite(len2) && std::fabs(dx) <= kSmallTrianglePx &&
+              std::fabs(dy) <= kSmallTrianglePx && t.reach[i] <= kSmallTriangleReachPx &&
+              std::isfinite(polygon[i].x) && std::isfinite(polygon[i].y);
+    }
+    if (small) {
+      const double low = std::min({t.y[0], t.y[1], t.y[2]});
+      t.key = static_cast<std::int32_t>(low > 0.0 ? std::min(low, 65536.0) : 0.0);
+      triangles_.push_back(t);
+      return;
+    }
+  }
   for (int i = 0; i < count; ++i) {
     const int j = (i + 1) % count;
     const WindowVertex& a = polygon[i];
@@ -333,6 +427,18 @@ void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, floa
   for (const Segment& s : segments_) sorted_[starts_[static_cast<std::size_t>(s.key)]++] = s;
   for (const Segment& s : sorted_)
     addSegment(Point{s.ax, s.ay}, Point{s.bx, s.by}, clip, width, height, edge_dist, s.reach);
+  // The small triangles, by the same counting sort.
+  max_key = 0;
+  for (const SmallTriangle& t : triangles_) max_key = std::max(max_key, t.key);
+  starts_.assign(static_cast<std::size_t>(max_key) + 2, 0);
+  for (const SmallTriangle& t : triangles_) ++starts_[static_cast<std::size_t>(t.key) + 1];
+  for (std::size_t k = 1; k < starts_.size(); ++k) starts_[k] += starts_[k - 1];
+  sorted_triangles_.resize(triangles_.size());
+  for (const SmallTriangle& t : triangles_)
+    sorted_triangles_[starts_[static_cast<std::size_t>(t.key)]++] = t;
+  for (const SmallTriangle& t : sorted_triangles_)
+    addSmallTriangle(Point{t.x[0], t.y[0]}, Point{t.x[1], t.y[1]}, Point{t.x[2], t.y[2]}, t.reach,
+                     clip, width, height, edge_dist);
   clear();
 }
 

@@ -304,12 +304,15 @@ void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& c
 // in random places otherwise miss it on nearly every row).
 class EdgeDistanceBatch {
  public:
-  void clear() { segments_.clear(); }
+  void clear() {
+    segments_.clear();
+    triangles_.clear();
+  }
   // The polygon's vertex positions and per-vertex reach, as addEdgeDistances() takes them.
   void add(const WindowVertex* polygon, int count, const double* reach_px);
   // addEdgeDistances() of every added polygon into edge_dist, then clear().
   void apply(const PixelRect& clip, int width, int height, float* edge_dist);
-  std::size_t capacity() const { return segments_.capacity(); }
+  std::size_t capacity() const { return segments_.capacity() + triangles_.capacity(); }
   void release() { *this = {}; }
 
  private:
@@ -323,8 +326,18 @@ class EdgeDistanceBatch {
     double reach;
     std::int32_t key;  // its lower row, clamped to [0, 65536] (the sort key)
   };
+  // A triangle at most kSmallTrianglePx across with narrow reaches, kept whole: its three
+  // edges are applied in one pass over its box (addSmallTriangle() in uncertainty.cpp).
+  struct SmallTriangle {
+    double x[3];
+    double y[3];
+    double reach[3];   // of the edge from vertex k to vertex k + 1
+    std::int32_t key;  // its lowest row, clamped to [0, 65536]
+  };
   std::vector<Segment> segments_;
   std::vector<Segment> sorted_;
+  std::vector<SmallTriangle> triangles_;
+  std::vector<SmallTriangle> sorted_triangles_;
   std::vector<std::uint32_t> starts_;
 };
 

@@ -337,8 +337,9 @@ TEST(EdgeDist, DistanceToEdgeSegmentsCappedAtOne) {
 // visit leaves min(cur, float(max(hypot(q) - reach, 0))) with q from the segment point
 // nearest the centre. Bit for bit, on random segments from a fraction of a pixel to longer
 // than the image (the short ones take the bounding-box rows, the long ones the per-row
-// band), in an image whose width is not a multiple of four (rows end inside a group of
-// four lanes), with and without reach, points on the segments and zero-length segments.
+// band; in the batch, triangles up to 4 px across take the small-triangle pass, all three
+// edges over one box), in an image whose width is not a multiple of four (rows end inside a group
+// of four lanes), with and without reach, points on the segments and zero-length segments.
 TEST(EdgeDist, EqualsItsDefinitionAtEveryPixelBitForBit) {
   constexpr int kW = 37;
   constexpr int kH = 23;

@@ -73,12 +73,17 @@ TEST(VertexStage, PositionsMatchGlmBitForBit) {
     const glm::dmat4 vp = randomMatrix(rng);
     glm::dmat4 abs_vp(0.0);
     for (int c = 0; c < 4; ++c) abs_vp[c] = glm::abs(vp[c]);
-    std::vector<glm::vec3> positions;
-    for (int i = 0; i < 37; ++i) positions.push_back({pos(rng), pos(rng), pos(rng)});
-    positions.push_back({std::numeric_limits<float>::quiet_NaN(), 1.0f, 2.0f});
-    positions.push_back({std::numeric_limits<float>::infinity(), -0.0f, 0.0f});
-    positions.push_back({-0.0f, -0.0f, -0.0f});
-    positions.push_back({3.0e38f, -3.0e38f, 1.0e-45f});
+    std::vector<glm::vec3> positions = {{std::numeric_limits<float>::quiet_NaN(), 1.0f, 2.0f},
+                                        {std::numeric_limits<float>::infinity(), -0.0f, 0.0f},
+                                        {-0.0f, -0.0f, -0.0f},
+                                        {3.0e38f, -3.0e38f, 1.0e-45f}};
+    positions.reserve(positions.size() + 37);
+    for (int i = 0; i < 37; ++i) {
+      const float x = pos(rng);
+      const float y = pos(rng);
+      const float z = pos(rng);
+      positions.emplace_back(x, y, z);
+    }
     for (const TransformFn fn : transformBuilds()) {
       for (const bool errors : {false, true}) {
         std::vector<TransformedVertex> out(positions.size());
@@ -184,7 +189,10 @@ TEST(VertexWindows, RandomVerticesMatchTheScalarStagesBitForBit) {
       for (int i = 0; i < 403; ++i) {
         const double ww = w(rng);
         auto coord = [&] { return (i % 3 == 0 ? far(rng) : near(rng)) * std::fabs(ww); };
-        clips.push_back({coord(), coord(), near(rng) * ww, ww});
+        const double x = coord();
+        const double y = coord();
+        const double z = near(rng) * ww;
+        clips.emplace_back(x, y, z, ww);
       }
       expectWindowsMatch(clips, setup);
       setup.shift_x = 3;  // a sample shift (multisampling)
@@ -230,7 +238,7 @@ TEST(VertexWindows, EdgeCasesMatchTheScalarStages) {
     for (const double px : {0.5 + 0.5 * unit, 0.5 + 1.5 * unit, 0.5 - 0.5 * unit, 0.5 - 1.5 * unit,
                             100.5 + 2.5 * unit, 0.0, 200.0, -1.0}) {
       const double x_ndc = (px / 200.0 - 0.5) * 2.0;
-      clips.push_back({x_ndc, x_ndc * 0.5, 0.0, 1.0});
+      clips.emplace_back(x_ndc, x_ndc * 0.5, 0.0, 1.0);
     }
     expectWindowsMatch(clips, setup);
   }
