@@ -1,7 +1,7 @@
-// Reference renderer throughput, single-threaded, at 1024 x 1024: many tiny triangles
-// (setup cost) and full-screen layers per shading mode (per-fragment cost), each with the
-// uncertainty channels off and on (the CLI default). Counters: tris_per_s (the scene's
-// triangles) and frags_per_s (covered pixel centres, depth-tested or not, as the renderer
+// Reference renderer throughput, single-threaded, at 1024 x 1024: many tiny triangles, as a
+// soup and as one mesh (setup cost) and full-screen layers per shading mode (per-fragment cost),
+// each with the uncertainty channels off and on (the CLI default). Counters: tris_per_s (the
+// scene's triangles) and frags_per_s (covered pixel centres, depth-tested or not, as the renderer
 // counts them in frame.meta). The scenes come from rc_scene_builders
 // (tests/reference/test_scenes.h), which bench_gl renders too. Commands: docs/reference.md.
 #include <benchmark/benchmark.h>
@@ -46,6 +46,18 @@ void BM_SmallTriangles(benchmark::State& state) {
   run(state, scene, state.range(0) != 0);
 }
 BENCHMARK(BM_SmallTriangles)->ArgName("uncertainty")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// The same 100k triangles of 2 px^2 as one grid mesh (shared vertices, drawn in row order):
+// how a tessellated model arrives, next to the soup above.
+void BM_SmallTriangleMesh(benchmark::State& state) {
+  static const Scene scene = test::smallTriangleMeshScene(kSize, 100000);
+  run(state, scene, state.range(0) != 0);
+}
+BENCHMARK(BM_SmallTriangleMesh)
+    ->ArgName("uncertainty")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond);
 
 // 8 full-screen layers drawn back to front (8 * 1024^2 fragments, all passing), one point
 // light, Blinn-Phong, shininess 32.

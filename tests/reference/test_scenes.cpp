@@ -1,7 +1,9 @@
 // Scenes built in code: see test_scenes.h.
 #include "tests/reference/test_scenes.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 
 namespace rc::test {
@@ -246,6 +248,38 @@ Scene smallTrianglesScene(int size, int count) {
     const float z = 0.25f + 0.5f * static_cast<float>(i % 97) / 97.0f;
     o.mesh.positions.insert(o.mesh.positions.end(), {{x, y, z}, {x + 2, y, z}, {x, y + 2, z}});
     o.mesh.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
+  }
+  o.mesh.normals.assign(o.mesh.positions.size(), {0.0f, 0.0f, 1.0f});
+  s.objects.push_back(std::move(o));
+  return s;
+}
+
+Scene smallTriangleMeshScene(int size, int count) {
+  Scene s = windowScene(size, size);
+  s.name = "bench/small_triangle_mesh";
+  s.state.shading = Shading::Flat;
+  Object o;
+  o.name = "grid";
+  // cols x rows cells, as square as the window allows (2 px a cell).
+  const int cells = std::max(1, count / 2);
+  const int cols = std::max(1, std::min(size / 2 - 1, static_cast<int>(std::sqrt(cells))));
+  const int rows = std::max(1, (cells + cols - 1) / cols);
+  const float x0 = 0.5f * static_cast<float>(size - 2 * cols) + 0.25f;
+  const float y0 = 0.5f * static_cast<float>(size - 2 * rows) + 0.25f;
+  for (int j = 0; j <= rows; ++j) {
+    for (int i = 0; i <= cols; ++i) {
+      const float z = 0.25f + 0.5f * static_cast<float>(i + j) / static_cast<float>(cols + rows);
+      o.mesh.positions.emplace_back(x0 + 2.0f * static_cast<float>(i),
+                                    y0 + 2.0f * static_cast<float>(j), z);
+    }
+  }
+  const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(j * (cols + 1) + i); };
+  for (int j = 0; j < rows && static_cast<int>(o.mesh.triangles.size()) < count; ++j) {
+    for (int i = 0; i < cols && static_cast<int>(o.mesh.triangles.size()) < count; ++i) {
+      o.mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      if (static_cast<int>(o.mesh.triangles.size()) < count)
+        o.mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
   }
   o.mesh.normals.assign(o.mesh.positions.size(), {0.0f, 0.0f, 1.0f});
   s.objects.push_back(std::move(o));

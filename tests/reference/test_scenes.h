@@ -61,6 +61,12 @@ std::string frameBytes(const Frame& frame);
 // cycling through 97 values in [0.25, 0.75). Setup-bound: measures triangles per second.
 Scene smallTrianglesScene(int size = 1024, int count = 100000);
 
+// The same number of triangles of the same size as one mesh, the way a finely tessellated
+// model arrives: a grid of 2 x 2 px cells, each split into two triangles, every inner vertex
+// shared by six triangles (about count / 2 vertices), centred in the size x size window, its
+// depth a gentle slope in [0.25, 0.75], flat shaded. Every fragment passes.
+Scene smallTriangleMeshScene(int size = 1024, int count = 100000);
+
 // `layers` rectangles one pixel larger than the size x size window on every side, drawn
 // back to front (z = 0.1, 0.2, ...; every fragment passes the depth test and is shaded and
 // written), lit by one point light at (300, 700, 400) * size / 1024, ambient 0.1, Blinn-Phong
