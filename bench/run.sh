@@ -89,8 +89,10 @@ for d, _, _ in gls:
     head += [f"ref / {d}", f"ref+unc / {d}"]
 print("| " + " | ".join(head) + " |")
 print("|" + "---|" * len(head))
-scenes = ["BM_SmallTriangles", "BM_Layers/shading:0", "BM_Layers/shading:1", "BM_Layers/shading:2"]
-labels = {"BM_SmallTriangles": "100k 2-px triangles, flat", "BM_Layers/shading:0": "8 layers, flat",
+scenes = ["BM_SmallTriangles", "BM_SmallTriangleMesh", "BM_Layers/shading:0", "BM_Layers/shading:1",
+          "BM_Layers/shading:2"]
+labels = {"BM_SmallTriangles": "100k 2-px triangles, flat", "BM_SmallTriangleMesh": "the same as one mesh",
+          "BM_Layers/shading:0": "8 layers, flat",
           "BM_Layers/shading:1": "8 layers, gouraud", "BM_Layers/shading:2": "8 layers, phong"}
 for scene in scenes:
     r0 = ref.get(scene + "/uncertainty:0")

@@ -181,6 +181,11 @@ void BM_SmallTriangles(benchmark::State& state) {
   renderScene(state, scene);
 }
 
+void BM_SmallTriangleMesh(benchmark::State& state) {
+  static const rc::Scene scene = rc::bench::smallTriangleMesh();
+  renderScene(state, scene);
+}
+
 void BM_Layers(benchmark::State& state) {
   static const rc::Scene scenes[3] = {rc::bench::layers(rc::Shading::Flat),
                                       rc::bench::layers(rc::Shading::Gouraud),
@@ -204,6 +209,7 @@ BENCHMARK(BM_Stages1080p)
     ->UseRealTime();
 BENCHMARK(BM_HarnessOverhead1080p)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SmallTriangles)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SmallTriangleMesh)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Layers)
     ->ArgName("shading")
     ->DenseRange(0, 2)

@@ -52,6 +52,8 @@ Scene sphere1080p(ColorFormat color) {
 
 Scene smallTriangles() { return test::smallTrianglesScene(kRefSize, 100000); }
 
+Scene smallTriangleMesh() { return test::smallTriangleMeshScene(kRefSize, 100000); }
+
 Scene layers(Shading shading) { return test::layersScene(shading, kRefSize, 8); }
 
 }  // namespace rc::bench

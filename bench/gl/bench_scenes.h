@@ -16,6 +16,8 @@ Scene sphere1080p(ColorFormat color);
 // (tests/reference/test_scenes.h) with the same parameters:
 // 100k right triangles with 2-pixel legs at random positions, flat, one material.
 Scene smallTriangles();
+// The same triangles as one grid mesh (shared vertices, row order).
+Scene smallTriangleMesh();
 // 8 full-screen rectangles back to front, one point light, Blinn-Phong, shininess 32.
 Scene layers(Shading shading);
 
