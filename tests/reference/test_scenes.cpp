@@ -229,10 +229,18 @@ std::string frameBytes(const Frame& frame) {
   return out;
 }
 
-Scene smallTrianglesScene(int size, int count) {
+namespace {
+// A flat-shaded size x size window scene named `name` (the small-triangle benchmarks).
+Scene flatWindowScene(int size, const char* name) {
   Scene s = windowScene(size, size);
-  s.name = "bench/small_triangles";
+  s.name = name;
   s.state.shading = Shading::Flat;
+  return s;
+}
+}  // namespace
+
+Scene smallTrianglesScene(int size, int count) {
+  Scene s = flatWindowScene(size, "bench/small_triangles");
   Object o;
   o.name = "triangles";
   std::uint32_t seed = 1;
@@ -255,9 +263,7 @@ Scene smallTrianglesScene(int size, int count) {
 }
 
 Scene smallTriangleMeshScene(int size, int count) {
-  Scene s = windowScene(size, size);
-  s.name = "bench/small_triangle_mesh";
-  s.state.shading = Shading::Flat;
+  Scene s = flatWindowScene(size, "bench/small_triangle_mesh");
   Object o;
   o.name = "grid";
   // cols x rows cells, as square as the window allows (2 px a cell).
