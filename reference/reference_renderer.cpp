@@ -837,8 +837,12 @@ struct PhongQuad {
 // lanes per instruction where SSE2 does two.
 __attribute__((target_clones("avx2", "default"))) void shadePhongQuad(
     const PhongQuad& q, const FragmentInterpolator::Row& row) {
-  Lane4 dx = splat4(q.dx[0]);  // unused lanes repeat the first fragment
-  for (int lane = 1; lane < q.count; ++lane) dx[lane] = q.dx[lane];
+  // One load (a loop over the lanes compiled to a call of memcpy); unused lanes repeat the
+  // first fragment.
+  Lane4 dx;
+  __builtin_memcpy(&dx, q.dx, sizeof dx);
+  const Mask4 used = Mask4{0, 1, 2, 3} < Mask4{q.count, q.count, q.count, q.count};
+  dx = used ? dx : splat4(q.dx[0]);
   Lane4 b[3];
   q.interp->barycentricAt4(row, dx, b);
   const Vec3x4 p = combine4(b[0], b[1], b[2], q.world[0], q.world[1], q.world[2]);
@@ -846,19 +850,33 @@ __attribute__((target_clones("avx2", "default"))) void shadePhongQuad(
       safeNormalize4(combine4(b[0], b[1], b[2], q.normal[0], q.normal[1], q.normal[2]));
   const LitColor4 lit = shadePrepared4(*q.shading, p, n);
   const Vec3x4 c = lit.ambient_diffuse + lit.specular;
-  for (int lane = 0; lane < q.count; ++lane) {
-    float* out = q.colors + 4 * q.index[lane];
-    if (q.rgba8) {
+  if (q.rgba8) {
+    for (int lane = 0; lane < q.count; ++lane) {
+      float* out = q.colors + 4 * q.index[lane];
       out[0] = storeColor(c.x[lane], ColorFormat::RGBA8);
       out[1] = storeColor(c.y[lane], ColorFormat::RGBA8);
       out[2] = storeColor(c.z[lane], ColorFormat::RGBA8);
-    } else {
-      out[0] = static_cast<float>(c.x[lane]);
-      out[1] = static_cast<float>(c.y[lane]);
-      out[2] = static_cast<float>(c.z[lane]);
+      out[3] = q.alpha;
     }
-    out[3] = q.alpha;
+    return;
   }
+  // rgba32f: the conversions four lanes at a time (each lane's float(c) as the scalar cast
+  // rounds it), then each fragment's four channels stored as one vector.
+  using Float4 = float __attribute__((vector_size(16)));
+  const Float4 r = __builtin_convertvector(c.x, Float4);
+  const Float4 g = __builtin_convertvector(c.y, Float4);
+  const Float4 bl = __builtin_convertvector(c.z, Float4);
+  const Float4 a = {q.alpha, q.alpha, q.alpha, q.alpha};
+  const Float4 rg_lo = __builtin_shufflevector(r, g, 0, 4, 1, 5);   // r0 g0 r1 g1
+  const Float4 rg_hi = __builtin_shufflevector(r, g, 2, 6, 3, 7);   // r2 g2 r3 g3
+  const Float4 ba_lo = __builtin_shufflevector(bl, a, 0, 4, 1, 5);  // b0 a b1 a
+  const Float4 ba_hi = __builtin_shufflevector(bl, a, 2, 6, 3, 7);  // b2 a b3 a
+  const Float4 px[4] = {__builtin_shufflevector(rg_lo, ba_lo, 0, 1, 4, 5),
+                        __builtin_shufflevector(rg_lo, ba_lo, 2, 3, 6, 7),
+                        __builtin_shufflevector(rg_hi, ba_hi, 0, 1, 4, 5),
+                        __builtin_shufflevector(rg_hi, ba_hi, 2, 3, 6, 7)};
+  for (int lane = 0; lane < q.count; ++lane)
+    __builtin_memcpy(q.colors + 4 * q.index[lane], &px[lane], sizeof px[lane]);
 }
 
 // The shade functor of fillSpans() for untextured, unblended Phong: fragments that passed

@@ -101,8 +101,10 @@ struct LitColor4 {
 };
 [[gnu::always_inline]] inline LitColor4 shadePrepared4(const PreparedShading& s, const Vec3x4& p,
                                                        const Vec3x4& n) {
-  const Vec3x4 ambient = splat4(s.ambient);
-  LitColor4 out{ambient, splat4(glm::dvec3(0.0))};
+  // The sums in plain locals, not in a LitColor4 built up front: GCC copied that aggregate
+  // through the stack in 8-byte pieces on every call.
+  Vec3x4 ambient_diffuse = splat4(s.ambient);
+  Vec3x4 specular_sum = {splat4(0.0), splat4(0.0), splat4(0.0)};
   // n == 0 (every component compares equal to zero): ambient only.
   const Mask4 zero_normal = (n.x == splat4(0.0)) & (n.y == splat4(0.0)) & (n.z == splat4(0.0));
   const Vec3x4 v = safeNormalize4(splat4(s.eye) - p);
@@ -141,10 +143,10 @@ struct LitColor4 {
       diffuse = splat4(light.kd_radiance) * maxZero4(n_dot_l);
       specular = splat4(light.ks_radiance) * power;
     }
-    out.ambient_diffuse = select4(lit, out.ambient_diffuse + diffuse, out.ambient_diffuse);
-    out.specular = select4(lit, out.specular + specular, out.specular);
+    ambient_diffuse = select4(lit, ambient_diffuse + diffuse, ambient_diffuse);
+    specular_sum = select4(lit, specular_sum + specular, specular_sum);
   }
-  return out;
+  return LitColor4{ambient_diffuse, specular_sum};
 }
 
 #pragma GCC diagnostic pop
