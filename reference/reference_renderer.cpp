@@ -935,9 +935,12 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
     const FragmentInterpolator::Row row = kBarycentrics ? interp.row(cy) : interp.depthRow(cy);
     const std::size_t row_index =
         static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    // In a local: the depth and id stores (std::uint32_t) may alias clip_.x0 (int), so the
+    // member would be reloaded for every fragment.
+    const int x0 = clip_.x0;
     for (int px = x_begin; px < x_end; ++px) {
       const double dx = interp.dx(px + 0.5);
-      const std::size_t index = row_index + static_cast<std::size_t>(px - clip_.x0);
+      const std::size_t index = row_index + static_cast<std::size_t>(px - x0);
       const double z = clampDepth(interp.depthAt(row, dx));
       const std::uint32_t key = depthKey(z, kFormat);  // kFormat constant: the switch folds
       const bool pass = always || key < depth[index];
