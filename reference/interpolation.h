@@ -64,13 +64,16 @@ class FragmentInterpolator {
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // inlined: no 32-byte vector crosses a call
-  // barycentricAt() at four pixels of the row (dx per lane): in each lane the same
-  // operations on the same operands, the quotient's choice as a per-lane select.
-  [[gnu::always_inline]] void barycentricAt4(const Row& r, Lane4 dx, Lane4 out[3]) const {
-    const Lane4 den = splat4(r.inv_w) + splat4(inv_w_.ddx) * dx;
-    const Mask4 row_quotient = (den == splat4(r.inv_w)) & (den != splat4(0.0));
-    const Lane4 inv = row_quotient ? splat4(r.w) : splat4(1.0) / den;
-    for (int k = 0; k < 3; ++k) out[k] = (splat4(r.num[k]) + splat4(num_[k].ddx) * dx) * inv;
+  // barycentricAt() at four or eight pixels of the row (V is Lane4 or Lane8; dx per lane):
+  // in each lane the same operations on the same operands, the quotient's choice as a
+  // per-lane select.
+  template <class V>
+  [[gnu::always_inline]] void barycentricAtLanes(const Row& r, V dx, V out[3]) const {
+    const V den = splatAs<V>(r.inv_w) + splatAs<V>(inv_w_.ddx) * dx;
+    const MaskOf<V> row_quotient = (den == splatAs<V>(r.inv_w)) & (den != splatAs<V>(0.0));
+    const V inv = selectLanes(row_quotient, splatAs<V>(r.w), splatAs<V>(1.0) / den);
+    for (int k = 0; k < 3; ++k)
+      out[k] = (splatAs<V>(r.num[k]) + splatAs<V>(num_[k].ddx) * dx) * inv;
   }
 
 #pragma GCC diagnostic pop

@@ -810,13 +810,14 @@ inline void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool 
   for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
 }
 
-// Lane4 values stay inside shadePhongQuad() (everything it calls is inlined): -Wpsabi's
-// note on passing 32-byte vectors without AVX does not apply (for the rest of the file:
-// GCC also gives it at the end of the translation unit).
+// Lane4 and Lane8 values stay inside shadePhongQuad() (everything it calls is inlined):
+// -Wpsabi's note on passing 32-byte vectors without AVX does not apply (for the rest of the
+// file: GCC also gives it at the end of the translation unit).
 #pragma GCC diagnostic ignored "-Wpsabi"
 
-// Untextured, unblended Phong fragments of one row, up to four: what PhongQuads shades.
+// Untextured, unblended Phong fragments of one row, up to eight: what PhongQuads shades.
 struct PhongQuad {
+  static constexpr int kMax = 8;
   const FragmentInterpolator* interp = nullptr;
   const PreparedShading* shading = nullptr;
   glm::dvec3 world[3];   // the original vertices' world positions
@@ -825,62 +826,92 @@ struct PhongQuad {
   bool rgba8 = false;
   float alpha = 0.0f;  // the stored opacity
   int count = 0;       // fragments pending
-  std::size_t index[4] = {0, 0, 0, 0};
-  double dx[4] = {0.0, 0.0, 0.0, 0.0};
+  std::size_t index[kMax] = {};
+  double dx[kMax] = {};
 };
 
-// The colour of the quad's fragments: with b = barycentricAt(row, dx), the scalar form is
-// store(ambient_diffuse + specular of shadePrepared(shading, b.x * w0 + b.y * w1 + b.z *
-// w2, safeNormalize(b.x * n0 + b.y * n1 + b.z * n2))); here lane by lane the same
-// operations (shading_lanes.h). Compiled twice, for x86-64's baseline and for AVX2 (no
-// FMA), and picked at load time: the bits are the same either way, AVX2 only does four
-// lanes per instruction where SSE2 does two.
-__attribute__((target_clones("avx2", "default"))) void shadePhongQuad(
-    const PhongQuad& q, const FragmentInterpolator::Row& row) {
-  // One load (a loop over the lanes compiled to a call of memcpy); unused lanes repeat the
-  // first fragment.
-  Lane4 dx;
-  __builtin_memcpy(&dx, q.dx, sizeof dx);
-  const Mask4 used = Mask4{0, 1, 2, 3} < Mask4{q.count, q.count, q.count, q.count};
-  dx = used ? dx : splat4(q.dx[0]);
-  Lane4 b[3];
-  q.interp->barycentricAt4(row, dx, b);
-  const Vec3x4 p = combine4(b[0], b[1], b[2], q.world[0], q.world[1], q.world[2]);
-  const Vec3x4 n =
-      safeNormalize4(combine4(b[0], b[1], b[2], q.normal[0], q.normal[1], q.normal[2]));
-  const LitColor4 lit = shadePrepared4(*q.shading, p, n);
-  const Vec3x4 c = lit.ambient_diffuse + lit.specular;
-  if (q.rgba8) {
-    for (int lane = 0; lane < q.count; ++lane) {
-      float* out = q.colors + 4 * q.index[lane];
-      out[0] = storeColor(c.x[lane], ColorFormat::RGBA8);
-      out[1] = storeColor(c.y[lane], ColorFormat::RGBA8);
-      out[2] = storeColor(c.z[lane], ColorFormat::RGBA8);
-      out[3] = q.alpha;
-    }
-    return;
+using Float4 = float __attribute__((vector_size(16)));
+
+// Lanes 4h .. 4h + 3 of v.
+template <class V>
+[[gnu::always_inline]] inline Lane4 quarterOf(V v, int h) {
+  if constexpr (std::is_same_v<V, Lane8>) {
+    return h == 0 ? v.lo : v.hi;
+  } else {
+    return v;
   }
-  // rgba32f: the conversions four lanes at a time (each lane's float(c) as the scalar cast
-  // rounds it), then each fragment's four channels stored as one vector.
-  using Float4 = float __attribute__((vector_size(16)));
-  const Float4 r = __builtin_convertvector(c.x, Float4);
-  const Float4 g = __builtin_convertvector(c.y, Float4);
-  const Float4 bl = __builtin_convertvector(c.z, Float4);
-  const Float4 a = {q.alpha, q.alpha, q.alpha, q.alpha};
-  const Float4 rg_lo = __builtin_shufflevector(r, g, 0, 4, 1, 5);   // r0 g0 r1 g1
-  const Float4 rg_hi = __builtin_shufflevector(r, g, 2, 6, 3, 7);   // r2 g2 r3 g3
-  const Float4 ba_lo = __builtin_shufflevector(bl, a, 0, 4, 1, 5);  // b0 a b1 a
-  const Float4 ba_hi = __builtin_shufflevector(bl, a, 2, 6, 3, 7);  // b2 a b3 a
+}
+
+// rgba32f: fragments 0 .. n-1 of four (channels r, g, b per lane, each float(c) as the
+// scalar cast rounds it), each fragment's four channels stored as one vector.
+[[gnu::always_inline]] inline void storeRgba32f(float* colors, const std::size_t* index, int n,
+                                                Lane4 cr, Lane4 cg, Lane4 cb, float alpha) {
+  const Float4 r = __builtin_convertvector(cr, Float4);
+  const Float4 g = __builtin_convertvector(cg, Float4);
+  const Float4 b = __builtin_convertvector(cb, Float4);
+  const Float4 a = {alpha, alpha, alpha, alpha};
+  const Float4 rg_lo = __builtin_shufflevector(r, g, 0, 4, 1, 5);  // r0 g0 r1 g1
+  const Float4 rg_hi = __builtin_shufflevector(r, g, 2, 6, 3, 7);  // r2 g2 r3 g3
+  const Float4 ba_lo = __builtin_shufflevector(b, a, 0, 4, 1, 5);  // b0 a b1 a
+  const Float4 ba_hi = __builtin_shufflevector(b, a, 2, 6, 3, 7);  // b2 a b3 a
   const Float4 px[4] = {__builtin_shufflevector(rg_lo, ba_lo, 0, 1, 4, 5),
                         __builtin_shufflevector(rg_lo, ba_lo, 2, 3, 6, 7),
                         __builtin_shufflevector(rg_hi, ba_hi, 0, 1, 4, 5),
                         __builtin_shufflevector(rg_hi, ba_hi, 2, 3, 6, 7)};
-  for (int lane = 0; lane < q.count; ++lane)
-    __builtin_memcpy(q.colors + 4 * q.index[lane], &px[lane], sizeof px[lane]);
+  for (int lane = 0; lane < n; ++lane)
+    __builtin_memcpy(colors + 4 * index[lane], &px[lane], sizeof px[lane]);
+}
+
+// The pending fragments in the lanes of V (Lane4 for up to four, Lane8 for more).
+template <class V>
+[[gnu::always_inline]] inline void shadePhongLanes(const PhongQuad& q,
+                                                   const FragmentInterpolator::Row& row) {
+  // One load (a loop over the lanes compiled to a call of memcpy); unused lanes repeat the
+  // first fragment.
+  V dx;
+  __builtin_memcpy(&dx, q.dx, sizeof dx);
+  dx = selectLanes(lanesBelow<V>(q.count), dx, splatAs<V>(q.dx[0]));
+  V b[3];
+  q.interp->barycentricAtLanes(row, dx, b);
+  const Vec3L<V> p = combineLanes(b[0], b[1], b[2], q.world[0], q.world[1], q.world[2]);
+  const Vec3L<V> n =
+      safeNormalizeLanes(combineLanes(b[0], b[1], b[2], q.normal[0], q.normal[1], q.normal[2]));
+  const LitColorL<V> lit = shadePreparedLanes(*q.shading, p, n);
+  const Vec3L<V> c = lit.ambient_diffuse + lit.specular;
+  if (q.rgba8) {
+    for (int k = 0; k < q.count; ++k) {
+      float* out = q.colors + 4 * q.index[k];
+      out[0] = storeColor(c.x[k], ColorFormat::RGBA8);
+      out[1] = storeColor(c.y[k], ColorFormat::RGBA8);
+      out[2] = storeColor(c.z[k], ColorFormat::RGBA8);
+      out[3] = q.alpha;
+    }
+    return;
+  }
+  for (int h = 0; 4 * h < q.count; ++h)
+    storeRgba32f(q.colors, q.index + 4 * h, std::min(4, q.count - 4 * h), quarterOf(c.x, h),
+                 quarterOf(c.y, h), quarterOf(c.z, h), q.alpha);
+}
+
+// The colour of the pending fragments: with b = barycentricAt(row, dx), the scalar form is
+// store(ambient_diffuse + specular of shadePrepared(shading, b.x * w0 + b.y * w1 + b.z *
+// w2, safeNormalize(b.x * n0 + b.y * n1 + b.z * n2))); here lane by lane the same
+// operations (shading_lanes.h), in four lanes up to four fragments and in eight above (two
+// independent halves the processor overlaps: the chain of divisions and square roots of
+// one quad is long). Compiled twice, for x86-64's baseline and for AVX2 (no FMA), and
+// picked at load time: the bits are the same either way, AVX2 only does four lanes per
+// instruction where SSE2 does two.
+__attribute__((target_clones("avx2", "default"))) void shadePhongQuad(
+    const PhongQuad& q, const FragmentInterpolator::Row& row) {
+  if (q.count <= 4) {
+    shadePhongLanes<Lane4>(q, row);
+  } else {
+    shadePhongLanes<Lane8>(q, row);
+  }
 }
 
 // The shade functor of fillSpans() for untextured, unblended Phong: fragments that passed
-// are collected and coloured four at a time, the rest at the end of each span (fillSpans()
+// are collected and coloured eight at a time, the rest at the end of each span (fillSpans()
 // calls flush()). Deferring a colour write past later fragments of the span changes
 // nothing: nothing in the loop reads colour, and a span's pixels are distinct.
 class PhongQuads {
@@ -900,7 +931,7 @@ class PhongQuads {
   TexelNote operator()(std::size_t index, const FragmentInterpolator::Row& row, double dx) {
     q_.index[q_.count] = index;
     q_.dx[q_.count] = dx;
-    if (++q_.count == 4) flush(row);
+    if (++q_.count == PhongQuad::kMax) flush(row);
     return TexelNote{};
   }
   void flush(const FragmentInterpolator::Row& row) {

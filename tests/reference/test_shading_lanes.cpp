@@ -1,6 +1,6 @@
-// The four-lane shading of untextured Phong spans (reference/shading_lanes.h) against the
-// scalar shadePrepared() it stands for: every lane must give the scalar result bit for bit,
-// on random points and normals and on every branch (zero normal, light at the shaded point,
+// The four- and eight-lane shading of untextured Phong spans (reference/shading_lanes.h) against
+// the scalar shadePrepared() it stands for: every lane must give the scalar result bit for bit, on
+// random points and normals and on every branch (zero normal, light at the shaded point,
 // directional and point lights, each attenuation, both specular models, shininess 0,
 // integral, power of two and fractional), compiled for x86-64's baseline and for AVX2.
 #include <gtest/gtest.h>
@@ -8,6 +8,7 @@
 #include <bit>
 #include <cstdint>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include "reference/shading.h"
@@ -22,45 +23,72 @@ namespace {
 
 using namespace rc::ref;
 
+// Eight points and normals: the Lane8 form shades all eight, the Lane4 form the first
+// four and then the last four.
 struct LaneInput {
-  glm::dvec3 p[4];
-  glm::dvec3 n[4];
+  glm::dvec3 p[8];
+  glm::dvec3 n[8];
 };
 struct LaneOutput {
-  glm::dvec3 ad[4];
-  glm::dvec3 sp[4];
+  glm::dvec3 ad[8];
+  glm::dvec3 sp[8];
 };
 
-template <class Out>
-void unpack(const LitColor4& lit, Out& out) {
-  for (int k = 0; k < 4; ++k) {
-    out.ad[k] = {lit.ambient_diffuse.x[k], lit.ambient_diffuse.y[k], lit.ambient_diffuse.z[k]};
-    out.sp[k] = {lit.specular.x[k], lit.specular.y[k], lit.specular.z[k]};
+double laneOf(Lane4 v, int k) { return v[k]; }
+double laneOf(const Lane8& v, int k) { return v[k]; }
+
+template <class V>
+void unpack(const LitColorL<V>& lit, int first, LaneOutput& out) {
+  for (int k = 0; k < kLaneCount<V>; ++k) {
+    out.ad[first + k] = {laneOf(lit.ambient_diffuse.x, k), laneOf(lit.ambient_diffuse.y, k),
+                         laneOf(lit.ambient_diffuse.z, k)};
+    out.sp[first + k] = {laneOf(lit.specular.x, k), laneOf(lit.specular.y, k),
+                         laneOf(lit.specular.z, k)};
   }
 }
 
-Vec3x4 pack(const glm::dvec3* v) {
-  Vec3x4 r;
-  for (int k = 0; k < 4; ++k) {
-    r.x[k] = v[k].x;
-    r.y[k] = v[k].y;
-    r.z[k] = v[k].z;
+template <class V>
+Vec3L<V> pack(const glm::dvec3* v) {
+  Vec3L<V> r{};
+  for (int k = 0; k < kLaneCount<V>; ++k) {
+    if constexpr (std::is_same_v<V, Lane8>) {
+      r.x.set(k, v[k].x);
+      r.y.set(k, v[k].y);
+      r.z.set(k, v[k].z);
+    } else {
+      r.x[k] = v[k].x;
+      r.y[k] = v[k].y;
+      r.z[k] = v[k].z;
+    }
   }
   return r;
 }
 
-// The same inlined code compiled for the baseline and for AVX2 (as the renderer's
-// target_clones function is).
-LaneOutput shadeBaseline(const PreparedShading& s, const LaneInput& in) {
+template <class V>
+[[gnu::always_inline]] inline LaneOutput shadeLanes(const PreparedShading& s, const LaneInput& in) {
   LaneOutput out;
-  unpack(shadePrepared4(s, pack(in.p), safeNormalize4(pack(in.n))), out);
+  for (int first = 0; first < 8; first += kLaneCount<V>)
+    unpack<V>(
+        shadePreparedLanes<V>(s, pack<V>(in.p + first), safeNormalizeLanes(pack<V>(in.n + first))),
+        first, out);
   return out;
 }
-__attribute__((target("avx2"))) LaneOutput shadeAvx2(const PreparedShading& s,
-                                                     const LaneInput& in) {
-  LaneOutput out;
-  unpack(shadePrepared4(s, pack(in.p), safeNormalize4(pack(in.n))), out);
-  return out;
+
+// The same inlined code compiled for the baseline and for AVX2 (as the renderer's
+// target_clones function is), four and eight lanes at a time.
+LaneOutput shadeBaseline4(const PreparedShading& s, const LaneInput& in) {
+  return shadeLanes<Lane4>(s, in);
+}
+LaneOutput shadeBaseline8(const PreparedShading& s, const LaneInput& in) {
+  return shadeLanes<Lane8>(s, in);
+}
+__attribute__((target("avx2"))) LaneOutput shadeAvx2_4(const PreparedShading& s,
+                                                       const LaneInput& in) {
+  return shadeLanes<Lane4>(s, in);
+}
+__attribute__((target("avx2"))) LaneOutput shadeAvx2_8(const PreparedShading& s,
+                                                       const LaneInput& in) {
+  return shadeLanes<Lane8>(s, in);
 }
 
 bool sameBits(const glm::dvec3& a, const glm::dvec3& b) {
@@ -69,19 +97,21 @@ bool sameBits(const glm::dvec3& a, const glm::dvec3& b) {
   return true;
 }
 
-// Checks every lane of both builds against shadePrepared(s, p, safeNormalize(n)).
+// Checks every lane of both builds, four and eight lanes wide, against
+// shadePrepared(s, p, safeNormalize(n)).
 void expectLanesEqualScalar(const PreparedShading& s, const LaneInput& in, const char* what) {
-  const LaneOutput base = shadeBaseline(s, in);
   const bool avx2 = __builtin_cpu_supports("avx2");
-  const LaneOutput wide = avx2 ? shadeAvx2(s, in) : base;
-  for (int k = 0; k < 4; ++k) {
+  const LaneOutput outs[4] = {shadeBaseline4(s, in), shadeBaseline8(s, in),
+                              avx2 ? shadeAvx2_4(s, in) : shadeBaseline4(s, in),
+                              avx2 ? shadeAvx2_8(s, in) : shadeBaseline8(s, in)};
+  const char* builds[4] = {"baseline, 4 lanes", "baseline, 8 lanes", "AVX2, 4 lanes",
+                           "AVX2, 8 lanes"};
+  for (int k = 0; k < 8; ++k) {
     const LitColor scalar = shadePrepared(s, in.p[k], safeNormalize(in.n[k]));
-    EXPECT_TRUE(sameBits(base.ad[k], scalar.ambient_diffuse) &&
-                sameBits(base.sp[k], scalar.specular))
-        << what << " lane " << k << ": baseline lanes differ from the scalar shading";
-    EXPECT_TRUE(sameBits(wide.ad[k], scalar.ambient_diffuse) &&
-                sameBits(wide.sp[k], scalar.specular))
-        << what << " lane " << k << ": AVX2 lanes differ from the scalar shading";
+    for (int b = 0; b < 4; ++b)
+      EXPECT_TRUE(sameBits(outs[b].ad[k], scalar.ambient_diffuse) &&
+                  sameBits(outs[b].sp[k], scalar.specular))
+          << what << " lane " << k << ": " << builds[b] << " differ from the scalar shading";
   }
 }
 
@@ -112,14 +142,17 @@ TEST(ShadingLanes, EveryLaneIsTheScalarShadingBitForBit) {
         const PreparedShading s = prepareShading(lighting, m);
         for (int round = 0; round < 40; ++round) {
           LaneInput in;
-          for (int k = 0; k < 4; ++k) {
+          for (int k = 0; k < 8; ++k) {
             in.p[k] = vec();
             in.n[k] = vec();
           }
           // Branches: a zero normal, a point at the first light, a point at the eye.
           if (round % 4 == 1) in.n[round % 3] = glm::dvec3(0.0);
+          if (round % 4 == 2) in.n[4 + round % 3] = glm::dvec3(0.0);
           if (round % 5 == 2) in.p[3] = lights[0].position;
+          if (round % 5 == 3) in.p[6] = lights[2].position;
           if (round % 7 == 3) in.p[1] = lighting.eye;
+          if (round % 7 == 4) in.p[7] = lighting.eye;
           expectLanesEqualScalar(s, in, "random");
           ++cases;
         }
@@ -143,15 +176,22 @@ TEST(ShadingLanes, ComparisonSeesASmallMove) {
   lighting.lights = &lights;
   const PreparedShading s = prepareShading(lighting, m);
   LaneInput in;
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < 8; ++k) {
     in.p[k] = {0.1 * k, 0.2, 0.3};
     in.n[k] = {0.1, 0.2, 1.0};
   }
-  const LaneOutput base = shadeBaseline(s, in);
-  const glm::dvec3 moved_p = {in.p[2].x + 1e-9, in.p[2].y, in.p[2].z};
-  const LitColor scalar = shadePrepared(s, moved_p, safeNormalize(in.n[2]));
-  EXPECT_FALSE(sameBits(base.ad[2], scalar.ambient_diffuse) &&
-               sameBits(base.sp[2], scalar.specular));
+  for (const LaneOutput& base : {shadeBaseline4(s, in), shadeBaseline8(s, in)}) {
+    for (const int k : {2, 6}) {
+      const glm::dvec3 moved_p = {in.p[k].x + 1e-9, in.p[k].y, in.p[k].z};
+      const LitColor scalar = shadePrepared(s, moved_p, safeNormalize(in.n[k]));
+      EXPECT_FALSE(sameBits(base.ad[k], scalar.ambient_diffuse) &&
+                   sameBits(base.sp[k], scalar.specular));
+      // And unmoved, the same bits (the lane is the one compared).
+      const LitColor same = shadePrepared(s, in.p[k], safeNormalize(in.n[k]));
+      EXPECT_TRUE(sameBits(base.ad[k], same.ambient_diffuse) &&
+                  sameBits(base.sp[k], same.specular));
+    }
+  }
 }
 
 }  // namespace
