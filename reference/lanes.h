@@ -36,7 +36,13 @@ struct Lane8 {
   Lane4 lo;
   Lane4 hi;
   double operator[](int k) const { return k < 4 ? lo[k] : hi[k - 4]; }
-  void set(int k, double v) { (k < 4 ? lo[k] : hi[k - 4]) = v; }
+  void set(int k, double v) {
+    if (k < 4) {
+      lo[k] = v;
+    } else {
+      hi[k - 4] = v;
+    }
+  }
 };
 [[gnu::always_inline]] inline Lane8 operator+(Lane8 a, Lane8 b) {
   return {a.lo + b.lo, a.hi + b.hi};

@@ -889,8 +889,8 @@ template <class V>
     return;
   }
   for (int h = 0; 4 * h < q.count; ++h)
-    storeRgba32f(q.colors, q.index + 4 * h, std::min(4, q.count - 4 * h), quarterOf(c.x, h),
-                 quarterOf(c.y, h), quarterOf(c.z, h), q.alpha);
+    storeRgba32f(q.colors, &q.index[static_cast<std::size_t>(4 * h)], std::min(4, q.count - 4 * h),
+                 quarterOf(c.x, h), quarterOf(c.y, h), quarterOf(c.z, h), q.alpha);
 }
 
 // The colour of the pending fragments: with b = barycentricAt(row, dx), the scalar form is
