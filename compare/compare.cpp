@@ -801,6 +801,15 @@ class Comparator {
       }
     }
     ShadingExcess out;
+    // The colour's own sensitivity to its vertices' positions (shade_reach, units per px,
+    // from the reference's attribute planes): where the neighbours show a flatter gradient
+    // than the surface has, as around a sliver whose pixels have no same-primitive
+    // neighbour, it is the gradient the slope band moves (docs/tolerances.md (b)).
+    double plane = 0.0;
+    if (have_uncertainty_ && u_.id[i] == e_.id[i]) {
+      const double r = u_.shade_reach[i];
+      plane = std::isnan(r) ? 0.0 : r;
+    }
     // What the reference knows at the pixel: with nearest filtering, a sample within the
     // band of a texel boundary may take the texel across it (texel_alt, RGB only); in
     // rgba8 every blended fragment may round differently (blend_count).
@@ -821,8 +830,10 @@ class Comparator {
     }
     for (int c = 0; c < 4; ++c) {
       const double m = std::max(std::fabs(pa[c]), std::fabs(pb[c]));
-      out.allowances[c] = shade_relative_units_ * m + shade_slope_band_ * around.gradient[c] +
-                          blends + (c < 3 ? texel + filtering : 0.0) + coverage_allowance_;
+      const double gradient =
+          c < 3 ? std::max(static_cast<double>(around.gradient[c]), plane) : around.gradient[c];
+      out.allowances[c] = shade_relative_units_ * m + shade_slope_band_ * gradient + blends +
+                          (c < 3 ? texel + filtering : 0.0) + coverage_allowance_;
     }
     for (int c = 0; c < 4; ++c) {
       const double excess = d[c] - out.allowances[c];

@@ -85,8 +85,9 @@ std::string depthText(const PairResult& r) {
 }
 
 std::string shadingAllowanceText(const Tolerances& t, double slope_band_px) {
-  std::string s = fmt::format("{:.3g} x 255 x |C| + {:.3g} x {:.3g} px x |dC/dpx|",
-                              t.shading_relative, t.shading_slope_factor, slope_band_px);
+  std::string s =
+      fmt::format("{:.3g} x 255 x |C| + {:.3g} x {:.3g} px x max(|dC/dpx|, shade_reach)",
+                  t.shading_relative, t.shading_slope_factor, slope_band_px);
   if (t.texture_weight_error > 0.0 || t.texture_rounding_units > 0.0)
     s += fmt::format(" + {:.3g} x texel_alt + {:.3g} x texel_gain (linear texture filtering)",
                      t.texture_weight_error, t.texture_rounding_units);

@@ -253,6 +253,11 @@ std::string story(const Json& doc) {
         "  texel_dist {} px: a texel boundary that close may be sampled on either side; "
         "texel_alt {} units is the colour change the other texel makes\n",
         fmtNum(doc["texel_dist"]), fmtNum(doc["texel_alt"]));
+  if (doc["shade_reach"].is_number() && doc["shade_reach"].get<double>() > 0.0)
+    s += fmt::format(
+        "  shade_reach {} units/px: how much the colour moves per px its vertices move "
+        "(interpolated colours; the slope band times it is allowed)\n",
+        fmtNum(doc["shade_reach"]));
   if (doc["blend_count"].is_number() && doc["blend_count"].get<double>() > 0.0)
     s += fmt::format("  blend_count {} blended fragments, blend_gap {} steps, blend_slope {}\n",
                      fmtNum(doc["blend_count"]), fmtNum(doc["blend_gap"]),

@@ -134,11 +134,13 @@ struct TriangleContext {
 };
 
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
+// And, despite the name, what it adds to shade_reach (interpolated colours).
 struct TexelNote {
   float dist = 1.0f;   // px
   float alt = 0.0f;    // 8-bit units, weighted as the fragment's colour is in the pixel
   float gain = 0.0f;   // units per texel unit, weighted alike
   float reach = 0.0f;  // linear filtering: texels (s + t) the sample may move
+  float shade = 0.0f;  // shade_reach: 8-bit units per px of vertex movement, weighted alike
 };
 
 // A blended fragment the A-buffer keeps (ReferenceOptions::abuffer) until its pixel's list
@@ -285,6 +287,9 @@ class Renderer {
   glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b, ShadingTerms* terms,
                            TexelNote* note = nullptr, const FragmentInterpolator* interp = nullptr,
                            const FragmentInterpolator::Row* row = nullptr, double dx = 0.0) const;
+  float gouraudReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
+                     const FragmentInterpolator& interp, const FragmentInterpolator::Row& row,
+                     double dx) const;
   TexelNote texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                       const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
                       const FragmentInterpolator::Row& row, double dx) const;
@@ -701,6 +706,9 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   }
   const glm::dvec4 color = finalColor(lit, tex, t.material->opacity);
   if (note && t.texel_choice) *note = texelNote(t, uv, b, lit.ambient_diffuse, *interp, *row, dx);
+  if constexpr (kShading == Shading::Gouraud) {
+    if (note) note->shade = gouraudReach(t, b, tex, *interp, *row, dx);
+  }
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
     terms->texture = tex;
@@ -708,6 +716,35 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
     terms->color = color;
   }
   return color;
+}
+
+// shade_reach of a Gouraud fragment (docs/tolerances.md (b)): its colour T * AD + S
+// follows planes through the triangle's vertices (AD and S interpolated; T, the texture,
+// has its own channels). Another implementation's planes go through its snapped vertices:
+// with each moved by up to d px, the plane's value at the pixel moves, to first order, by
+// grad C . sum_k b_k delta_k, at most |grad C| * sum_k |b_k| * d (b the pixel's
+// barycentrics: sum |b_k| = 1 inside the triangle, more where the centre is covered only by
+// the snapped triangle, as at a sliver's edge). The largest channel's |grad C| * sum |b_k|
+// in 8-bit units per px, weighted by alpha when the fragment is blended; infinite where it
+// is not a number.
+float Renderer::gouraudReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
+                             const FragmentInterpolator& interp,
+                             const FragmentInterpolator::Row& row, double dx) const {
+  glm::dvec3 db[2];
+  interp.barycentricGradient(row, dx, b, db);
+  double worst = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const glm::dvec3 ad(t.gouraud[0]->ambient_diffuse[c], t.gouraud[1]->ambient_diffuse[c],
+                        t.gouraud[2]->ambient_diffuse[c]);
+    const glm::dvec3 sp(t.gouraud[0]->specular[c], t.gouraud[1]->specular[c],
+                        t.gouraud[2]->specular[c]);
+    const double gx = tex[c] * glm::dot(db[0], ad) + glm::dot(db[0], sp);
+    const double gy = tex[c] * glm::dot(db[1], ad) + glm::dot(db[1], sp);
+    worst = std::max(worst, std::sqrt(gx * gx + gy * gy));
+  }
+  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+  const double reach = 255.0 * worst * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
+  return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
 }
 
 // The texel channels of a textured fragment (docs/tolerances.md (c), (d), (e)), in 8-bit
@@ -995,7 +1032,8 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       ids[index] = id;
       const TexelNote note = shade(index, row, dx);
       if constexpr (kGaps)
-        gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain, note.reach);
+        gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain, note.reach,
+                            note.shade);
     }
     if constexpr (requires { shade.flush(row); }) shade.flush(row);
   });
@@ -1056,13 +1094,16 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
       const LitColor g0 = *t.gouraud[0];
       const LitColor g1 = *t.gouraud[1];
       const LitColor g2 = *t.gouraud[2];
+      const bool notes = uncertainty_;
       fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
         const glm::dvec3 b = interp.barycentricAt(row, dx);
         const glm::dvec3 ad =
             b.x * g0.ambient_diffuse + b.y * g1.ambient_diffuse + b.z * g2.ambient_diffuse;
         const glm::dvec3 sp = b.x * g0.specular + b.y * g1.specular + b.z * g2.specular;
         store(index, ad + sp);
-        return TexelNote{};
+        TexelNote note;
+        if (notes) note.shade = gouraudReach(t, b, glm::dvec3(1.0), interp, row, dx);
+        return note;
       });
     } else {
       // Phong: four fragments at a time (shadePhongQuad() has the scalar form).
@@ -1184,7 +1225,7 @@ void Renderer::resolveABuffer() {
       writeColor(index, f.color, true);
       if (uncertainty_)
         gaps_.colourWritten(index, true, f.alpha, f.note.dist, f.note.alt, f.note.gain,
-                            f.note.reach);
+                            f.note.reach, f.note.shade);
       z.push_back(f.z);
       slope.push_back(f.slope);
       if (sorted_ != nullptr) sorted_->push_back({f.id, f.seq, f.z, f.color, storedColor(index)});
@@ -1277,6 +1318,7 @@ constexpr bool kTakeSmallest[kUncertaintyChannels] = {
     false,  // texel_gain
     false,  // depth_reach
     false,  // texel_reach
+    false,  // shade_reach
 };
 
 // Multisampling: one render per sample (SampleShift), then the resolve: the colour is the

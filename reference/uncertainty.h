@@ -74,9 +74,9 @@ namespace rc::ref {
 //    clear_gap as they stand then): the smallest such gap, and the steepest fragment;
 //  - depth_reach: the largest float32 reach (steps) of every fragment the pixel saw, drawn
 //    or not: it bounds the stored depth's error and both sides of every comparison above;
-//  - blend_count, texel_dist, texel_alt, texel_gain, texel_reach: composited like the
-//    colour itself (colourWritten()): an opaque write starts them afresh, a blended one
-//    adds its own, weighted by alpha (texel_reach: the largest).
+//  - blend_count, texel_dist, texel_alt, texel_gain, texel_reach, shade_reach: composited
+//    like the colour itself (colourWritten()): an opaque write starts them afresh, a blended
+//    one adds its own, weighted by alpha (texel_reach: the largest).
 //
 // Storage: the window depth of the fragment that stored each pixel's depth (a double: the
 // gap must be exact), and the gaps already in steps, as the floats the frame keeps:
@@ -105,6 +105,7 @@ class UncertaintyTracker {
     texel_gain_ = frame.texel_gain.data();
     depth_reach_ = frame.depth_reach.data();
     texel_reach_ = frame.texel_reach.data();
+    shade_reach_ = frame.shade_reach.data();
   }
 
   // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px)
@@ -144,18 +145,20 @@ class UncertaintyTracker {
   }
 
   // A fragment's colour was written: over the old one when `blended` (with weight `alpha`),
-  // else in its place. texel_dist / texel_alt are the fragment's own (texel_alt already
-  // weighted by alpha when blended).
+  // else in its place. texel_dist / texel_alt are the fragment's own (texel_alt, texel_gain
+  // and shade_reach already weighted by alpha when blended).
   void colourWritten(std::size_t index, bool blended, float alpha, float texel_dist,
-                     float texel_alt, float texel_gain, float texel_reach) {
+                     float texel_alt, float texel_gain, float texel_reach, float shade_reach) {
     if (!blended) {
       blend_count_[index] = 0.0f;
       texel_dist_[index] = texel_dist;
       texel_alt_[index] = texel_alt;
       texel_gain_[index] = texel_gain;
       texel_reach_[index] = texel_reach;
+      shade_reach_[index] = shade_reach;
       return;
     }
+    shade_reach_[index] = (1.0f - alpha) * shade_reach_[index] + shade_reach;
     blend_count_[index] += 1.0f;
     texel_reach_[index] = std::max(texel_reach_[index], texel_reach);
     texel_dist_[index] = std::min(texel_dist_[index], texel_dist);
@@ -255,6 +258,7 @@ class UncertaintyTracker {
   float* texel_gain_ = nullptr;
   float* depth_reach_ = nullptr;
   float* texel_reach_ = nullptr;
+  float* shade_reach_ = nullptr;
 };
 
 // Twice the signed area (> 0 counter-clockwise) and the perimeter of a window polygon.

@@ -740,6 +740,34 @@ TEST_F(CompareTest, TexelReachWidensLinearFilteringByItsShare) {
   EXPECT_EQ(run(1e6f, whole + fail + 1.0), n);
 }
 
+// shade_reach (docs/tolerances.md (b)): the attribute-plane term is the slope band times the
+// larger of the neighbours' gradient and the reference's shade_reach, on R, G and B. With
+// 1e5 units/px the band's share passes on green, a percent more (plus fail) fails; without
+// the channel, or on alpha (no interpolated attribute moves it), the same error fails.
+TEST_F(CompareTest, ShadeReachWidensTheAttributePlaneTerm) {
+  tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F);
+  const Block b = kBackBlock;
+  const double band = compare().depth.band_px;
+  ASSERT_GT(band, 0.0);
+  const double share = tol_.shading_slope_factor * band * 1e5;
+  const Frame original = gl_;
+  auto run = [&](float reach, double units, int channel) {
+    gl_ = original;
+    forBlock(b, [&](int x, int y) {
+      const std::size_t i = ref_.index(x, y);
+      ref_.shade_reach[i] = reach;
+      gl_.color[i * 4 + channel] = ref_.color[i * 4 + channel] + static_cast<float>(units / 255.0);
+    });
+    return compare().shading.over_fail;
+  };
+  const auto n = static_cast<std::uint64_t>(b.size());
+  const double fail = tol_.shading.fail;
+  EXPECT_EQ(run(1e5f, share, 1), 0u);
+  EXPECT_EQ(run(1e5f, 1.01 * share + fail + 1.0, 1), n);
+  EXPECT_EQ(run(0.0f, share, 1), n) << "without shade_reach";
+  EXPECT_EQ(run(1e5f, share, 3), n) << "alpha";
+}
+
 // rgba8 blending: each blended fragment may round its way (2 units, docs/tolerances.md).
 TEST_F(CompareTest, Rgba8BlendsEachAddTheirRounding) {
   tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);

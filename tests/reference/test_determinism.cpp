@@ -78,7 +78,7 @@ TEST(Determinism, IdenticalAcrossOptimisationLevels) {
 }
 
 // The golden listing (tests/reference/data/golden_frames.txt): one hash over every buffer
-// of the frame (colour, depth, id and all 12 uncertainty channels, frameBytes()) per
+// of the frame (colour, depth, id and every uncertainty channel, frameBytes()) per
 // catalog fixture, random scene (`generate --seed 1 --count 10` under four profiles; their
 // files are pinned by RandomScenes.GoldenHash) and benchmark scene, each under the four
 // option sets of renderCorpus(). It was recorded before the reference's speed work of

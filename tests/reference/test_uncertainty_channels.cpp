@@ -4,9 +4,12 @@
 // blend_gap from the layers drawn.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "reference/fragment_ops.h"
 #include "reference/reference_renderer.h"
@@ -237,6 +240,95 @@ TEST(UncertaintyChannels, TexelAltOfABlendedLayerIsWeightedByItsAlpha) {
   EXPECT_EQ(f.blend_count[i], 1.0f);
   EXPECT_EQ(f.texel_dist[i], 0.0f);
   EXPECT_NEAR(f.texel_alt[i], 0.25 * kRowsContrast, 1e-3);
+}
+
+// shade_reach (docs/tolerances.md (b)): for Gouraud, sum |b_k| times the largest channel's
+// screen gradient of the interpolated colour, in 8-bit units per px. Under the window
+// scene's orthographic camera the colour is an affine function of the window position, so
+// inside the triangle (sum |b_k| = 1) the channel equals 255 times the largest channel's
+// |(C(x+1, y) - C(x, y), C(x, y+1) - C(x, y))| read off the frame itself; a blended layer's
+// is weighted by its alpha; flat shading has none. At a sliver's edge, where the centre is
+// covered by the snapped triangle but outside the exact one, it grows with sum |b_k|.
+Scene gouraudRamp() {
+  Scene s = test::windowScene(32, 32);
+  s.state.shading = Shading::Gouraud;
+  s.state.color_format = ColorFormat::RGBA32F;
+  s.ambient_light = glm::dvec3(0.0);
+  s.lights.push_back(Light{LightType::Directional, {}, {0.0, 0.0, -1.0}, {1.0, 0.8, 0.6}, 2.0});
+  s.materials[0].diffuse = {0.9, 0.7, 0.5};
+  const std::size_t o =
+      test::addMesh(s, {{-8, -8, 0.5f}, {40, -8, 0.5f}, {-8, 40, 0.5f}}, {{0, 1, 2}});
+  // n.l differs per vertex, so the lit vertex colours do: 1, 0.8, 0.6 (normalised normals).
+  s.objects[o].mesh.normals = {{0.0f, 0.0f, 1.0f}, {0.6f, 0.0f, 0.8f}, {0.0f, 0.8f, 0.6f}};
+  return s;
+}
+
+TEST(UncertaintyChannels, ShadeReachIsTheGouraudColoursGradient) {
+  const Scene s = gouraudRamp();
+  const Frame f = renderReference(s);
+  int checked = 0;
+  for (const auto& [x, y] : {std::pair{4, 27}, std::pair{10, 25}, std::pair{5, 20}}) {
+    const std::size_t i = f.index(x, y);
+    const std::size_t right = f.index(x + 1, y);
+    const std::size_t down = f.index(x, y + 1);  // image row y + 1: one px lower
+    ASSERT_EQ(f.id[i], 1u);
+    double want = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const double gx = f.color[4 * right + c] - f.color[4 * i + c];
+      const double gy = f.color[4 * down + c] - f.color[4 * i + c];
+      want = std::max(want, 255.0 * std::hypot(gx, gy));
+    }
+    EXPECT_GT(want, 1.0);  // a real ramp (about 4.3 units/px)
+    EXPECT_NEAR(f.shade_reach[i], want, want * 1e-4) << x << "," << y;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 3);
+
+  // Blended at opacity 0.25 over the background: a quarter of it.
+  Scene blended = s;
+  blended.materials[0].opacity = 0.25;
+  blended.state.blend = Blend::Alpha;
+  const Frame b = renderReference(blended);
+  EXPECT_NEAR(b.shade_reach[f.index(4, 27)], 0.25 * f.shade_reach[f.index(4, 27)],
+              f.shade_reach[f.index(4, 27)] * 1e-6);
+
+  // Flat: one colour per triangle, nothing to move.
+  Scene flat = s;
+  flat.state.shading = Shading::Flat;
+  EXPECT_EQ(renderReference(flat).shade_reach[f.index(4, 27)], 0.0f);
+
+  // A sliver about 0.002 px high with the same vertex colours, its bottom edge 0.001 to
+  // 0.0015 px above the centres of window row 8: snapped to 1/256 px that edge moves onto
+  // them, so the centres are drawn though outside the exact triangle (sum |b_k| from 2 to
+  // about 2.5 along the row). There the colour changes across the sliver hundreds of times
+  // faster, and so does the channel.
+  Scene sliver = s;
+  sliver.objects[0].mesh.positions = {{-8, 8.501f, 0.5f}, {40, 8.5015f, 0.5f}, {-8, 8.503f, 0.5f}};
+  // The camera is affine, so the colour's gradient is one vector over the triangle: the
+  // channel divided by sum |b_k| (from the pixel's trace) is the same at every pixel, and
+  // some pixel has sum |b_k| well above 1 (its centre outside the exact sliver).
+  const Frame g = renderReference(sliver);
+  int drawn = 0;
+  double ratio = 0.0;
+  double most = 0.0;
+  for (int y = 0; y < g.height; ++y) {
+    for (int x = 0; x < g.width; ++x) {
+      const std::size_t k = g.index(x, y);
+      if (g.id[k] == 0) continue;
+      ++drawn;
+      EXPECT_GT(g.shade_reach[k], 100.0f * f.shade_reach[f.index(4, 27)]) << x << "," << y;
+      const std::vector<FragmentTrace> trace = tracePixel(sliver, ReferenceOptions{}, x, y);
+      ASSERT_EQ(trace.size(), 1u);
+      const glm::dvec3 bary = trace[0].barycentric;
+      const double sum = std::fabs(bary.x) + std::fabs(bary.y) + std::fabs(bary.z);
+      most = std::max(most, sum);
+      const double r = g.shade_reach[k] / sum;
+      if (ratio == 0.0) ratio = r;
+      EXPECT_NEAR(r, ratio, ratio * 1e-5) << x << "," << y << ": sum |b| " << sum;
+    }
+  }
+  EXPECT_GT(drawn, 0);
+  EXPECT_GT(most, 1.5);
 }
 
 }  // namespace
