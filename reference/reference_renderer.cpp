@@ -106,8 +106,24 @@ struct ReachPlane {
   }
 };
 
+// Phong fan triangles thinner than this (px, the smallest altitude of the unsnapped
+// triangle) record shade_reach (phongReach()): their pixels may have no neighbour of the
+// same primitive across the thin direction, which is where the neighbours' gradient fails.
+constexpr double kPhongReachAltitudePx = 1.0;
+
+// The smallest altitude (px) of the window triangle: twice its area over its longest edge
+// (0 for a degenerate one; NaN where a coordinate is not finite).
+inline double minAltitudePx(const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
+  const double area2 = std::fabs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
+  const double longest =
+      std::max({std::hypot(b.x - a.x, b.y - a.y), std::hypot(c.x - b.x, c.y - b.y),
+                std::hypot(a.x - c.x, a.y - c.y)});
+  return longest > 0.0 ? area2 / longest : 0.0;
+}
+
 // One object serves every triangle of a frame (Renderer::context_): drawWindowed() resets prim,
-// pass and the flags read before they are set (constant, depth_slope, texel_choice);
+// pass and the flags read before they are set (constant, depth_slope, texel_choice,
+// phong_reach);
 // prepareTriangle() writes what its shading mode reads (material to v, gouraud, flat, the
 // constant colour, centroid and face normal where lit or traced), the per-fan set-up the
 // uncertainty fields. The initial values only matter for the first triangle.
@@ -129,6 +145,7 @@ struct TriangleContext {
   ReachPlane depth_reach;         // steps: its vertices' float32 window-depth reach, interpolated,
                                   // plus the float32 set-up of its depth plane (planeSetupError())
   bool texel_choice = false;      // textured: record the texel channels
+  bool phong_reach = false;       // Phong, thinner than kPhongReachAltitudePx: shade_reach
   glm::dvec2 uq_max{0.0};         // largest |u / w|, |v / w| over its three vertices
   glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
 };
@@ -290,6 +307,9 @@ class Renderer {
   float gouraudReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
                      const FragmentInterpolator& interp, const FragmentInterpolator::Row& row,
                      double dx) const;
+  float phongReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
+                   const LitColor& lit, const FragmentInterpolator& interp,
+                   const FragmentInterpolator::Row& row, double dx) const;
   TexelNote texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                       const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
                       const FragmentInterpolator::Row& row, double dx) const;
@@ -612,6 +632,7 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
   t.constant = false;
   t.depth_slope = 0.0f;
   t.texel_choice = false;
+  t.phong_reach = false;
   bool prepared = false;
   // The clipped polygon is drawn as a fan; each piece is culled by its own snapped area
   // (as GL implementations set up each post-clip triangle).
@@ -637,6 +658,8 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
       // (docs/tolerances.md "Plane set-up": what is left uncovered there).
       if (!clipped) t.depth_reach.widen(planeSetupError(wv[0], wv[i], wv[i + 1]) * depth_steps_);
       t.texel_choice = t.texture != nullptr;
+      t.phong_reach = scene_.state.shading == Shading::Phong &&
+                      !(minAltitudePx(wv[0], wv[i], wv[i + 1]) >= kPhongReachAltitudePx);
       if (t.texel_choice && scene_.state.texture_filter == TextureFilter::Linear)
         t.texture_range = textureRangeOf(t.texture);
       if (t.texel_choice) {
@@ -708,6 +731,8 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   if (note && t.texel_choice) *note = texelNote(t, uv, b, lit.ambient_diffuse, *interp, *row, dx);
   if constexpr (kShading == Shading::Gouraud) {
     if (note) note->shade = gouraudReach(t, b, tex, *interp, *row, dx);
+  } else if constexpr (kShading == Shading::Phong) {
+    if (note && t.phong_reach) note->shade = phongReach(t, b, tex, lit, *interp, *row, dx);
   }
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
@@ -742,6 +767,46 @@ float Renderer::gouraudReach(const TriangleContext& t, const glm::dvec3& b, cons
     const double gy = tex[c] * glm::dot(db[1], ad) + glm::dot(db[1], sp);
     worst = std::max(worst, std::sqrt(gx * gx + gy * gy));
   }
+  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+  const double reach = 255.0 * worst * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
+  return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+}
+
+// shade_reach of a Phong fragment of a fan triangle thinner than kPhongReachAltitudePx
+// (TriangleContext::phong_reach; in thicker ones its neighbours show the gradient, (b)):
+// the same first-order bound as gouraudReach(), sum |b_k| * |grad C|, with C = T * AD + S
+// lit from the interpolated position and normal, which is not linear in them: grad C by
+// forward differences along the barycentrics' screen derivatives, with a step that moves
+// them by 1e-6 (the quotient is then within about 1e-6 of the derivative, relative, where
+// the lighting is smooth; far inside what the bound is used for). The texture stays T (its
+// change has the texel terms). 8-bit units per px, weighted by alpha when blended.
+float Renderer::phongReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
+                           const LitColor& lit, const FragmentInterpolator& interp,
+                           const FragmentInterpolator::Row& row, double dx) const {
+  glm::dvec3 db[2];
+  interp.barycentricGradient(row, dx, b, db);
+  auto colour = [&](const glm::dvec3& q) {
+    const glm::dvec3 p = q.x * t.v[0]->world + q.y * t.v[1]->world + q.z * t.v[2]->world;
+    const glm::dvec3 n =
+        safeNormalize(q.x * t.v[0]->normal + q.y * t.v[1]->normal + q.z * t.v[2]->normal);
+    const LitColor l = shadePrepared(*t.shading, p, n);
+    return l.ambient_diffuse * tex + l.specular;
+  };
+  const glm::dvec3 c0 = lit.ambient_diffuse * tex + lit.specular;
+  glm::dvec3 g[2];
+  for (int a = 0; a < 2; ++a) {
+    const double scale = std::max({std::fabs(db[a].x), std::fabs(db[a].y), std::fabs(db[a].z)});
+    if (!(scale > 0.0)) {  // no change along this axis (or NaN: below)
+      g[a] =
+          std::isnan(scale) ? glm::dvec3(std::numeric_limits<double>::infinity()) : glm::dvec3(0.0);
+      continue;
+    }
+    const double h = 1e-6 / scale;  // px
+    g[a] = (colour(b + h * db[a]) - c0) / h;
+  }
+  double worst = 0.0;
+  for (int c = 0; c < 3; ++c)
+    worst = std::max(worst, std::sqrt(g[0][c] * g[0][c] + g[1][c] * g[1][c]));
   const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
   const double reach = 255.0 * worst * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
   return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
@@ -1074,7 +1139,9 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
   // Untextured, unblended Gouraud and Phong: fragmentColor() and writeColor() written out
   // with the triangle's constants in locals (the same expressions: an untextured colour is
   // (ambient + diffuse) * 1 + specular, and x * 1 == x exactly).
-  if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat) {
+  // (Phong fans that record shade_reach take the general path.)
+  if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat &&
+      !(uncertainty_ && t.phong_reach)) {
     const bool rgba8 = color_format_ == ColorFormat::RGBA8;
     const float alpha = storeColor(t.material->opacity, color_format_);
     auto store = [=](std::size_t index, const glm::dvec3& c) {

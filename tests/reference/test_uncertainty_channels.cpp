@@ -13,6 +13,7 @@
 
 #include "reference/fragment_ops.h"
 #include "reference/reference_renderer.h"
+#include "reference/shading.h"
 #include "tests/reference/test_scenes.h"
 
 namespace rc {
@@ -329,6 +330,71 @@ TEST(UncertaintyChannels, ShadeReachIsTheGouraudColoursGradient) {
   }
   EXPECT_GT(drawn, 0);
   EXPECT_GT(most, 1.5);
+}
+
+// Phong (docs/tolerances.md (b)): in a fan triangle thinner than a pixel, shade_reach is
+// sum |b_k| times the largest channel's screen gradient of the lit colour, which the
+// renderer takes by forward differences. Here the gradient is taken independently: the
+// barycentrics' gradient from the vertices (the window camera is affine), the colour from
+// shadePrepared() at the traced barycentrics moved both ways along it (central
+// differences). A triangle thicker than a pixel leaves the channel 0 (its neighbours show
+// the gradient).
+TEST(UncertaintyChannels, ShadeReachOfAPhongSliverIsItsColoursGradient) {
+  Scene s = gouraudRamp();
+  s.state.shading = Shading::Phong;
+  s.lights = {Light{LightType::Point, {16.0, 8.0, 50.0}, {}, {1.0, 0.9, 0.8}, 2.0}};
+  s.materials[0].specular = glm::dvec3(0.5);
+  s.materials[0].shininess = 8.0;
+  EXPECT_EQ(renderReference(s).shade_reach[s.width * 27 + 4], 0.0f) << "a thick triangle";
+
+  Scene sliver = s;
+  std::vector<glm::vec3>& pos = sliver.objects[0].mesh.positions;
+  pos = {{-8, 8.501f, 0.5f}, {40, 8.5015f, 0.5f}, {-8, 8.503f, 0.5f}};
+  const Frame g = renderReference(sliver);
+  const ref::PreparedShading shading =
+      ref::prepareShading(ref::sceneLighting(sliver), sliver.materials[0]);
+  const Mesh& mesh = sliver.objects[0].mesh;
+  const glm::dvec2 v0(pos[0]);
+  const glm::dvec2 v1(pos[1]);
+  const glm::dvec2 v2(pos[2]);
+  const double area2 = (v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y);
+  // grad b_k = perp(opposite edge) / area2, perp(e) = (-e.y, e.x) for counter-clockwise.
+  const glm::dvec2 grad[3] = {glm::dvec2(-(v2.y - v1.y), v2.x - v1.x) / area2,
+                              glm::dvec2(-(v0.y - v2.y), v0.x - v2.x) / area2,
+                              glm::dvec2(-(v1.y - v0.y), v1.x - v0.x) / area2};
+  auto colour = [&](const glm::dvec3& b) {
+    glm::dvec3 p(0.0);
+    glm::dvec3 n(0.0);
+    for (int k = 0; k < 3; ++k) {
+      p += b[k] * glm::dvec3(mesh.positions[k]);
+      n += b[k] * glm::dvec3(mesh.normals[k]);
+    }
+    const ref::LitColor lit = ref::shadePrepared(shading, p, ref::safeNormalize(n));
+    return lit.ambient_diffuse + lit.specular;
+  };
+  int drawn = 0;
+  for (int y = 0; y < g.height; ++y) {
+    for (int x = 0; x < g.width; ++x) {
+      const std::size_t k = g.index(x, y);
+      if (g.id[k] == 0) continue;
+      ++drawn;
+      const std::vector<FragmentTrace> trace = tracePixel(sliver, ReferenceOptions{}, x, y);
+      ASSERT_EQ(trace.size(), 1u);
+      const glm::dvec3 b = trace[0].barycentric;
+      glm::dvec3 d[2];
+      for (int a = 0; a < 2; ++a) {
+        const glm::dvec3 db(grad[0][a], grad[1][a], grad[2][a]);
+        const double h = 1e-5 / std::max({std::fabs(db.x), std::fabs(db.y), std::fabs(db.z)});
+        d[a] = (colour(b + h * db) - colour(b - h * db)) / (2.0 * h);
+      }
+      double worst = 0.0;
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::hypot(d[0][c], d[1][c]));
+      const double want = 255.0 * worst * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z));
+      EXPECT_GT(want, 1e4) << x << "," << y;
+      EXPECT_NEAR(g.shade_reach[k], want, want * 1e-3) << x << "," << y;
+    }
+  }
+  EXPECT_GT(drawn, 0);
 }
 
 }  // namespace
