@@ -97,6 +97,12 @@ class FragmentInterpolator {
   }
   // 1 / w at the fragment (the perspective-correct denominator).
   double invWAt(const Row& r, double dx) const { return r.inv_w + inv_w_.ddx * dx; }
+  // The screen gradients (d/dx, d/dy) of numerator k and of the denominator, constant over
+  // the triangle: with them the gradient of an interpolated value v = sum_k a_k B_k at a
+  // fragment is (sum_k a_k dN_k - v dD) / D (barycentricGradient() summed), one division
+  // a fragment whatever the number of values.
+  glm::dvec2 numeratorGradient(int k) const { return {num_[k].ddx, num_[k].ddy}; }
+  glm::dvec2 denominatorGradient() const { return {inv_w_.ddx, inv_w_.ddy}; }
 
   // Window z at window point (x, y), not clamped.
   double depth(double x, double y) const { return depthAt(depthRow(y), dx(x)); }

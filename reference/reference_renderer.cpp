@@ -106,10 +106,13 @@ struct ReachPlane {
   }
 };
 
-// Phong fan triangles thinner than this (px, the smallest altitude of the unsnapped
-// triangle) record shade_reach (phongReach()): their pixels may have no neighbour of the
-// same primitive across the thin direction, which is where the neighbours' gradient fails.
-constexpr double kPhongReachAltitudePx = 1.0;
+// Gouraud and Phong fan triangles thinner than this (px, the smallest altitude of the
+// unsnapped triangle) record shade_reach (gouraudReach(), phongReach()): their pixels may
+// have no neighbour of the same primitive across the thin direction, which is where the
+// neighbours' gradient fails (docs/tolerances.md (b)); in thicker ones it does not, and
+// the channel's cost (more than the rest of a Gouraud fragment's uncertainty work) is not
+// spent.
+constexpr double kThinAltitudePx = 1.0;
 
 // The smallest altitude (px) of the window triangle: twice its area over its longest edge
 // (0 for a degenerate one; NaN where a coordinate is not finite).
@@ -123,7 +126,7 @@ inline double minAltitudePx(const WindowVertex& a, const WindowVertex& b, const 
 
 // One object serves every triangle of a frame (Renderer::context_): drawWindowed() resets prim,
 // pass and the flags read before they are set (constant, depth_slope, texel_choice,
-// phong_reach);
+// thin);
 // prepareTriangle() writes what its shading mode reads (material to v, gouraud, flat, the
 // constant colour, centroid and face normal where lit or traced), the per-fan set-up the
 // uncertainty fields. The initial values only matter for the first triangle.
@@ -141,11 +144,16 @@ struct TriangleContext {
   bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
-  float depth_slope = 0.0f;       // |grad z| in depth-format steps per px
-  ReachPlane depth_reach;         // steps: its vertices' float32 window-depth reach, interpolated,
-                                  // plus the float32 set-up of its depth plane (planeSetupError())
-  bool texel_choice = false;      // textured: record the texel channels
-  bool phong_reach = false;       // Phong, thinner than kPhongReachAltitudePx: shade_reach
+  float depth_slope = 0.0f;   // |grad z| in depth-format steps per px
+  ReachPlane depth_reach;     // steps: its vertices' float32 window-depth reach, interpolated,
+                              // plus the float32 set-up of its depth plane (planeSetupError())
+  bool texel_choice = false;  // textured: record the texel channels
+  bool thin = false;          // thinner than kThinAltitudePx: records shade_reach
+  // Gouraud (uncertainty channels): per colour channel sum_k A_k grad N_k of AD and S, and
+  // grad D (FragmentInterpolator::numeratorGradient()), for gouraudReach().
+  glm::dvec2 ad_grad[3] = {};
+  glm::dvec2 sp_grad[3] = {};
+  glm::dvec2 den_grad{0.0};
   glm::dvec2 uq_max{0.0};         // largest |u / w|, |v / w| over its three vertices
   glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
 };
@@ -304,9 +312,9 @@ class Renderer {
   glm::dvec4 fragmentColor(const TriangleContext& t, const glm::dvec3& b, ShadingTerms* terms,
                            TexelNote* note = nullptr, const FragmentInterpolator* interp = nullptr,
                            const FragmentInterpolator::Row* row = nullptr, double dx = 0.0) const;
-  float gouraudReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
-                     const FragmentInterpolator& interp, const FragmentInterpolator::Row& row,
-                     double dx) const;
+  float gouraudReach(const TriangleContext& t, const glm::dvec3& b, const LitColor& lit,
+                     const glm::dvec3& tex, const FragmentInterpolator& interp,
+                     const FragmentInterpolator::Row& row, double dx) const;
   float phongReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
                    const LitColor& lit, const FragmentInterpolator& interp,
                    const FragmentInterpolator::Row& row, double dx) const;
@@ -632,7 +640,7 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
   t.constant = false;
   t.depth_slope = 0.0f;
   t.texel_choice = false;
-  t.phong_reach = false;
+  t.thin = false;
   bool prepared = false;
   // The clipped polygon is drawn as a fan; each piece is culled by its own snapped area
   // (as GL implementations set up each post-clip triangle).
@@ -658,8 +666,19 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
       // (docs/tolerances.md "Plane set-up": what is left uncovered there).
       if (!clipped) t.depth_reach.widen(planeSetupError(wv[0], wv[i], wv[i + 1]) * depth_steps_);
       t.texel_choice = t.texture != nullptr;
-      t.phong_reach = scene_.state.shading == Shading::Phong &&
-                      !(minAltitudePx(wv[0], wv[i], wv[i + 1]) >= kPhongReachAltitudePx);
+      t.thin = scene_.state.shading != Shading::Flat &&
+               !(minAltitudePx(wv[0], wv[i], wv[i + 1]) >= kThinAltitudePx);
+      if (t.thin && scene_.state.shading == Shading::Gouraud) {
+        for (int c = 0; c < 3; ++c) {
+          t.ad_grad[c] = glm::dvec2(0.0);
+          t.sp_grad[c] = glm::dvec2(0.0);
+          for (int k = 0; k < 3; ++k) {
+            t.ad_grad[c] += t.gouraud[k]->ambient_diffuse[c] * interp.numeratorGradient(k);
+            t.sp_grad[c] += t.gouraud[k]->specular[c] * interp.numeratorGradient(k);
+          }
+        }
+        t.den_grad = interp.denominatorGradient();
+      }
       if (t.texel_choice && scene_.state.texture_filter == TextureFilter::Linear)
         t.texture_range = textureRangeOf(t.texture);
       if (t.texel_choice) {
@@ -730,9 +749,9 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   const glm::dvec4 color = finalColor(lit, tex, t.material->opacity);
   if (note && t.texel_choice) *note = texelNote(t, uv, b, lit.ambient_diffuse, *interp, *row, dx);
   if constexpr (kShading == Shading::Gouraud) {
-    if (note) note->shade = gouraudReach(t, b, tex, *interp, *row, dx);
+    if (note && t.thin) note->shade = gouraudReach(t, b, lit, tex, *interp, *row, dx);
   } else if constexpr (kShading == Shading::Phong) {
-    if (note && t.phong_reach) note->shade = phongReach(t, b, tex, lit, *interp, *row, dx);
+    if (note && t.thin) note->shade = phongReach(t, b, tex, lit, *interp, *row, dx);
   }
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
@@ -743,7 +762,8 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   return color;
 }
 
-// shade_reach of a Gouraud fragment (docs/tolerances.md (b)): its colour T * AD + S
+// shade_reach of a Gouraud fragment of a fan triangle thinner than kThinAltitudePx
+// (TriangleContext::thin; docs/tolerances.md (b)): its colour T * AD + S
 // follows planes through the triangle's vertices (AD and S interpolated; T, the texture,
 // has its own channels). Another implementation's planes go through its snapped vertices:
 // with each moved by up to d px, the plane's value at the pixel moves, to first order, by
@@ -752,28 +772,28 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
 // the snapped triangle, as at a sliver's edge). The largest channel's |grad C| * sum |b_k|
 // in 8-bit units per px, weighted by alpha when the fragment is blended; infinite where it
 // is not a number.
-float Renderer::gouraudReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
-                             const FragmentInterpolator& interp,
+float Renderer::gouraudReach(const TriangleContext& t, const glm::dvec3& b, const LitColor& lit,
+                             const glm::dvec3& tex, const FragmentInterpolator& interp,
                              const FragmentInterpolator::Row& row, double dx) const {
-  glm::dvec3 db[2];
-  interp.barycentricGradient(row, dx, b, db);
-  double worst = 0.0;
+  // grad v = (sum_k a_k grad N_k - v grad D) / D for v = AD_c and S_c (the sums per
+  // triangle: TriangleContext::ad_grad, sp_grad).
+  const double inv = 1.0 / interp.invWAt(row, dx);
+  double worst2 = 0.0;
   for (int c = 0; c < 3; ++c) {
-    const glm::dvec3 ad(t.gouraud[0]->ambient_diffuse[c], t.gouraud[1]->ambient_diffuse[c],
-                        t.gouraud[2]->ambient_diffuse[c]);
-    const glm::dvec3 sp(t.gouraud[0]->specular[c], t.gouraud[1]->specular[c],
-                        t.gouraud[2]->specular[c]);
-    const double gx = tex[c] * glm::dot(db[0], ad) + glm::dot(db[0], sp);
-    const double gy = tex[c] * glm::dot(db[1], ad) + glm::dot(db[1], sp);
-    worst = std::max(worst, std::sqrt(gx * gx + gy * gy));
+    const glm::dvec2 ad = (t.ad_grad[c] - lit.ambient_diffuse[c] * t.den_grad) * inv;
+    const glm::dvec2 sp = (t.sp_grad[c] - lit.specular[c] * t.den_grad) * inv;
+    const glm::dvec2 g = tex[c] * ad + sp;
+    const double g2 = g.x * g.x + g.y * g.y;
+    if (!(g2 <= worst2)) worst2 = g2;  // NaN kept (infinite below)
   }
   const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
-  const double reach = 255.0 * worst * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
+  const double reach =
+      255.0 * std::sqrt(worst2) * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
   return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
 }
 
-// shade_reach of a Phong fragment of a fan triangle thinner than kPhongReachAltitudePx
-// (TriangleContext::phong_reach; in thicker ones its neighbours show the gradient, (b)):
+// shade_reach of a Phong fragment of a fan triangle thinner than kThinAltitudePx
+// (TriangleContext::thin):
 // the same first-order bound as gouraudReach(), sum |b_k| * |grad C|, with C = T * AD + S
 // lit from the interpolated position and normal, which is not linear in them: grad C by
 // forward differences along the barycentrics' screen derivatives, with a step that moves
@@ -805,8 +825,10 @@ float Renderer::phongReach(const TriangleContext& t, const glm::dvec3& b, const 
     g[a] = (colour(b + h * db[a]) - c0) / h;
   }
   double worst = 0.0;
-  for (int c = 0; c < 3; ++c)
-    worst = std::max(worst, std::sqrt(g[0][c] * g[0][c] + g[1][c] * g[1][c]));
+  for (int c = 0; c < 3; ++c) {
+    const double n = std::sqrt(g[0][c] * g[0][c] + g[1][c] * g[1][c]);
+    if (!(n <= worst)) worst = n;  // NaN kept (infinite below)
+  }
   const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
   const double reach = 255.0 * worst * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
   return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
@@ -1141,7 +1163,7 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
   // (ambient + diffuse) * 1 + specular, and x * 1 == x exactly).
   // (Phong fans that record shade_reach take the general path.)
   if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat &&
-      !(uncertainty_ && t.phong_reach)) {
+      !(uncertainty_ && t.thin && scene_.state.shading == Shading::Phong)) {
     const bool rgba8 = color_format_ == ColorFormat::RGBA8;
     const float alpha = storeColor(t.material->opacity, color_format_);
     auto store = [=](std::size_t index, const glm::dvec3& c) {
@@ -1161,17 +1183,26 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
       const LitColor g0 = *t.gouraud[0];
       const LitColor g1 = *t.gouraud[1];
       const LitColor g2 = *t.gouraud[2];
-      const bool notes = uncertainty_;
-      fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
-        const glm::dvec3 b = interp.barycentricAt(row, dx);
-        const glm::dvec3 ad =
-            b.x * g0.ambient_diffuse + b.y * g1.ambient_diffuse + b.z * g2.ambient_diffuse;
-        const glm::dvec3 sp = b.x * g0.specular + b.y * g1.specular + b.z * g2.specular;
-        store(index, ad + sp);
-        TexelNote note;
-        if (notes) note.shade = gouraudReach(t, b, glm::dvec3(1.0), interp, row, dx);
-        return note;
-      });
+      // Two loops: the shade_reach of thin triangles (uncertainty channels) in its own, so
+      // that every other triangle's loop is the one without it.
+      auto gouraud = [&](auto reach) {
+        fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+          const glm::dvec3 b = interp.barycentricAt(row, dx);
+          const glm::dvec3 ad =
+              b.x * g0.ambient_diffuse + b.y * g1.ambient_diffuse + b.z * g2.ambient_diffuse;
+          const glm::dvec3 sp = b.x * g0.specular + b.y * g1.specular + b.z * g2.specular;
+          store(index, ad + sp);
+          TexelNote note;
+          if constexpr (decltype(reach)::value)
+            note.shade = gouraudReach(t, b, LitColor{ad, sp}, glm::dvec3(1.0), interp, row, dx);
+          return note;
+        });
+      };
+      if (uncertainty_ && t.thin) {
+        gouraud(std::true_type{});
+      } else {
+        gouraud(std::false_type{});
+      }
     } else {
       // Phong: four fragments at a time (shadePhongQuad() has the scalar form).
       PhongQuads quads(t, interp, colors, rgba8, alpha);

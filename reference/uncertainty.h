@@ -106,6 +106,7 @@ class UncertaintyTracker {
     depth_reach_ = frame.depth_reach.data();
     texel_reach_ = frame.texel_reach.data();
     shade_reach_ = frame.shade_reach.data();
+    shade_active_ = false;
   }
 
   // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px)
@@ -155,10 +156,11 @@ class UncertaintyTracker {
       texel_alt_[index] = texel_alt;
       texel_gain_[index] = texel_gain;
       texel_reach_[index] = texel_reach;
-      shade_reach_[index] = shade_reach;
+      if (shadeReachKept(shade_reach)) shade_reach_[index] = shade_reach;
       return;
     }
-    shade_reach_[index] = (1.0f - alpha) * shade_reach_[index] + shade_reach;
+    if (shadeReachKept(shade_reach))
+      shade_reach_[index] = (1.0f - alpha) * shade_reach_[index] + shade_reach;
     blend_count_[index] += 1.0f;
     texel_reach_[index] = std::max(texel_reach_[index], texel_reach);
     texel_dist_[index] = std::min(texel_dist_[index], texel_dist);
@@ -259,6 +261,15 @@ class UncertaintyTracker {
   float* depth_reach_ = nullptr;
   float* texel_reach_ = nullptr;
   float* shade_reach_ = nullptr;
+  // Whether a fragment has had a shade_reach other than 0 this frame. Until one has, every
+  // value of the plane is its initial 0 and every write would store 0 again: they are
+  // skipped, so that frames without thin triangles (most) do not write one more plane per
+  // fragment.
+  bool shade_active_ = false;
+  bool shadeReachKept(float shade_reach) {
+    if (shade_reach != 0.0f) shade_active_ = true;
+    return shade_active_;
+  }
 };
 
 // Twice the signed area (> 0 counter-clockwise) and the perimeter of a window polygon.
