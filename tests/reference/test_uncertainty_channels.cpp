@@ -64,7 +64,7 @@ std::shared_ptr<Texture> rowsTexture() {
   auto t = std::make_shared<Texture>();
   t->width = 4;
   t->height = 2;
-  t->rgba.assign(4 * 8, 255);
+  t->rgba.assign(std::size_t{4} * 8, 255);
   for (int i = 0; i < 4; ++i) {
     t->rgba[4 * i + 0] = 200;
     t->rgba[4 * i + 1] = 220;
