@@ -806,9 +806,14 @@ class Comparator {
     // than the surface has, as around a sliver whose pixels have no same-primitive
     // neighbour, it is the gradient the slope band moves (docs/tolerances.md (b)).
     double plane = 0.0;
+    // And how far float32 interpolation may turn a short interpolated normal
+    // (normal_reach, units; docs/tolerances.md (a)).
+    double normal = 0.0;
     if (have_uncertainty_ && u_.id[i] == e_.id[i]) {
       const double r = u_.shade_reach[i];
       plane = std::isnan(r) ? 0.0 : r;
+      const double n = u_.normal_reach[i];
+      normal = std::isnan(n) ? 0.0 : n;
     }
     // What the reference knows at the pixel: with nearest filtering, a sample within the
     // band of a texel boundary may take the texel across it (texel_alt, RGB only); in
@@ -833,7 +838,7 @@ class Comparator {
       const double gradient =
           c < 3 ? std::max(static_cast<double>(around.gradient[c]), plane) : around.gradient[c];
       out.allowances[c] = shade_relative_units_ * m + shade_slope_band_ * gradient + blends +
-                          (c < 3 ? texel + filtering : 0.0) + coverage_allowance_;
+                          (c < 3 ? texel + filtering + normal : 0.0) + coverage_allowance_;
     }
     for (int c = 0; c < 4; ++c) {
       const double excess = d[c] - out.allowances[c];

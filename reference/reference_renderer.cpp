@@ -124,9 +124,25 @@ inline double minAltitudePx(const WindowVertex& a, const WindowVertex& b, const 
   return longest > 0.0 ? area2 / longest : 0.0;
 }
 
+// Whether the interpolated normal of a triangle with these vertex normals can be short
+// against them (|n| < max_k |N_k| / 2 somewhere): a vertex normal under half the longest,
+// or two at 60 degrees or more. Elsewhere normal_reach is below 1e-5 of the colour, far
+// inside the relative term (docs/tolerances.md (a)), and is not computed.
+inline bool canBeShort(const glm::dvec3& n0, const glm::dvec3& n1, const glm::dvec3& n2) {
+  const double l[3] = {glm::length(n0), glm::length(n1), glm::length(n2)};
+  const double longest = std::max({l[0], l[1], l[2]});
+  if (!(std::min({l[0], l[1], l[2]}) >= 0.5 * longest)) return true;  // NaN too
+  return glm::dot(n0, n1) < 0.5 * l[0] * l[1] || glm::dot(n1, n2) < 0.5 * l[1] * l[2] ||
+         glm::dot(n2, n0) < 0.5 * l[2] * l[0];
+}
+
+// 16 ulps of float32: the error a driver's interpolated normal may carry, relative to the
+// magnitudes its planes hold (as kTexelCoordinateReach for texture coordinates).
+constexpr double kNormalReach = 0x1p-20;
+
 // One object serves every triangle of a frame (Renderer::context_): drawWindowed() resets prim,
 // pass and the flags read before they are set (constant, depth_slope, texel_choice,
-// thin);
+// thin, short_normals);
 // prepareTriangle() writes what its shading mode reads (material to v, gouraud, flat, the
 // constant colour, centroid and face normal where lit or traced), the per-fan set-up the
 // uncertainty fields. The initial values only matter for the first triangle.
@@ -144,11 +160,14 @@ struct TriangleContext {
   bool constant = false;  // flat, untextured, not blended: one stored colour
   float constant_stored[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // Of the fan triangle being drawn (uncertainty channels only):
-  float depth_slope = 0.0f;   // |grad z| in depth-format steps per px
-  ReachPlane depth_reach;     // steps: its vertices' float32 window-depth reach, interpolated,
-                              // plus the float32 set-up of its depth plane (planeSetupError())
-  bool texel_choice = false;  // textured: record the texel channels
-  bool thin = false;          // thinner than kThinAltitudePx: records shade_reach
+  float depth_slope = 0.0f;    // |grad z| in depth-format steps per px
+  ReachPlane depth_reach;      // steps: its vertices' float32 window-depth reach, interpolated,
+                               // plus the float32 set-up of its depth plane (planeSetupError())
+  bool texel_choice = false;   // textured: record the texel channels
+  bool thin = false;           // thinner than kThinAltitudePx: records shade_reach
+  bool short_normals = false;  // Phong, its normal can be short: records normal_reach
+  double n_max = 0.0;          // short_normals: largest |n / w| over the fan's vertices
+  double n_len_max = 0.0;      // short_normals: largest |N_k| of the triangle
   // Gouraud (uncertainty channels): per colour channel sum_k A_k grad N_k of AD and S, and
   // grad D (FragmentInterpolator::numeratorGradient()), for gouraudReach().
   glm::dvec2 ad_grad[3] = {};
@@ -161,11 +180,12 @@ struct TriangleContext {
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
 // And, despite the name, what it adds to shade_reach (interpolated colours).
 struct TexelNote {
-  float dist = 1.0f;   // px
-  float alt = 0.0f;    // 8-bit units, weighted as the fragment's colour is in the pixel
-  float gain = 0.0f;   // units per texel unit, weighted alike
-  float reach = 0.0f;  // linear filtering: texels (s + t) the sample may move
-  float shade = 0.0f;  // shade_reach: 8-bit units per px of vertex movement, weighted alike
+  float dist = 1.0f;    // px
+  float alt = 0.0f;     // 8-bit units, weighted as the fragment's colour is in the pixel
+  float gain = 0.0f;    // units per texel unit, weighted alike
+  float reach = 0.0f;   // linear filtering: texels (s + t) the sample may move
+  float shade = 0.0f;   // shade_reach: 8-bit units per px of vertex movement, weighted alike
+  float normal = 0.0f;  // normal_reach: 8-bit units, weighted alike
 };
 
 // A blended fragment the A-buffer keeps (ReferenceOptions::abuffer) until its pixel's list
@@ -315,6 +335,9 @@ class Renderer {
   float gouraudReach(const TriangleContext& t, const glm::dvec3& b, const LitColor& lit,
                      const glm::dvec3& tex, const FragmentInterpolator& interp,
                      const FragmentInterpolator::Row& row, double dx) const;
+  float normalReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& p,
+                    const FragmentInterpolator& interp, const FragmentInterpolator::Row& row,
+                    double dx) const;
   float phongReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
                    const LitColor& lit, const FragmentInterpolator& interp,
                    const FragmentInterpolator::Row& row, double dx) const;
@@ -641,6 +664,7 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
   t.depth_slope = 0.0f;
   t.texel_choice = false;
   t.thin = false;
+  t.short_normals = false;
   bool prepared = false;
   // The clipped polygon is drawn as a fan; each piece is culled by its own snapped area
   // (as GL implementations set up each post-clip triangle).
@@ -668,6 +692,19 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
       t.texel_choice = t.texture != nullptr;
       t.thin = scene_.state.shading != Shading::Flat &&
                !(minAltitudePx(wv[0], wv[i], wv[i + 1]) >= kThinAltitudePx);
+      if (scene_.state.shading == Shading::Phong) {
+        t.short_normals = canBeShort(t.v[0]->normal, t.v[1]->normal, t.v[2]->normal);
+        if (t.short_normals) {
+          t.n_max = 0.0;
+          t.n_len_max = std::max({glm::length(t.v[0]->normal), glm::length(t.v[1]->normal),
+                                  glm::length(t.v[2]->normal)});
+          for (const WindowVertex* w : {&wv[0], &wv[i], &wv[i + 1]}) {
+            const glm::dvec3 n = w->bary.x * t.v[0]->normal + w->bary.y * t.v[1]->normal +
+                                 w->bary.z * t.v[2]->normal;
+            t.n_max = std::max(t.n_max, glm::length(n) * std::fabs(w->inv_w));
+          }
+        }
+      }
       if (t.thin && scene_.state.shading == Shading::Gouraud) {
         for (int c = 0; c < 3; ++c) {
           t.ad_grad[c] = glm::dvec2(0.0);
@@ -752,6 +789,10 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
     if (note && t.thin) note->shade = gouraudReach(t, b, lit, tex, *interp, *row, dx);
   } else if constexpr (kShading == Shading::Phong) {
     if (note && t.thin) note->shade = phongReach(t, b, tex, lit, *interp, *row, dx);
+    if (note && t.short_normals) {
+      const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
+      note->normal = normalReach(t, b, p, *interp, *row, dx);
+    }
   }
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
@@ -789,6 +830,50 @@ float Renderer::gouraudReach(const TriangleContext& t, const glm::dvec3& b, cons
   const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
   const double reach =
       255.0 * std::sqrt(worst2) * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
+  return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+}
+
+// normal_reach of a Phong fragment whose interpolated normal can be short
+// (TriangleContext::short_normals; docs/tolerances.md (a)), where it is shorter than half
+// the longest vertex normal (0 elsewhere). A driver interpolates n = sum
+// b_k N_k in float32 with an error e per component of some ulps of the magnitudes its
+// planes hold: kNormalReach * (largest |N_k / w_k| / |1 / w| + |grad n| * image size),
+// |e| <= sqrt(3) times that. Normalising moves the direction by at most 2 |e| / |n| (2 when
+// |e| >= |n|). Each light's diffuse term moves by kd L att times that, its specular term by
+// ks L att s times it (Blinn; Phong's reflected vector moves 4 times as much), s at least 1.
+// 8-bit units, the largest channel, weighted by alpha when blended.
+float Renderer::normalReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& p,
+                            const FragmentInterpolator& interp,
+                            const FragmentInterpolator::Row& row, double dx) const {
+  const glm::dvec3 n = b.x * t.v[0]->normal + b.y * t.v[1]->normal + b.z * t.v[2]->normal;
+  glm::dvec3 db[2];
+  interp.barycentricGradient(row, dx, b, db);
+  double gradient = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const glm::dvec3 nc(t.v[0]->normal[c], t.v[1]->normal[c], t.v[2]->normal[c]);
+    gradient = std::max(gradient, std::hypot(glm::dot(db[0], nc), glm::dot(db[1], nc)));
+  }
+  const double q = std::fabs(interp.invWAt(row, dx));
+  const double image = std::max(scene_.width, scene_.height);
+  const double e = std::sqrt(3.0) * kNormalReach * (t.n_max / q + gradient * image);
+  const double len = glm::length(n);
+  // As long as the normal from planes is (at least half) as long as its vertices', the
+  // relative term (a) covers its rounding; beyond, it grows as 1 / |n|.
+  if (len >= 0.5 * t.n_len_max) return 0.0f;
+  const double direction = len > e ? 2.0 * e / len : 2.0;
+  const PreparedShading& s = *t.shading;
+  const double spec = std::max(s.shininess, 1.0) * (s.blinn ? 1.0 : 4.0);
+  glm::dvec3 k(0.0);
+  for (const PreparedLight& light : s.lights) {
+    double att = 1.0;
+    if (light.attenuated) {
+      const double r = glm::length(light.position - p);
+      att = s.attenuation == Attenuation::Inverse ? 1.0 / r : 1.0 / (r * r);
+    }
+    k += glm::abs(light.radiance) * att * (glm::abs(s.kd) + spec * glm::abs(s.ks));
+  }
+  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+  const double reach = 255.0 * direction * std::max({k.x, k.y, k.z}) * weight;
   return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
 }
 
@@ -1120,7 +1205,7 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
       const TexelNote note = shade(index, row, dx);
       if constexpr (kGaps)
         gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain, note.reach,
-                            note.shade);
+                            note.shade, note.normal);
     }
     if constexpr (requires { shade.flush(row); }) shade.flush(row);
   });
@@ -1163,7 +1248,7 @@ void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& 
   // (ambient + diffuse) * 1 + specular, and x * 1 == x exactly).
   // (Phong fans that record shade_reach take the general path.)
   if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat &&
-      !(uncertainty_ && t.thin && scene_.state.shading == Shading::Phong)) {
+      !(uncertainty_ && (t.thin || t.short_normals) && scene_.state.shading == Shading::Phong)) {
     const bool rgba8 = color_format_ == ColorFormat::RGBA8;
     const float alpha = storeColor(t.material->opacity, color_format_);
     auto store = [=](std::size_t index, const glm::dvec3& c) {
@@ -1323,7 +1408,7 @@ void Renderer::resolveABuffer() {
       writeColor(index, f.color, true);
       if (uncertainty_)
         gaps_.colourWritten(index, true, f.alpha, f.note.dist, f.note.alt, f.note.gain,
-                            f.note.reach, f.note.shade);
+                            f.note.reach, f.note.shade, f.note.normal);
       z.push_back(f.z);
       slope.push_back(f.slope);
       if (sorted_ != nullptr) sorted_->push_back({f.id, f.seq, f.z, f.color, storedColor(index)});
@@ -1417,6 +1502,7 @@ constexpr bool kTakeSmallest[kUncertaintyChannels] = {
     false,  // depth_reach
     false,  // texel_reach
     false,  // shade_reach
+    false,  // normal_reach
 };
 
 // Multisampling: one render per sample (SampleShift), then the resolve: the colour is the

@@ -74,7 +74,8 @@ namespace rc::ref {
 //    clear_gap as they stand then): the smallest such gap, and the steepest fragment;
 //  - depth_reach: the largest float32 reach (steps) of every fragment the pixel saw, drawn
 //    or not: it bounds the stored depth's error and both sides of every comparison above;
-//  - blend_count, texel_dist, texel_alt, texel_gain, texel_reach, shade_reach: composited
+//  - blend_count, texel_dist, texel_alt, texel_gain, texel_reach, shade_reach,
+//    normal_reach: composited
 //    like the colour itself (colourWritten()): an opaque write starts them afresh, a blended
 //    one adds its own, weighted by alpha (texel_reach: the largest).
 //
@@ -106,7 +107,9 @@ class UncertaintyTracker {
     depth_reach_ = frame.depth_reach.data();
     texel_reach_ = frame.texel_reach.data();
     shade_reach_ = frame.shade_reach.data();
+    normal_reach_ = frame.normal_reach.data();
     shade_active_ = false;
+    normal_active_ = false;
   }
 
   // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px)
@@ -149,17 +152,21 @@ class UncertaintyTracker {
   // else in its place. texel_dist / texel_alt are the fragment's own (texel_alt, texel_gain
   // and shade_reach already weighted by alpha when blended).
   void colourWritten(std::size_t index, bool blended, float alpha, float texel_dist,
-                     float texel_alt, float texel_gain, float texel_reach, float shade_reach) {
+                     float texel_alt, float texel_gain, float texel_reach, float shade_reach,
+                     float normal_reach) {
     if (!blended) {
       blend_count_[index] = 0.0f;
       texel_dist_[index] = texel_dist;
       texel_alt_[index] = texel_alt;
       texel_gain_[index] = texel_gain;
       texel_reach_[index] = texel_reach;
-      if (shadeReachKept(shade_reach)) shade_reach_[index] = shade_reach;
+      if (kept(shade_active_, shade_reach)) shade_reach_[index] = shade_reach;
+      if (kept(normal_active_, normal_reach)) normal_reach_[index] = normal_reach;
       return;
     }
-    if (shadeReachKept(shade_reach))
+    if (kept(normal_active_, normal_reach))
+      normal_reach_[index] = (1.0f - alpha) * normal_reach_[index] + normal_reach;
+    if (kept(shade_active_, shade_reach))
       shade_reach_[index] = (1.0f - alpha) * shade_reach_[index] + shade_reach;
     blend_count_[index] += 1.0f;
     texel_reach_[index] = std::max(texel_reach_[index], texel_reach);
@@ -261,14 +268,16 @@ class UncertaintyTracker {
   float* depth_reach_ = nullptr;
   float* texel_reach_ = nullptr;
   float* shade_reach_ = nullptr;
-  // Whether a fragment has had a shade_reach other than 0 this frame. Until one has, every
-  // value of the plane is its initial 0 and every write would store 0 again: they are
-  // skipped, so that frames without thin triangles (most) do not write one more plane per
-  // fragment.
+  float* normal_reach_ = nullptr;
+  // Whether a fragment has had a shade_reach (normal_reach) other than 0 this frame. Until
+  // one has, every value of the plane is its initial 0 and every write would store 0 again:
+  // they are skipped, so that frames without thin triangles (short normals), most, do not
+  // write one more plane per fragment.
   bool shade_active_ = false;
-  bool shadeReachKept(float shade_reach) {
-    if (shade_reach != 0.0f) shade_active_ = true;
-    return shade_active_;
+  bool normal_active_ = false;
+  static bool kept(bool& active, float value) {
+    if (value != 0.0f) active = true;
+    return active;
   }
 };
 

@@ -768,6 +768,28 @@ TEST_F(CompareTest, ShadeReachWidensTheAttributePlaneTerm) {
   EXPECT_EQ(run(1e5f, share, 3), n) << "alpha";
 }
 
+// normal_reach (docs/tolerances.md (a)): added as it stands to R, G and B, not to alpha.
+TEST_F(CompareTest, NormalReachWidensRgbByItsUnits) {
+  tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F);
+  const Block b = kBackBlock;
+  const Frame original = gl_;
+  auto run = [&](float reach, double units, int channel) {
+    gl_ = original;
+    forBlock(b, [&](int x, int y) {
+      const std::size_t i = ref_.index(x, y);
+      ref_.normal_reach[i] = reach;
+      gl_.color[i * 4 + channel] = ref_.color[i * 4 + channel] + static_cast<float>(units / 255.0);
+    });
+    return compare().shading.over_fail;
+  };
+  const auto n = static_cast<std::uint64_t>(b.size());
+  const double fail = tol_.shading.fail;
+  EXPECT_EQ(run(40.0f, 40.0, 2), 0u);
+  EXPECT_EQ(run(40.0f, 40.0 + fail + 2.0, 2), n);
+  EXPECT_EQ(run(0.0f, 40.0, 2), n) << "without normal_reach";
+  EXPECT_EQ(run(40.0f, 40.0, 3), n) << "alpha";
+}
+
 // rgba8 blending: each blended fragment may round its way (2 units, docs/tolerances.md).
 TEST_F(CompareTest, Rgba8BlendsEachAddTheirRounding) {
   tol_ = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);

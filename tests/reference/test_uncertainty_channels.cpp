@@ -370,5 +370,56 @@ TEST(UncertaintyChannels, ShadeReachOfAPhongSliverIsItsColoursGradient) {
   expectThickNothingSliverTheGradient(Shading::Phong, 1e-3);
 }
 
+// normal_reach (docs/tolerances.md (a)): where a Phong triangle's interpolated normal can be
+// short (vertex normals N0, 0, 0 here: n = b0 N0), a driver's float32 planes may turn it by
+// 2 |e| / |n|, |e| = sqrt(3) 2^-20 (largest |N_k / w_k| / |1 / w| + |grad n| * image size),
+// and the colour then moves by up to L (kd + s ks) per radian (Blinn, no attenuation),
+// where n is under half as long as N0 (b0 < 1/2; 0 elsewhere). The
+// window camera is affine (w = 1), so everything but b0 is constant: the channel is that
+// formula, computed here from the vertices, at every drawn pixel whose normal is longer
+// than |e|; with three equal normals nothing is recorded.
+TEST(UncertaintyChannels, NormalReachFollowsTheShortNormal) {
+  Scene s = test::windowScene(32, 32);
+  s.state.shading = Shading::Phong;
+  s.state.color_format = ColorFormat::RGBA32F;
+  s.ambient_light = glm::dvec3(0.0);
+  s.lights.push_back(Light{LightType::Point, {16.0, 16.0, 40.0}, {}, {1.0, 0.9, 0.8}, 1.5});
+  s.materials[0].diffuse = {0.6, 0.5, 0.4};
+  s.materials[0].specular = glm::dvec3(0.3);
+  s.materials[0].shininess = 16.0;
+  const glm::vec3 v[3] = {{2, 2, 0.5f}, {30, 4, 0.5f}, {6, 29, 0.5f}};
+  test::addMesh(s, {v[0], v[1], v[2]}, {{0, 1, 2}});
+  const Frame same = renderReference(s);  // every normal (0, 0, 1)
+  for (std::size_t k = 0; k < same.pixelCount(); ++k) EXPECT_EQ(same.normal_reach[k], 0.0f);
+
+  s.objects[0].mesh.normals = {{0.0f, 0.0f, 1.0f}, {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
+  const Frame f = renderReference(s);
+  const double area2 =
+      (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y);
+  // b0 = ((v1 - p) x (v2 - p)) / area2, grad b0 = perp(v2 - v1) / area2.
+  const double grad_b0 = std::hypot(v[2].y - v[1].y, v[2].x - v[1].x) / std::fabs(area2);
+  const double e = std::sqrt(3.0) * 0x1p-20 * (1.0 + grad_b0 * 32.0);
+  const double k = 1.5 * (0.6 + 16.0 * 0.3);  // red: the largest channel
+  int checked = 0;
+  for (int y = 0; y < f.height; ++y) {
+    for (int x = 0; x < f.width; ++x) {
+      const std::size_t i = f.index(x, y);
+      if (f.id[i] == 0) continue;
+      const double px = x + 0.5;
+      const double py = f.height - 1 - y + 0.5;  // GL window y
+      const double b0 = ((v[1].x - px) * (v[2].y - py) - (v[2].x - px) * (v[1].y - py)) / area2;
+      if (!(b0 > e)) continue;
+      if (b0 >= 0.5) {  // at least half as long as N0: the relative term covers it
+        EXPECT_EQ(f.normal_reach[i], 0.0f) << x << "," << y;
+        continue;
+      }
+      const double want = 255.0 * 2.0 * e / b0 * k;
+      EXPECT_NEAR(f.normal_reach[i], want, want * 1e-5) << x << "," << y;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
 }  // namespace
 }  // namespace rc
