@@ -56,6 +56,18 @@ class CompareTest : public ::testing::Test {
   PairResult compare(ClassMaps* maps = nullptr) {
     return compareFrames(ref_, gl_, ref_, tol_, maps);
   }
+  // Pixels over fail when, over `block`, the reference's `channel` holds `value` and the
+  // driver's colour channel `c` is `units` (8-bit) above the reference's (from `original`).
+  std::uint64_t overFailWith(const Frame& original, const Block& block,
+                             std::vector<float> Frame::*channel, float value, double units, int c) {
+    gl_ = original;
+    forBlock(block, [&](int x, int y) {
+      const std::size_t i = ref_.index(x, y);
+      (ref_.*channel)[i] = value;
+      gl_.color[i * 4 + c] = ref_.color[i * 4 + c] + static_cast<float>(units / 255.0);
+    });
+    return compare().shading.over_fail;
+  }
 
   Frame ref_;
   Frame gl_;
@@ -752,13 +764,7 @@ TEST_F(CompareTest, ShadeReachWidensTheAttributePlaneTerm) {
   const double share = tol_.shading_slope_factor * band * 1e5;
   const Frame original = gl_;
   auto run = [&](float reach, double units, int channel) {
-    gl_ = original;
-    forBlock(b, [&](int x, int y) {
-      const std::size_t i = ref_.index(x, y);
-      ref_.shade_reach[i] = reach;
-      gl_.color[i * 4 + channel] = ref_.color[i * 4 + channel] + static_cast<float>(units / 255.0);
-    });
-    return compare().shading.over_fail;
+    return overFailWith(original, b, &Frame::shade_reach, reach, units, channel);
   };
   const auto n = static_cast<std::uint64_t>(b.size());
   const double fail = tol_.shading.fail;
@@ -774,13 +780,7 @@ TEST_F(CompareTest, NormalReachWidensRgbByItsUnits) {
   const Block b = kBackBlock;
   const Frame original = gl_;
   auto run = [&](float reach, double units, int channel) {
-    gl_ = original;
-    forBlock(b, [&](int x, int y) {
-      const std::size_t i = ref_.index(x, y);
-      ref_.normal_reach[i] = reach;
-      gl_.color[i * 4 + channel] = ref_.color[i * 4 + channel] + static_cast<float>(units / 255.0);
-    });
-    return compare().shading.over_fail;
+    return overFailWith(original, b, &Frame::normal_reach, reach, units, channel);
   };
   const auto n = static_cast<std::uint64_t>(b.size());
   const double fail = tol_.shading.fail;

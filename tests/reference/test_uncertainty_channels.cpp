@@ -250,15 +250,23 @@ TEST(UncertaintyChannels, TexelAltOfABlendedLayerIsWeightedByItsAlpha) {
 // independently: the barycentrics from the pixel's trace, their gradient from the vertices
 // (the window camera is affine), the colour as Gouraud or Phong defines it from
 // shadePrepared(), differentiated by central differences.
-Scene litRamp(Shading shading) {
+// A 32 x 32 window scene in rgba32f, no ambient light, one point light of colour (1, 0.9,
+// 0.8) at `light` with `intensity`, the material's diffuse, specular and shininess given.
+Scene litWindowScene(Shading shading, const glm::dvec3& light, double intensity,
+                     const glm::dvec3& diffuse, double specular, double shininess) {
   Scene s = test::windowScene(32, 32);
   s.state.shading = shading;
   s.state.color_format = ColorFormat::RGBA32F;
   s.ambient_light = glm::dvec3(0.0);
-  s.lights.push_back(Light{LightType::Point, {16.0, 8.0, 50.0}, {}, {1.0, 0.9, 0.8}, 2.0});
-  s.materials[0].diffuse = {0.9, 0.7, 0.5};
-  s.materials[0].specular = glm::dvec3(0.5);
-  s.materials[0].shininess = 8.0;
+  s.lights.push_back(Light{LightType::Point, light, {}, {1.0, 0.9, 0.8}, intensity});
+  s.materials[0].diffuse = diffuse;
+  s.materials[0].specular = glm::dvec3(specular);
+  s.materials[0].shininess = shininess;
+  return s;
+}
+
+Scene litRamp(Shading shading) {
+  Scene s = litWindowScene(shading, {16.0, 8.0, 50.0}, 2.0, {0.9, 0.7, 0.5}, 0.5, 8.0);
   const std::size_t o =
       test::addMesh(s, {{-8, -8, 0.5f}, {40, -8, 0.5f}, {-8, 40, 0.5f}}, {{0, 1, 2}});
   s.objects[o].mesh.normals = {{0.0f, 0.0f, 1.0f}, {0.6f, 0.0f, 0.8f}, {0.0f, 0.8f, 0.6f}};
@@ -379,14 +387,7 @@ TEST(UncertaintyChannels, ShadeReachOfAPhongSliverIsItsColoursGradient) {
 // formula, computed here from the vertices, at every drawn pixel whose normal is longer
 // than |e|; with three equal normals nothing is recorded.
 TEST(UncertaintyChannels, NormalReachFollowsTheShortNormal) {
-  Scene s = test::windowScene(32, 32);
-  s.state.shading = Shading::Phong;
-  s.state.color_format = ColorFormat::RGBA32F;
-  s.ambient_light = glm::dvec3(0.0);
-  s.lights.push_back(Light{LightType::Point, {16.0, 16.0, 40.0}, {}, {1.0, 0.9, 0.8}, 1.5});
-  s.materials[0].diffuse = {0.6, 0.5, 0.4};
-  s.materials[0].specular = glm::dvec3(0.3);
-  s.materials[0].shininess = 16.0;
+  Scene s = litWindowScene(Shading::Phong, {16.0, 16.0, 40.0}, 1.5, {0.6, 0.5, 0.4}, 0.3, 16.0);
   const glm::vec3 v[3] = {{2, 2, 0.5f}, {30, 4, 0.5f}, {6, 29, 0.5f}};
   test::addMesh(s, {v[0], v[1], v[2]}, {{0, 1, 2}});
   const Frame same = renderReference(s);  // every normal (0, 0, 1)
