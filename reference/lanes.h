@@ -36,14 +36,16 @@ struct Lane8 {
   Lane4 lo;
   Lane4 hi;
   double operator[](int k) const { return k < 4 ? lo[k] : hi[k - 4]; }
-  void set(int k, double v) {
-    if (k < 4) {
-      lo[k] = v;
-    } else {
-      hi[k - 4] = v;
-    }
-  }
 };
+// Lane k of v set to x (Lane8's halves are not one subscriptable vector).
+[[gnu::always_inline]] inline void setLane(Lane4& v, int k, double x) { v[k] = x; }
+[[gnu::always_inline]] inline void setLane(Lane8& v, int k, double x) {
+  if (k < 4) {
+    v.lo[k] = x;
+  } else {
+    v.hi[k - 4] = x;
+  }
+}
 [[gnu::always_inline]] inline Lane8 operator+(Lane8 a, Lane8 b) {
   return {a.lo + b.lo, a.hi + b.hi};
 }

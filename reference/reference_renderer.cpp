@@ -803,6 +803,22 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   return color;
 }
 
+// How much of a fragment's colour stays in the pixel: its opacity when its pass blends,
+// else all of it (the weight of the texel and reach channels it adds).
+inline double blendWeight(const TriangleContext& t) {
+  return t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+}
+
+// A reach as the float its channel stores: NaN (nothing known) as +inf (anything allowed).
+inline float reachChannel(double reach) {
+  return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+}
+
+// sum_k |b_k|: 1 inside the triangle, more where the centre lies outside it.
+inline double baryMagnitude(const glm::dvec3& b) {
+  return std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z);
+}
+
 // shade_reach of a Gouraud fragment of a fan triangle thinner than kThinAltitudePx
 // (TriangleContext::thin; docs/tolerances.md (b)): its colour T * AD + S
 // follows planes through the triangle's vertices (AD and S interpolated; T, the texture,
@@ -827,10 +843,9 @@ float Renderer::gouraudReach(const TriangleContext& t, const glm::dvec3& b, cons
     const double g2 = g.x * g.x + g.y * g.y;
     if (!(g2 <= worst2)) worst2 = g2;  // NaN kept (infinite below)
   }
-  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
-  const double reach =
-      255.0 * std::sqrt(worst2) * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
-  return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+  const double weight = blendWeight(t);
+  const double reach = 255.0 * std::sqrt(worst2) * baryMagnitude(b) * weight;
+  return reachChannel(reach);
 }
 
 // normal_reach of a Phong fragment whose interpolated normal can be short
@@ -846,6 +861,10 @@ float Renderer::normalReach(const TriangleContext& t, const glm::dvec3& b, const
                             const FragmentInterpolator& interp,
                             const FragmentInterpolator::Row& row, double dx) const {
   const glm::dvec3 n = b.x * t.v[0]->normal + b.y * t.v[1]->normal + b.z * t.v[2]->normal;
+  const double len = glm::length(n);
+  // As long as the normal from planes is (at least half) as long as its vertices', the
+  // relative term (a) covers its rounding; beyond, it grows as 1 / |n|.
+  if (len >= 0.5 * t.n_len_max) return 0.0f;
   glm::dvec3 db[2];
   interp.barycentricGradient(row, dx, b, db);
   double gradient = 0.0;
@@ -856,10 +875,6 @@ float Renderer::normalReach(const TriangleContext& t, const glm::dvec3& b, const
   const double q = std::fabs(interp.invWAt(row, dx));
   const double image = std::max(scene_.width, scene_.height);
   const double e = std::sqrt(3.0) * kNormalReach * (t.n_max / q + gradient * image);
-  const double len = glm::length(n);
-  // As long as the normal from planes is (at least half) as long as its vertices', the
-  // relative term (a) covers its rounding; beyond, it grows as 1 / |n|.
-  if (len >= 0.5 * t.n_len_max) return 0.0f;
   const double direction = len > e ? 2.0 * e / len : 2.0;
   const PreparedShading& s = *t.shading;
   const double spec = std::max(s.shininess, 1.0) * (s.blinn ? 1.0 : 4.0);
@@ -872,9 +887,9 @@ float Renderer::normalReach(const TriangleContext& t, const glm::dvec3& b, const
     }
     k += glm::abs(light.radiance) * att * (glm::abs(s.kd) + spec * glm::abs(s.ks));
   }
-  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+  const double weight = blendWeight(t);
   const double reach = 255.0 * direction * std::max({k.x, k.y, k.z}) * weight;
-  return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+  return reachChannel(reach);
 }
 
 // shade_reach of a Phong fragment of a fan triangle thinner than kThinAltitudePx
@@ -914,9 +929,9 @@ float Renderer::phongReach(const TriangleContext& t, const glm::dvec3& b, const 
     const double n = std::sqrt(g[0][c] * g[0][c] + g[1][c] * g[1][c]);
     if (!(n <= worst)) worst = n;  // NaN kept (infinite below)
   }
-  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
-  const double reach = 255.0 * worst * (std::fabs(b.x) + std::fabs(b.y) + std::fabs(b.z)) * weight;
-  return std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+  const double weight = blendWeight(t);
+  const double reach = 255.0 * worst * baryMagnitude(b) * weight;
+  return reachChannel(reach);
 }
 
 // The texel channels of a textured fragment (docs/tolerances.md (c), (d), (e)), in 8-bit
@@ -929,7 +944,7 @@ float Renderer::phongReach(const TriangleContext& t, const glm::dvec3& b, const 
 TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                               const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
                               const FragmentInterpolator::Row& row, double dx) const {
-  const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+  const double weight = blendWeight(t);
   TexelNote note;
   note.gain = static_cast<float>(
       weight * std::max({ambient_diffuse.x, ambient_diffuse.y, ambient_diffuse.z, 0.0}));
@@ -960,8 +975,7 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
     for (int c = 0; c < 3; ++c) alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
     note.alt = static_cast<float>(255.0 * alt * weight);
     const double reach = s.reach + tt.reach;
-    note.reach =
-        std::isnan(reach) ? std::numeric_limits<float>::infinity() : static_cast<float>(reach);
+    note.reach = reachChannel(reach);
     return note;
   }
   const TexelChoice choice = nearestTexelChoice(*t.texture, s, tt, scene_.state.texture_wrap, 1.0);

@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <type_traits>
 
 #include <glm/glm.hpp>
 
@@ -86,13 +85,7 @@ template <class V>
   if (exponent == 0) return splatAs<V>(1.0);
   V result;
   if (exponent < 0) {
-    for (int k = 0; k < kLaneCount<V>; ++k) {
-      if constexpr (std::is_same_v<V, Lane8>) {
-        result.set(k, std::pow(base[k], shininess));
-      } else {
-        result[k] = std::pow(base[k], shininess);
-      }
-    }
+    for (int k = 0; k < kLaneCount<V>; ++k) setLane(result, k, std::pow(base[k], shininess));
   } else {
     auto e = static_cast<unsigned>(exponent);
     if ((e & (e - 1)) == 0) {

@@ -8,7 +8,6 @@
 #include <bit>
 #include <cstdint>
 #include <random>
-#include <type_traits>
 #include <vector>
 
 #include "reference/shading.h"
@@ -51,15 +50,9 @@ template <class V>
 Vec3L<V> pack(const glm::dvec3* v) {
   Vec3L<V> r{};
   for (int k = 0; k < kLaneCount<V>; ++k) {
-    if constexpr (std::is_same_v<V, Lane8>) {
-      r.x.set(k, v[k].x);
-      r.y.set(k, v[k].y);
-      r.z.set(k, v[k].z);
-    } else {
-      r.x[k] = v[k].x;
-      r.y[k] = v[k].y;
-      r.z[k] = v[k].z;
-    }
+    setLane(r.x, k, v[k].x);
+    setLane(r.y, k, v[k].y);
+    setLane(r.z, k, v[k].z);
   }
   return r;
 }
