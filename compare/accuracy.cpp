@@ -625,12 +625,14 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
   if (data.known.entries.empty()) {
     line("None: fixtures/expectations.json lists no expected failure.");
   } else {
-    line("| id | fixture | backend | driver version | state | class | reason |");
+    line("| id | fixture | backend | driver version | state, tags | class | reason |");
     line("|---|---|---|---|---|---|---|");
     for (const Expectation& k : data.known.entries) {
       std::string state;
       for (const auto& [key, value] : k.state)
         state += fmt::format("{}{} {}", state.empty() ? "" : ", ", key, value);
+      for (const std::string& tag : k.tags)
+        state += fmt::format("{}tag {}", state.empty() ? "" : ", ", tag);
       line(fmt::format("| {} | `{}` | `{}` | {} | {} | {} | {} |", k.id, k.fixture, k.backend,
                        k.driver_version.empty() ? "any" : "`" + k.driver_version + "`",
                        state.empty() ? "any" : state, k.cls, cell(k.reason)));

@@ -2,6 +2,7 @@
 // "Expected failures".
 #include "compare/expectations.h"
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 
@@ -94,7 +95,8 @@ Expectations parseExpectations(const json& doc, const std::string& source) {
     bad(source, "expectations", "must be an array");
   static const std::set<std::string> classes = {"visibility", "depth", "shading"};
   static const std::set<std::string> keys = {"id",    "fixture", "backend", "driver_version",
-                                             "state", "class",   "reason",  "strict"};
+                                             "state", "tags",    "class",   "reason",
+                                             "strict"};
   Expectations out;
   std::set<std::string> ids;
   const json& list = doc["expectations"];
@@ -130,6 +132,16 @@ Expectations parseExpectations(const json& doc, const std::string& source) {
         x.state[key] = stateValue(value);
       }
     }
+    if (e.contains("tags")) {
+      const json& tags = e["tags"];
+      if (!tags.is_array() || tags.empty())
+        bad(source, at + ".tags", "must be a non-empty array of tags");
+      for (std::size_t k = 0; k < tags.size(); ++k) {
+        if (!tags[k].is_string() || tags[k].get<std::string>().empty())
+          bad(source, fmt::format("{}.tags[{}]", at, k), "must be a non-empty string");
+        x.tags.push_back(tags[k].get<std::string>());
+      }
+    }
     const bool pattern = x.fixture.find_first_of("*?") != std::string::npos;
     x.strict = !pattern;
     if (e.contains("strict")) {
@@ -156,6 +168,7 @@ PairContext contextOf(const PairResult& result) {
   c.backend = result.actual;
   c.driver_version = result.actual_driver;
   c.state = result.state.is_object() ? result.state : json::object();
+  c.tags = result.tags;
   return c;
 }
 
@@ -168,6 +181,8 @@ bool covers(const Expectation& e, const PairContext& pair) {
     const auto it = pair.state.find(key);
     if (it == pair.state.end() || stateValue(*it) != value) return false;
   }
+  for (const std::string& tag : e.tags)
+    if (std::find(pair.tags.begin(), pair.tags.end(), tag) == pair.tags.end()) return false;
   return true;
 }
 

@@ -2,7 +2,7 @@
 // the conformance suite, the accuracy report and campaigns expect, each scoped so that a
 // known difference does not hide others: to fixtures (a name or a glob), backends (a '*'
 // part matches one ':'-separated part), the driver version the actual side reported, and
-// the fixture's render state (e.g. softpipe with d16). One parser and one matcher for
+// the fixture's render state (e.g. softpipe with d16) and tags. One parser and one matcher for
 // every user of the file.
 #pragma once
 
@@ -24,6 +24,9 @@ struct Expectation {
   std::string backend;         // backend SPEC pattern: "gl:*:softpipe"
   std::string driver_version;  // glob over the actual side's GL version string; "" = any
   std::map<std::string, std::string> state;  // render state key -> value (as in the fixture)
+  // Tags the fixture must all carry (e.g. the random generator's "clear:wide-color"): for a
+  // difference that needs a scene property no render state key names.
+  std::vector<std::string> tags;
   std::string cls;                           // visibility | depth | shading
   std::string reason;
   // The conformance suite also fails when the listed class passes (an expected failure
@@ -54,6 +57,7 @@ struct PairContext {
   std::string backend;         // the actual side's SPEC
   std::string driver_version;  // the actual side's GL version string ("" for the reference)
   nlohmann::json state = nlohmann::json::object();  // the fixture's render state
+  std::vector<std::string> tags;                    // the fixture's tags
 };
 PairContext contextOf(const PairResult& result);
 

@@ -114,6 +114,15 @@ TEST(Expectations, EachMistakeIsOneLineNamingItsPath) {
           "reason": "r"}, {"id": "x", "fixture": "a", "backend": "b", "class": "depth",
           "reason": "r"}]})",
        "t.json: expectations[1].id: repeats \"x\""},
+      {R"({"expectations": [{"fixture": "*", "backend": "b", "class": "depth", "reason": "r",
+          "tags": "texture"}]})",
+       "t.json: expectations[0].tags: must be a non-empty array of tags"},
+      {R"({"expectations": [{"fixture": "*", "backend": "b", "class": "depth", "reason": "r",
+          "tags": []}]})",
+       "t.json: expectations[0].tags: must be a non-empty array of tags"},
+      {R"({"expectations": [{"fixture": "*", "backend": "b", "class": "depth", "reason": "r",
+          "tags": ["texture", 3]}]})",
+       "t.json: expectations[0].tags[1]: must be a non-empty string"},
       {R"({"expectations": [7]})", "t.json: expectations[0]: must be an object"},
       {R"({"expectation": []})", "t.json: expectation: unknown key"},
       {R"({"expectations": {}})", "t.json: expectations: must be an array"},
@@ -143,6 +152,36 @@ TEST(Expectations, BooleanStateValuesMatchTheFixturesBooleans) {
   EXPECT_FALSE(covers(x.entries[0], pair));
   pair.state = json::object();  // a pair without state (an old frame) is not covered
   EXPECT_FALSE(covers(x.entries[0], pair));
+}
+
+// An entry with tags covers a pair only when the fixture carries every one of them (and
+// run's reports carry the fixture's tags through to the matcher).
+TEST(Expectations, TagsMustAllBeOnTheFixture) {
+  const Expectations x = parseExpectations(json::parse(R"({"expectations": [
+      {"id": "wide", "fixture": "*", "backend": "gl:*:softpipe", "state": {"blend": "alpha"},
+       "tags": ["texture", "clear:wide-color"], "class": "shading", "reason": "r"}]})"),
+                                           "t");
+  ASSERT_EQ(x.entries[0].tags.size(), 2u);
+  PairContext pair;
+  pair.fixture = "random/s1/0001";
+  pair.backend = "gl:egl:softpipe";
+  pair.state = {{"blend", "alpha"}};
+  pair.tags = {"random", "clear:wide-color", "texture"};
+  EXPECT_TRUE(covers(x.entries[0], pair));
+  pair.tags = {"random", "texture"};  // one tag missing
+  EXPECT_FALSE(covers(x.entries[0], pair));
+  pair.tags = {};
+  EXPECT_FALSE(covers(x.entries[0], pair));
+  PairResult r;
+  r.fixture = "random/s1/0001";
+  r.actual = "gl:osmesa:softpipe";
+  r.state = {{"blend", "alpha"}};
+  r.tags = {"texture", "clear:wide-color"};
+  r.status = Status::Fail;
+  r.shading.status = Status::Fail;
+  ASSERT_EQ(knownFailuresOf(x, r).size(), 1u);
+  r.tags.pop_back();
+  EXPECT_TRUE(knownFailuresOf(x, r).empty());
 }
 
 }  // namespace

@@ -66,6 +66,7 @@ class ConformancePair : public ::testing::Test {
     pair.backend = backend_;
     pair.driver_version = gl.frame->meta.value("gl_version", "");
     pair.state = stateJson(scene.state);
+    pair.tags = scene.tags;
     std::set<std::string> allowed;
     std::set<std::string> required;
     std::string reasons;
