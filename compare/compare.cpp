@@ -868,6 +868,7 @@ class Comparator {
       // exceeding warn by k in the deciding channel (the channels' allowances differ).
       const float e = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
       maps_->shading_tolerance[i] = static_cast<float>(tol_.shading.raisedBy(e - s.excess).warn);
+      if (i == maps_->describe_pixel) maps_->describe_allowances = s.allowances;
     }
     // The excess is already net of the channel's allowance: the base thresholds judge it
     // (never NaN: a NaN channel excess is never the largest).

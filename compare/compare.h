@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -194,6 +195,12 @@ struct ClassMaps {
   // Compute LDR-FLIP (`--flip`): it costs ~2000 instructions a pixel near differences,
   // more than the rest of the comparison, so it is opt-in (a threshold also asks for it).
   bool want_flip = false;
+  // One pixel (index) whose per-channel shading allowances a tool wants to show (`explain`):
+  // recorded where that pixel's largest channel error is over warn, the only place the
+  // comparison computes them; NaN otherwise.
+  static constexpr double kNoAllowance = std::numeric_limits<double>::quiet_NaN();
+  std::size_t describe_pixel = static_cast<std::size_t>(-1);
+  std::array<double, 4> describe_allowances{kNoAllowance, kNoAllowance, kNoAllowance, kNoAllowance};
 };
 
 // Sizes the maps for a width x height comparison: allocates and touches the five per-pixel

@@ -94,9 +94,8 @@ Expectations parseExpectations(const json& doc, const std::string& source) {
   if (!doc.contains("expectations") || !doc["expectations"].is_array())
     bad(source, "expectations", "must be an array");
   static const std::set<std::string> classes = {"visibility", "depth", "shading"};
-  static const std::set<std::string> keys = {"id",    "fixture", "backend", "driver_version",
-                                             "state", "tags",    "class",   "reason",
-                                             "strict"};
+  static const std::set<std::string> keys = {
+      "id", "fixture", "backend", "driver_version", "state", "tags", "class", "reason", "strict"};
   Expectations out;
   std::set<std::string> ids;
   const json& list = doc["expectations"];

@@ -27,7 +27,7 @@ struct Expectation {
   // Tags the fixture must all carry (e.g. the random generator's "clear:wide-color"): for a
   // difference that needs a scene property no render state key names.
   std::vector<std::string> tags;
-  std::string cls;                           // visibility | depth | shading
+  std::string cls;  // visibility | depth | shading
   std::string reason;
   // The conformance suite also fails when the listed class passes (an expected failure
   // that went away). Default: true for an entry naming one fixture exactly, false for a

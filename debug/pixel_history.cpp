@@ -281,6 +281,14 @@ std::string story(const Json& doc) {
           c["depth"]["verdict"].get<std::string>(), fmtNum(c["shading"]["abs"]),
           fmtNum(c["shading"]["warn_above"]), c["shading"]["verdict"].get<std::string>());
     s += fmt::format("; whole image: {}\n", b["pair_status"].get<std::string>());
+    if (c.contains("shading") && c["shading"].is_object() &&
+        c["shading"]["allowance_rgba"].is_array())
+      s += fmt::format(
+          "    shading per channel (R, G, B, A): actual - reference {} 8-bit units, allowances {}; "
+          "a "
+          "channel warns above its allowance + {} and fails above its allowance + {}\n",
+          fmtVec(c["shading"]["delta_rgba"]), fmtVec(c["shading"]["allowance_rgba"]),
+          fmtNum(c["shading"]["base_warn"]), fmtNum(c["shading"]["base_fail"]));
   }
   return s;
 }
@@ -440,6 +448,7 @@ Json backendPixel(const std::string& spec, const Frame& reference, const Frame& 
   j["depth"] = num(frame.depth[i]);
 
   ClassMaps maps;
+  maps.describe_pixel = i;
   const PairResult r = compareFrames(reference, frame, reference, tolerances, &maps);
   const PixelClass cls = maps.pixel_class[i];
   const PixelClassInfo& info = pixelClassInfo(cls);
@@ -467,6 +476,17 @@ Json backendPixel(const std::string& spec, const Frame& reference, const Frame& 
                     {"warn_above", num(held.warn)},
                     {"fail_above", num(held.fail)},
                     {"verdict", toString(held.verdict(shading))}};
+    // Each channel's own allowance (a channel warns above allowance + warn): computed by
+    // the comparison only where the largest channel error is over warn, null elsewhere.
+    if (!std::isnan(maps.describe_allowances[0])) {
+      Json allowances = Json::array();
+      for (const double a : maps.describe_allowances) allowances.push_back(num(a));
+      c["shading"]["allowance_rgba"] = allowances;
+      c["shading"]["base_warn"] = num(tolerances.shading.warn);
+      c["shading"]["base_fail"] = num(tolerances.shading.fail);
+    } else {
+      c["shading"]["allowance_rgba"] = nullptr;
+    }
   } else {
     c["depth"] = nullptr;
     c["shading"] = nullptr;

@@ -253,6 +253,31 @@ TEST(PixelHistory, BackendVerdictsOnAlteredFrames) {
   j = backendPixel("red", ref, red, tol, i);
   EXPECT_EQ(j["class"]["shading"]["verdict"], "fail") << j.dump(2);
   EXPECT_NEAR(j["class"]["shading"]["delta_rgba"][0].get<double>(), 100.0, 1e-3);
+  // Each channel's allowance is shown where the pixel is over warn, and agrees with the
+  // threshold the largest error is held to: warn_above = warn + |d|max - max_c(|d_c| - a_c).
+  const Json& sh = j["class"]["shading"];
+  ASSERT_TRUE(sh["allowance_rgba"].is_array()) << j.dump(2);
+  double excess = -1e300;
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_GE(sh["allowance_rgba"][c].get<double>(), 0.0);
+    excess = std::max(excess, std::fabs(sh["delta_rgba"][c].get<double>()) -
+                                  sh["allowance_rgba"][c].get<double>());
+  }
+  EXPECT_NEAR(sh["warn_above"].get<double>(), tol.shading.warn + sh["abs"].get<double>() - excess,
+              1e-3);
+  EXPECT_EQ(sh["base_warn"].get<double>(), tol.shading.warn);
+  Json doc = historyAt(s, 1, 1);
+  doc["backends"]["red"] = j;
+  const std::string story = pixelStory(doc);
+  EXPECT_NE(story.find("shading per channel (R, G, B, A): actual - reference (99.99"),
+            std::string::npos)
+      << story;
+  // Within warn the comparison does not compute them: null, not made up.
+  Frame close = ref;
+  close.color[4 * i] += 0.005f / 255.0f;  // under the base warn, 1/64 unit in rgba32f
+  j = backendPixel("close", ref, close, tol, i);
+  EXPECT_EQ(j["class"]["shading"]["verdict"], "pass");
+  EXPECT_TRUE(j["class"]["shading"]["allowance_rgba"].is_null()) << j.dump(2);
 
   // Nothing drawn where the reference drew the quad, away from every edge: a hard miss.
   Frame missing = ref;
