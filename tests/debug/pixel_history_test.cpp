@@ -24,7 +24,7 @@ using debugtest::litWindow;
 using debugtest::pointLight;
 using Json = nlohmann::ordered_json;
 
-Json historyAt(const Scene& scene, int x, int y, ReferenceOptions options = {}) {
+Json historyAt(const Scene& scene, int x, int y, const ReferenceOptions& options = {}) {
   PixelQuery q;
   q.fixture_file = "in-memory";
   q.reference_spec = "ref";
