@@ -26,6 +26,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -110,6 +111,8 @@ class UncertaintyTracker {
     normal_reach_ = frame.normal_reach.data();
     shade_active_ = false;
     normal_active_ = false;
+    texel_active_ = false;
+    blend_active_ = false;
   }
 
   // Fragment at clamped window depth z, on a plane of depth gradient `slope` (steps/px)
@@ -154,12 +157,16 @@ class UncertaintyTracker {
   void colourWritten(std::size_t index, bool blended, float alpha, float texel_dist,
                      float texel_alt, float texel_gain, float texel_reach, float shade_reach,
                      float normal_reach) {
+    if (!texel_active_ && !initialTexel(texel_dist, texel_alt, texel_gain, texel_reach))
+      texel_active_ = true;
     if (!blended) {
-      blend_count_[index] = 0.0f;
-      texel_dist_[index] = texel_dist;
-      texel_alt_[index] = texel_alt;
-      texel_gain_[index] = texel_gain;
-      texel_reach_[index] = texel_reach;
+      if (blend_active_) blend_count_[index] = 0.0f;
+      if (texel_active_) {
+        texel_dist_[index] = texel_dist;
+        texel_alt_[index] = texel_alt;
+        texel_gain_[index] = texel_gain;
+        texel_reach_[index] = texel_reach;
+      }
       if (kept(shade_active_, shade_reach)) shade_reach_[index] = shade_reach;
       if (kept(normal_active_, normal_reach)) normal_reach_[index] = normal_reach;
       return;
@@ -168,11 +175,14 @@ class UncertaintyTracker {
       normal_reach_[index] = (1.0f - alpha) * normal_reach_[index] + normal_reach;
     if (kept(shade_active_, shade_reach))
       shade_reach_[index] = (1.0f - alpha) * shade_reach_[index] + shade_reach;
+    blend_active_ = true;
     blend_count_[index] += 1.0f;
-    texel_reach_[index] = std::max(texel_reach_[index], texel_reach);
-    texel_dist_[index] = std::min(texel_dist_[index], texel_dist);
-    texel_alt_[index] = (1.0f - alpha) * texel_alt_[index] + texel_alt;
-    texel_gain_[index] = (1.0f - alpha) * texel_gain_[index] + texel_gain;
+    if (texel_active_) {
+      texel_reach_[index] = std::max(texel_reach_[index], texel_reach);
+      texel_dist_[index] = std::min(texel_dist_[index], texel_dist);
+      texel_alt_[index] = (1.0f - alpha) * texel_alt_[index] + texel_alt;
+      texel_gain_[index] = (1.0f - alpha) * texel_gain_[index] + texel_gain;
+    }
   }
 
   // The A-buffer's sorted list at a pixel (ReferenceOptions::abuffer): window depths z and
@@ -278,6 +288,23 @@ class UncertaintyTracker {
   static bool kept(bool& active, float value) {
     if (value != 0.0f) active = true;
     return active;
+  }
+  // The same for the four texel planes and blend_count, which every written fragment
+  // touched (an untextured one storing their initial values, an opaque one blend_count 0):
+  // until a fragment brings a texel value other than the initial ones (bit for bit: -0 is
+  // stored as -0) the planes hold only initial values, and so would every write; until a
+  // blended fragment has been written, every blend_count is 0. (A blended write of initial
+  // texel values over initial ones leaves them too: min(1, 1), max(0, 0), (1 - a) 0 + 0 =
+  // +0 for a in [0, 1].) In an untextured, opaque frame the five planes are not touched per
+  // fragment at all (docs/performance.md, tenth pass).
+  bool texel_active_ = false;
+  bool blend_active_ = false;
+  static bool sameBits(float a, float b) {
+    return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
+  }
+  static bool initialTexel(float dist, float alt, float gain, float reach) {
+    return sameBits(dist, 1.0f) && sameBits(alt, 0.0f) && sameBits(gain, 0.0f) &&
+           sameBits(reach, 0.0f);
   }
 };
 
