@@ -13,6 +13,7 @@
 
 #include "app/backends.h"
 #include "app/commands.h"
+#include "fixtures/big_buffer.h"
 #include "fixtures/errors.h"
 #include "fixtures/frame_stream.h"
 #include "fixtures/loader.h"
@@ -55,6 +56,7 @@ namespace rc {
 int workerCommand(const std::string& spec) {
   using namespace worker;
   const BackendSpec backend = parseBackendSpec(spec);
+  keepFreedMemory();  // one fixture's frames after another (fixtures/big_buffer.h)
   std::string line;
   while (std::getline(std::cin, line)) {
     const nlohmann::json request = nlohmann::json::parse(line, nullptr, false);

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 
+#include "fixtures/big_buffer.h"
 #include "reference/reference_renderer.h"
 #include "tests/reference/test_scenes.h"
 
@@ -84,4 +85,14 @@ BENCHMARK(BM_EmptyFrame)->ArgName("uncertainty")->Arg(0)->Arg(1)->Unit(benchmark
 }  // namespace
 }  // namespace rc
 
-BENCHMARK_MAIN();
+// The renderer as `run`'s workers use it: freed frames kept for the next render
+// (keepFreedMemory(), fixtures/big_buffer.h), so that a benchmark measures rendering and
+// not the kernel handing the same pages back every iteration.
+int main(int argc, char** argv) {
+  rc::keepFreedMemory();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
