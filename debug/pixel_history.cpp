@@ -284,9 +284,9 @@ std::string story(const Json& doc) {
     if (c.contains("shading") && c["shading"].is_object() &&
         c["shading"]["allowance_rgba"].is_array())
       s += fmt::format(
-          "    shading per channel (R, G, B, A): actual - reference {} 8-bit units, allowances {}; "
-          "a "
-          "channel warns above its allowance + {} and fails above its allowance + {}\n",
+          "    shading per channel (R, G, B, A): actual - reference {} 8-bit units, "
+          "allowances {}; a channel warns above its allowance + {} and fails above its "
+          "allowance + {}\n",
           fmtVec(c["shading"]["delta_rgba"]), fmtVec(c["shading"]["allowance_rgba"]),
           fmtNum(c["shading"]["base_warn"]), fmtNum(c["shading"]["base_fail"]));
   }
