@@ -127,10 +127,12 @@ inline double minAltitudePx(const WindowVertex& a, const WindowVertex& b, const 
 // Whether the interpolated normal of a triangle with these vertex normals can be short
 // against them (|n| < max_k |N_k| / 2 somewhere): a vertex normal under half the longest,
 // or two at 60 degrees or more. Elsewhere normal_reach is below 1e-5 of the colour, far
-// inside the relative term (docs/tolerances.md (a)), and is not computed.
-inline bool canBeShort(const glm::dvec3& n0, const glm::dvec3& n1, const glm::dvec3& n2) {
+// inside the relative term (docs/tolerances.md (a)), and is not computed. `longest`: the
+// longest |N_k| (normalReach() needs it too).
+inline bool canBeShort(const glm::dvec3& n0, const glm::dvec3& n1, const glm::dvec3& n2,
+                       double& longest) {
   const double l[3] = {glm::length(n0), glm::length(n1), glm::length(n2)};
-  const double longest = std::max({l[0], l[1], l[2]});
+  longest = std::max({l[0], l[1], l[2]});
   if (!(std::min({l[0], l[1], l[2]}) >= 0.5 * longest)) return true;  // NaN too
   return glm::dot(n0, n1) < 0.5 * l[0] * l[1] || glm::dot(n1, n2) < 0.5 * l[1] * l[2] ||
          glm::dot(n2, n0) < 0.5 * l[2] * l[0];
@@ -693,11 +695,9 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
       t.thin = scene_.state.shading != Shading::Flat &&
                !(minAltitudePx(wv[0], wv[i], wv[i + 1]) >= kThinAltitudePx);
       if (scene_.state.shading == Shading::Phong) {
-        t.short_normals = canBeShort(t.v[0]->normal, t.v[1]->normal, t.v[2]->normal);
+        t.short_normals = canBeShort(t.v[0]->normal, t.v[1]->normal, t.v[2]->normal, t.n_len_max);
         if (t.short_normals) {
           t.n_max = 0.0;
-          t.n_len_max = std::max({glm::length(t.v[0]->normal), glm::length(t.v[1]->normal),
-                                  glm::length(t.v[2]->normal)});
           for (const WindowVertex* w : {&wv[0], &wv[i], &wv[i + 1]}) {
             const glm::dvec3 n = w->bary.x * t.v[0]->normal + w->bary.y * t.v[1]->normal +
                                  w->bary.z * t.v[2]->normal;
