@@ -20,6 +20,7 @@
 #include "reference/clipper.h"
 #include "reference/fragment_ops.h"
 #include "reference/interpolation.h"
+#include "reference/prefetch.h"
 #include "reference/rasterizer.h"
 #include "reference/shading.h"
 #include "reference/shading_lanes.h"
@@ -304,6 +305,7 @@ class Renderer {
  private:
   void transformVertices();
   void drawTriangle(const PrimitiveRef& prim, const DrawPass& pass);
+  void prefetchRows(const PrimitiveRef& prim);
   void drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const ClipVertex* poly,
                    int count, bool clipped);
   bool windowVertexSetup(const ClipVertex& c, WindowVertex& wv, FixedVertex& fv, double& reach,
@@ -379,11 +381,17 @@ class Renderer {
   EdgeDistanceBatch& edges_;           // scratch
   std::vector<std::vector<VertexWindow>>& windows_;  // per object, per vertex, scratch
   const SampleShift shift_;                          // multisampling: the sample drawn
-  std::uint64_t triangles_drawn_ = 0;                // fan triangles that reached the fragment loop
-  std::uint64_t fragments_ = 0;                      // covered pixel centres (depth tested or not)
-  std::vector<KeptFragment> kept_;                   // A-buffer: blended fragments, in draw order
-  std::uint32_t blend_seq_ = 0;                      // triangles of blending passes drawn so far
-  ABufferTally abuffer_;                             // A-buffer: what the resolve found
+  // prefetchRows(): the first vertex of the last triangle it saw.
+  double prefetch_x_ = -1e9;
+  double prefetch_y_ = -1e9;
+  // How far rasterizing moves a vertex: half a subpixel step, and the sample's offset.
+  const double prefetch_margin_ =
+      0.5 / snap_scale_ + std::max(std::fabs(shift_.offset.x), std::fabs(shift_.offset.y));
+  std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
+  std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
+  std::vector<KeptFragment> kept_;     // A-buffer: blended fragments, in draw order
+  std::uint32_t blend_seq_ = 0;        // triangles of blending passes drawn so far
+  ABufferTally abuffer_;               // A-buffer: what the resolve found
   // textureRange() of each texture met so far (linear filtering with uncertainty).
   std::vector<std::pair<const Texture*, glm::dvec4>> texture_ranges_;
   const glm::dvec4& textureRangeOf(const Texture* texture);
@@ -436,8 +444,10 @@ Frame Renderer::run() {
 
   transformVertices();
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter)) {
-    for (const PrimitiveRef& prim : pass.primitives) {
-      drawTriangle(prim, pass);
+    const std::vector<PrimitiveRef>& prims = pass.primitives;
+    for (std::size_t j = 0; j < prims.size(); ++j) {
+      if (j + PrefetchBox::kAhead < prims.size()) prefetchRows(prims[j + PrefetchBox::kAhead]);
+      drawTriangle(prims[j], pass);
       if (pass.blend) ++blend_seq_;
     }
   }
@@ -562,6 +572,42 @@ void Renderer::setUpWindows(std::size_t object) {
     if ((w.flags & VertexWindow::kDrawable) == 0) continue;
     vertexReach(ClipVertex{verts[i].clip, glm::dvec3(0.0), verts[i].clip_err}, w.reach,
                 w.depth_reach);
+  }
+}
+
+// Asks for the frame rows a small triangle drawn later in the pass will touch (prefetch.h:
+// the rows of a soup's triangles are otherwise missed one triangle after another). Only
+// triangles drawn from their vertices' window set-up, the ones drawTriangle() does not
+// clip; a hint, so the output is the same without it.
+inline void Renderer::prefetchRows(const PrimitiveRef& prim) {
+  const auto& tri = scene_.objects[prim.object].mesh.triangles[prim.triangle];
+  const VertexWindow* windows = windows_[prim.object].data();
+  const VertexWindow& a = windows[tri[0]];
+  // Next to the last triangle asked about (a mesh in order): its rows are in the cache or
+  // streaming in already, and the prefetches would only cost instructions. Tested first,
+  // on one vertex, to keep that case cheap.
+  const double dx = a.x - prefetch_x_;
+  const double dy = a.y - prefetch_y_;
+  prefetch_x_ = a.x;
+  prefetch_y_ = a.y;
+  if (std::fabs(dx) <= PrefetchBox::kMaxColumns && std::fabs(dy) <= 1.0) return;
+  const VertexWindow& b = windows[tri[1]];
+  const VertexWindow& c = windows[tri[2]];
+  if (!(a.flags & b.flags & c.flags & VertexWindow::kDrawable)) return;
+  const double x[3] = {a.x, b.x, c.x};
+  const double y[3] = {a.y, b.y, c.y};
+  PrefetchBox box{};
+  if (!box.set(x, y, prefetch_margin_, clip_.x0, clip_.x1, clip_.y0, clip_.y1)) return;
+  for (int py = box.row_begin; py < box.row_end; ++py) {
+    // Rows are stored top down (fillSpans()).
+    const std::size_t row =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    const std::size_t begin = row + static_cast<std::size_t>(box.col_begin - clip_.x0);
+    const std::size_t end = row + static_cast<std::size_t>(box.col_end - clip_.x0);
+    prefetchSpan(frame_.color.data(), 4 * begin, 4 * end);
+    prefetchSpan(depth_.data(), begin, end);
+    prefetchSpan(frame_.id.data(), begin, end);
+    if (uncertainty_) gaps_.prefetch(begin, end);
   }
 }
 

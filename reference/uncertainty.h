@@ -36,6 +36,7 @@
 #include "fixtures/frame.h"
 #include "fixtures/scene.h"
 #include "reference/fragment_ops.h"
+#include "reference/prefetch.h"
 #include "reference/rasterizer.h"
 #include "reference/viewport.h"
 
@@ -207,6 +208,34 @@ class UncertaintyTracker {
         gap_slope_[index] = std::max({gap_slope_[index], slope[k], slope[near]});
       }
     }
+  }
+
+  // Prefetches pixels [begin, end) of the planes a fragment there will touch: those every
+  // fragment touches, and those of the frame-wide groups once they are written
+  // (Renderer::prefetchRows()).
+  void prefetch(std::size_t begin, std::size_t end) const {
+    const auto span = [=](const auto* plane) { prefetchSpan(plane, begin, end); };
+    span(stored_z_.data());
+    span(clear_near_.data());
+    span(clear_far_.data());
+    span(clear_slope_);
+    span(gap_);
+    span(gap_slope_);
+    span(depth_slope_);
+    span(depth_reach_);
+    if (blend_active_) {
+      span(blend_count_);
+      span(blend_gap_);
+      span(blend_slope_);
+    }
+    if (texel_active_) {
+      span(texel_dist_);
+      span(texel_alt_);
+      span(texel_gain_);
+      span(texel_reach_);
+    }
+    if (shade_active_) span(shade_reach_);
+    if (normal_active_) span(normal_reach_);
   }
 
   // Ends the frame: clear_gap from each pixel's final id (frame.id).
