@@ -311,7 +311,10 @@ class Renderer {
   bool windowVertexSetup(const ClipVertex& c, WindowVertex& wv, FixedVertex& fv, double& reach,
                          double& depth_reach) const;
   void vertexReach(const ClipVertex& c, double& reach, double& depth_reach) const;
-  void setUpWindows(std::size_t object);
+  WindowSetup windowSetup() const;
+  // Window set-up (and the reaches, with the channels) of vertices [begin, end) of an object.
+  void setUpWindows(std::size_t object, const WindowSetup& setup, std::size_t begin,
+                    std::size_t end);
   void drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, const WindowVertex* wv,
                     const FixedVertex* fv, const double* reach, const double* depth_reach,
                     int count, bool clipped);
@@ -405,12 +408,12 @@ const glm::dvec4& Renderer::textureRangeOf(const Texture* texture) {
 }
 
 void Renderer::transformVertices() {
-  // Kept from the last frame (scratch): transformObject() and setUpWindows() rewrite every
-  // vertex they keep.
+  // Kept from the last frame (scratch): every vertex kept is rewritten below.
   vertices_.resize(scene_.objects.size());
   windows_.resize(scene_.objects.size());
   const Shading shading = scene_.state.shading;
   if (shading == Shading::Gouraud) gouraud_.resize(scene_.objects.size());
+  const WindowSetup setup = windowSetup();
   for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
     const Object& obj = scene_.objects[o];
     if (obj.mesh.triangles.empty()) {
@@ -418,16 +421,26 @@ void Renderer::transformVertices() {
       windows_[o].clear();
       continue;
     }
+    const std::size_t n = obj.mesh.positions.size();
+    vertices_[o].resize(n);
+    windows_[o].resize(n);
+    if (shading == Shading::Gouraud) gouraud_[o].resize(n);
     // Flat shading lights the face normal: vertex normals would go unused (unless traced).
-    transformObject(obj, camera_, vertices_[o], shading != Shading::Flat || trace_ != nullptr,
-                    uncertainty_);
-    setUpWindows(o);
-    if (shading != Shading::Gouraud) continue;
-    // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
+    const ObjectTransform transform(obj, camera_, shading != Shading::Flat || trace_ != nullptr,
+                                    uncertainty_);
     const PreparedShading& prepared = shading_[obj.material];
-    gouraud_[o].resize(vertices_[o].size());
-    for (std::size_t i = 0; i < vertices_[o].size(); ++i)
-      gouraud_[o][i] = shadePrepared(prepared, vertices_[o][i].world, vertices_[o][i].normal);
+    // In pieces that stay in the cache from the transform to the window set-up (and
+    // Gouraud's lighting): 512 x (128 + 72) bytes.
+    constexpr std::size_t kPiece = 512;
+    for (std::size_t begin = 0; begin < n; begin += kPiece) {
+      const std::size_t end = std::min(n, begin + kPiece);
+      transform.apply(begin, end, vertices_[o].data());
+      setUpWindows(o, setup, begin, end);
+      if (shading != Shading::Gouraud) continue;
+      // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
+      for (std::size_t i = begin; i < end; ++i)
+        gouraud_[o][i] = shadePrepared(prepared, vertices_[o][i].world, vertices_[o][i].normal);
+    }
   }
 }
 
@@ -552,10 +565,7 @@ inline void Renderer::vertexReach(const ClipVertex& c, double& reach, double& de
   depth_reach = std::isnan(dz) ? std::numeric_limits<double>::infinity() : dz;
 }
 
-void Renderer::setUpWindows(std::size_t object) {
-  const std::vector<TransformedVertex>& verts = vertices_[object];
-  std::vector<VertexWindow>& out = windows_[object];
-  out.resize(verts.size());
+WindowSetup Renderer::windowSetup() const {
   WindowSetup setup;
   setup.width = scene_.width;
   setup.height = scene_.height;
@@ -565,9 +575,16 @@ void Renderer::setUpWindows(std::size_t object) {
     setup.shift_x = shift_.units_x;
     setup.shift_y = shift_.units_y;
   }
-  setUpVertexWindows(verts.data(), verts.size(), setup, out.data());
+  return setup;
+}
+
+void Renderer::setUpWindows(std::size_t object, const WindowSetup& setup, std::size_t begin,
+                            std::size_t end) {
+  const TransformedVertex* verts = vertices_[object].data();
+  VertexWindow* out = windows_[object].data();
+  setUpVertexWindows(verts + begin, end - begin, setup, out + begin);
   if (!uncertainty_) return;
-  for (std::size_t i = 0; i < verts.size(); ++i) {
+  for (std::size_t i = begin; i < end; ++i) {
     VertexWindow& w = out[i];
     if ((w.flags & VertexWindow::kDrawable) == 0) continue;
     vertexReach(ClipVertex{verts[i].clip, glm::dvec3(0.0), verts[i].clip_err}, w.reach,

@@ -84,28 +84,40 @@ __attribute__((target("avx2"))) void transformPositionsAvx2(
 }
 }  // namespace detail
 
-void transformObject(const Object& object, const CameraTransform& camera,
-                     std::vector<TransformedVertex>& out, bool normals, bool errors) {
-  const Mesh& mesh = object.mesh;
-  glm::dmat4 abs_vp(0.0);
-  for (int c = 0; c < 4; ++c) abs_vp[c] = glm::abs(camera.view_projection[c]);
-  // Every field of every vertex is written below: a vector kept from an earlier frame
-  // need not be cleared first.
-  out.resize(mesh.positions.size());
+ObjectTransform::ObjectTransform(const Object& object, const CameraTransform& camera, bool normals,
+                                 bool errors)
+    : object_(&object),
+      camera_(&camera),
+      abs_vp_(0.0),
+      with_normals_(normals && !object.mesh.normals.empty()),
+      errors_(errors) {
+  for (int c = 0; c < 4; ++c) abs_vp_[c] = glm::abs(camera.view_projection[c]);
+  normal_matrix_ = with_normals_ ? normalMatrix(object.model) : glm::dmat3(0.0);
+}
+
+void ObjectTransform::apply(std::size_t begin, std::size_t end, TransformedVertex* out) const {
+  const Mesh& mesh = object_->mesh;
   // x86-64's baseline or AVX2 (no FMA), whichever the CPU has: the bits are the same either
   // way (lanes.h).
   static const bool kAvx2 = __builtin_cpu_supports("avx2");
   (kAvx2 ? detail::transformPositionsAvx2 : detail::transformPositionsBaseline)(
-      object.model, camera.view_projection, abs_vp, mesh.positions.data(), mesh.positions.size(),
-      out.data(), errors);
-  const bool with_normals = normals && !mesh.normals.empty();
-  const glm::dmat3 normal_matrix = with_normals ? normalMatrix(object.model) : glm::dmat3(0.0);
-  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      object_->model, camera_->view_projection, abs_vp_, mesh.positions.data() + begin, end - begin,
+      out + begin, errors_);
+  for (std::size_t i = begin; i < end; ++i) {
     TransformedVertex& v = out[i];
-    v.normal = with_normals && i < mesh.normals.size() ? worldNormal(normal_matrix, mesh.normals[i])
-                                                       : glm::dvec3(0.0);
+    v.normal = with_normals_ && i < mesh.normals.size()
+                   ? worldNormal(normal_matrix_, mesh.normals[i])
+                   : glm::dvec3(0.0);
     v.uv = i < mesh.uvs.size() ? glm::dvec2(mesh.uvs[i]) : glm::dvec2(0.0);
   }
+}
+
+void transformObject(const Object& object, const CameraTransform& camera,
+                     std::vector<TransformedVertex>& out, bool normals, bool errors) {
+  // Every field of every vertex is written: a vector kept from an earlier frame need not be
+  // cleared first.
+  out.resize(object.mesh.positions.size());
+  ObjectTransform(object, camera, normals, errors).apply(0, out.size(), out.data());
 }
 
 }  // namespace rc::ref

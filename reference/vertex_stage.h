@@ -47,6 +47,26 @@ inline constexpr double kUlp32 = 0x1p-24;  // float32 unit roundoff
 void transformObject(const Object& object, const CameraTransform& camera,
                      std::vector<TransformedVertex>& out, bool normals = true, bool errors = false);
 
+// transformObject() prepared once for an object and applied to ranges of its vertices:
+// the renderer transforms an object in pieces and sets up each piece's window positions
+// while its vertices are still in the cache (a soup of 300k vertices is 38 MB of them).
+// Each vertex gets the bits transformObject() gives it.
+class ObjectTransform {
+ public:
+  ObjectTransform(const Object& object, const CameraTransform& camera, bool normals = true,
+                  bool errors = false);
+  // Vertices [begin, end) of the object into out[begin, end).
+  void apply(std::size_t begin, std::size_t end, TransformedVertex* out) const;
+
+ private:
+  const Object* object_;
+  const CameraTransform* camera_;
+  glm::dmat4 abs_vp_;
+  glm::dmat3 normal_matrix_;
+  bool with_normals_;
+  bool errors_;
+};
+
 namespace detail {
 // The two builds transformObject() chooses between for the positions' part (world, clip,
 // clip_err; abs_vp: |view_projection| per entry), for the tests to run each (the AVX2 one
