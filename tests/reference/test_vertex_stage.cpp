@@ -103,6 +103,44 @@ TEST(VertexStage, PositionsMatchGlmBitForBit) {
   }
 }
 
+// The renderer transforms an object in pieces (ObjectTransform::apply on ranges): every
+// field of every vertex must come out as one whole transformObject() gives it, normals,
+// uvs (some vertices without: the mesh's arrays shorter) and error bounds included.
+TEST(VertexStage, RangesMatchTheWholeObjectBitForBit) {
+  std::mt19937_64 rng(20261203);
+  std::uniform_real_distribution<float> d(-50.0f, 50.0f);
+  Object object;
+  object.model = randomMatrix(rng);
+  for (int i = 0; i < 1000; ++i) object.mesh.positions.emplace_back(d(rng), d(rng), d(rng));
+  for (int i = 0; i < 990; ++i) object.mesh.normals.emplace_back(d(rng), d(rng), d(rng));
+  for (int i = 0; i < 700; ++i) object.mesh.uvs.emplace_back(d(rng), d(rng));
+  CameraTransform camera;
+  camera.view_projection = randomMatrix(rng);
+  for (const bool normals : {false, true}) {
+    for (const bool errors : {false, true}) {
+      std::vector<TransformedVertex> whole;
+      transformObject(object, camera, whole, normals, errors);
+      std::vector<TransformedVertex> pieces(whole.size());
+      const ObjectTransform transform(object, camera, normals, errors);
+      std::size_t begin = 0;
+      for (const std::size_t size : {1, 7, 512, 480}) {
+        transform.apply(begin, begin + size, pieces.data());
+        begin += size;
+      }
+      ASSERT_EQ(begin, whole.size());
+      for (std::size_t i = 0; i < whole.size(); ++i) {
+        const TransformedVertex& a = pieces[i];
+        const TransformedVertex& b = whole[i];
+        EXPECT_TRUE(sameVec(&a.world.x, &b.world.x, 3)) << "vertex " << i;
+        EXPECT_TRUE(sameVec(&a.normal.x, &b.normal.x, 3)) << "vertex " << i;
+        EXPECT_TRUE(sameVec(&a.clip.x, &b.clip.x, 4)) << "vertex " << i;
+        EXPECT_TRUE(sameVec(&a.uv.x, &b.uv.x, 2)) << "vertex " << i;
+        EXPECT_TRUE(sameVec(&a.clip_err.x, &b.clip_err.x, 4)) << "vertex " << i;
+      }
+    }
+  }
+}
+
 // The scalar statement of one VertexWindow: the tests classifyTriangle() and drawPolygon()
 // make of a vertex, and what it computes for a drawable one.
 struct Expected {
