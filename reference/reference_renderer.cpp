@@ -458,8 +458,13 @@ Frame Renderer::run() {
   transformVertices();
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter)) {
     const std::vector<PrimitiveRef>& prims = pass.primitives;
+    // Only where the frame's planes can be out of the cache: colour, depth key and id,
+    // and the tracker's eight planes (stored_z_ double) with the channels.
+    const std::size_t frame_bytes = frame_.pixelCount() * (uncertainty_ ? 24 + 36 : 24);
+    const bool prefetch = frame_bytes >= PrefetchBox::kMinFrameBytes;
     for (std::size_t j = 0; j < prims.size(); ++j) {
-      if (j + PrefetchBox::kAhead < prims.size()) prefetchRows(prims[j + PrefetchBox::kAhead]);
+      if (prefetch && j + PrefetchBox::kAhead < prims.size())
+        prefetchRows(prims[j + PrefetchBox::kAhead]);
       drawTriangle(prims[j], pass);
       if (pass.blend) ++blend_seq_;
     }
@@ -615,16 +620,18 @@ inline void Renderer::prefetchRows(const PrimitiveRef& prim) {
   const double y[3] = {a.y, b.y, c.y};
   PrefetchBox box{};
   if (!box.set(x, y, prefetch_margin_, clip_.x0, clip_.x1, clip_.y0, clip_.y1)) return;
-  for (int py = box.row_begin; py < box.row_end; ++py) {
-    // Rows are stored top down (fillSpans()).
-    const std::size_t row =
-        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
-    const std::size_t begin = row + static_cast<std::size_t>(box.col_begin - clip_.x0);
-    const std::size_t end = row + static_cast<std::size_t>(box.col_end - clip_.x0);
-    prefetchSpan(frame_.color.data(), 4 * begin, 4 * end);
-    prefetchSpan(depth_.data(), begin, end);
-    prefetchSpan(frame_.id.data(), begin, end);
-    if (uncertainty_) gaps_.prefetch(begin, end);
+  // Rows are stored top down (fillSpans()): pixel (x, y) at (clip.y1 - 1 - y) * width + x -
+  // clip.x0, so each row up is `width` elements back.
+  const auto width = static_cast<std::ptrdiff_t>(fb_width_);
+  std::ptrdiff_t begin = (clip_.y1 - 1 - box.row_begin) * width + (box.col_begin - clip_.x0);
+  const std::ptrdiff_t count = box.col_end - box.col_begin;
+  for (int py = box.row_begin; py < box.row_end; ++py, begin -= width) {
+    const auto first = static_cast<std::size_t>(begin);
+    const auto end = static_cast<std::size_t>(begin + count);
+    prefetchSpan(frame_.color.data(), 4 * first, 4 * end);
+    prefetchSpan(depth_.data(), first, end);
+    prefetchSpan(frame_.id.data(), first, end);
+    if (uncertainty_) gaps_.prefetch(first, end);
   }
 }
 
