@@ -12,6 +12,9 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
+
+#include "reference/rasterizer.h"
 
 namespace rc::ref {
 
@@ -33,11 +36,12 @@ template <class T>
   asm volatile("");
 }
 
-// The pixels whose centres can be covered by a triangle with window positions x[3], y[3]
-// that the rasterizer moves by at most `margin` px (snapping: half a subpixel step; a
-// multisample pass adds its sample offset), clipped to [x0, x1) x [y0, y1); set() is false
-// when that is empty or larger than is worth prefetching (a larger triangle walks its rows
-// in sequence, which the hardware prefetcher follows).
+// The pixels a triangle with snapped vertices v[3] (subpixel units, `bits` fractional bits,
+// as TriangleCoverage takes them) can cover: its snapped bounding box's pixel centres,
+// TriangleCoverage::setup()'s box, clipped to [x0, x1) x [y0, y1). set() is false when that
+// is empty or larger than is worth prefetching (a larger triangle walks its rows in
+// sequence, which the hardware prefetcher follows). The vertices must be inside the clip
+// volume (|coordinates| far below 2^61, as drawTriangle()'s fast path has them).
 struct PrefetchBox {
   static constexpr int kAhead = 8;        // triangles: 4 to 16 measured alike, 8 kept
   static constexpr int kMaxRows = 8;      // each row of each plane is its own miss
@@ -50,33 +54,23 @@ struct PrefetchBox {
   int col_end;
   int row_begin;
   int row_end;
-  bool set(const double* x, const double* y, double margin, int x0, int x1, int y0, int y1) {
-    // std::min/max: one instruction each (ternaries became branches, unpredictable in a
-    // soup). NaN fails the tests below.
-    const double lo_x = std::min(x[0], std::min(x[1], x[2])) - 0.5 - margin;
-    const double hi_x = std::max(x[0], std::max(x[1], x[2])) - 0.5 + margin;
-    const double lo_y = std::min(y[0], std::min(y[1], y[2])) - 0.5 - margin;
-    const double hi_y = std::max(y[0], std::max(y[1], y[2])) - 0.5 + margin;
-    // Comparisons first, so that NaN and far positions never reach a conversion.
-    if (!(hi_x - lo_x < kMaxColumns && hi_y - lo_y < kMaxRows)) return false;
-    if (!(lo_x >= x0 - 2.0 && hi_x <= x1 + 1.0 && lo_y >= y0 - 2.0 && hi_y <= y1 + 1.0))
-      return false;
-    // Pixel px is covered only if its centre px + 0.5 lies in [lo, hi] + 0.5.
-    col_begin = clampInt(ceilInt(lo_x), x0, x1);
-    col_end = clampInt(floorInt(hi_x) + 1, x0, x1);
-    row_begin = clampInt(ceilInt(lo_y), y0, y1);
-    row_end = clampInt(floorInt(hi_y) + 1, y0, y1);
+  bool set(const FixedVertex* v, int bits, int x0, int x1, int y0, int y1) {
+    const std::int64_t lo_x = std::min(v[0].x, std::min(v[1].x, v[2].x));
+    const std::int64_t hi_x = std::max(v[0].x, std::max(v[1].x, v[2].x));
+    const std::int64_t lo_y = std::min(v[0].y, std::min(v[1].y, v[2].y));
+    const std::int64_t hi_y = std::max(v[0].y, std::max(v[1].y, v[2].y));
+    if ((hi_x - lo_x) >> bits >= kMaxColumns || (hi_y - lo_y) >> bits >= kMaxRows) return false;
+    // ceil(n / 2^bits) is -((-n) >> bits) and floor is n >> bits (TriangleCoverage::setup()).
+    col_begin = clamp(-((-lo_x) >> bits), x0, x1);
+    col_end = clamp((hi_x >> bits) + 1, x0, x1);
+    row_begin = clamp(-((-lo_y) >> bits), y0, y1);
+    row_end = clamp((hi_y >> bits) + 1, y0, y1);
     return col_begin < col_end && row_begin < row_end;
   }
 
  private:
-  static int clampInt(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
-  // floor and ceil for v >= -8 (clip rectangles start at >= 0, and set() tests the rest):
-  // truncation of a positive number (std::floor is a library call on x86-64's baseline).
-  static int floorInt(double v) { return static_cast<int>(v + 8.0) - 8; }
-  static int ceilInt(double v) {
-    const int f = floorInt(v);
-    return f + (f < v ? 1 : 0);
+  static int clamp(std::int64_t n, int lo, int hi) {
+    return static_cast<int>(n < lo ? lo : n > hi ? hi : n);
   }
 };
 

@@ -387,9 +387,6 @@ class Renderer {
   // prefetchRows(): the first vertex of the last triangle it saw.
   double prefetch_x_ = -1e9;
   double prefetch_y_ = -1e9;
-  // How far rasterizing moves a vertex: half a subpixel step, and the sample's offset.
-  const double prefetch_margin_ =
-      0.5 / snap_scale_ + std::max(std::fabs(shift_.offset.x), std::fabs(shift_.offset.y));
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
   std::vector<KeptFragment> kept_;     // A-buffer: blended fragments, in draw order
@@ -615,11 +612,11 @@ inline void Renderer::prefetchRows(const PrimitiveRef& prim) {
   if (std::fabs(dx) <= PrefetchBox::kMaxColumns && std::fabs(dy) <= 1.0) return;
   const VertexWindow& b = windows[tri[1]];
   const VertexWindow& c = windows[tri[2]];
-  if (!(a.flags & b.flags & c.flags & VertexWindow::kDrawable)) return;
-  const double x[3] = {a.x, b.x, c.x};
-  const double y[3] = {a.y, b.y, c.y};
+  constexpr unsigned kFastPath = VertexWindow::kInside | VertexWindow::kDrawable;
+  if ((a.flags & b.flags & c.flags & kFastPath) != kFastPath) return;
+  const FixedVertex fixed[3] = {a.fixed, b.fixed, c.fixed};
   PrefetchBox box{};
-  if (!box.set(x, y, prefetch_margin_, clip_.x0, clip_.x1, clip_.y0, clip_.y1)) return;
+  if (!box.set(fixed, options_.subpixel_bits, clip_.x0, clip_.x1, clip_.y0, clip_.y1)) return;
   // Rows are stored top down (fillSpans()): pixel (x, y) at (clip.y1 - 1 - y) * width + x -
   // clip.x0, so each row up is `width` elements back.
   const auto width = static_cast<std::ptrdiff_t>(fb_width_);
