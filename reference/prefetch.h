@@ -10,7 +10,6 @@
 // of the output.
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
@@ -36,12 +35,7 @@ template <class T>
   asm volatile("");
 }
 
-// The pixels a triangle with snapped vertices v[3] (subpixel units, `bits` fractional bits,
-// as TriangleCoverage takes them) can cover: its snapped bounding box's pixel centres,
-// TriangleCoverage::setup()'s box, clipped to [x0, x1) x [y0, y1). set() is false when that
-// is empty or larger than is worth prefetching (a larger triangle walks its rows in
-// sequence, which the hardware prefetcher follows). The vertices must be inside the clip
-// volume (|coordinates| far below 2^61, as drawTriangle()'s fast path has them).
+// Which triangles get their rows prefetched, and how far ahead.
 struct PrefetchBox {
   static constexpr int kAhead = 8;        // triangles: 4 to 16 measured alike, 8 kept
   static constexpr int kMaxRows = 8;      // each row of each plane is its own miss
@@ -50,27 +44,17 @@ struct PrefetchBox {
   // the prefetches only cost instructions (100k 2-px triangles: at 200 x 200, 16.9-20.9 ms
   // without against 19.6-22.6 with; at 512 x 512, 25.2-31.4 without, 19.4-20.6 with).
   static constexpr std::size_t kMinFrameBytes = std::size_t{4} << 20;
-  int col_begin;
-  int col_end;
-  int row_begin;
-  int row_end;
-  bool set(const FixedVertex* v, int bits, int x0, int x1, int y0, int y1) {
-    const std::int64_t lo_x = std::min(v[0].x, std::min(v[1].x, v[2].x));
-    const std::int64_t hi_x = std::max(v[0].x, std::max(v[1].x, v[2].x));
-    const std::int64_t lo_y = std::min(v[0].y, std::min(v[1].y, v[2].y));
-    const std::int64_t hi_y = std::max(v[0].y, std::max(v[1].y, v[2].y));
-    if ((hi_x - lo_x) >> bits >= kMaxColumns || (hi_y - lo_y) >> bits >= kMaxRows) return false;
-    // ceil(n / 2^bits) is -((-n) >> bits) and floor is n >> bits (TriangleCoverage::setup()).
-    col_begin = clamp(-((-lo_x) >> bits), x0, x1);
-    col_end = clamp((hi_x >> bits) + 1, x0, x1);
-    row_begin = clamp(-((-lo_y) >> bits), y0, y1);
-    row_end = clamp((hi_y >> bits) + 1, y0, y1);
-    return col_begin < col_end && row_begin < row_end;
-  }
 
- private:
-  static int clamp(std::int64_t n, int lo, int hi) {
-    return static_cast<int>(n < lo ? lo : n > hi ? hi : n);
+  // The pixels a triangle with snapped vertices v[3] can cover within `clip`
+  // (snappedPixelBox(), TriangleCoverage's box); false when that is empty or larger than is
+  // worth prefetching (a larger triangle walks its rows in sequence, which the hardware
+  // prefetcher follows). The vertices must be inside the clip volume (|coordinates| far
+  // below 2^61, as drawTriangle()'s fast path has them).
+  static bool worthPrefetching(const FixedVertex* v, int bits, const PixelRect& clip,
+                               PixelBox& box) {
+    box = snappedPixelBox(v[0], v[1], v[2], bits, clip);
+    return !box.empty() && box.col_end - box.col_begin <= kMaxColumns &&
+           box.row_end - box.row_begin <= kMaxRows;
   }
 };
 

@@ -56,6 +56,34 @@ inline std::int64_t snappedArea2(const FixedVertex& v0, const FixedVertex& v1,
   return (v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y);
 }
 
+// The pixels whose centres lie inside the snapped bounding box of v0, v1, v2 (subpixel
+// units, `subpixel_bits` fractional bits), within `clip`: [col_begin, col_end) x
+// [row_begin, row_end), empty when either range is. TriangleCoverage's box, and the rows
+// the renderer prefetches (prefetch.h).
+struct PixelBox {
+  int col_begin;
+  int col_end;
+  int row_begin;
+  int row_end;
+  bool empty() const { return !(col_begin < col_end && row_begin < row_end); }
+};
+inline PixelBox snappedPixelBox(const FixedVertex& v0, const FixedVertex& v1, const FixedVertex& v2,
+                                int subpixel_bits, const PixelRect& clip) {
+  // floor(n / 2^bits) is the arithmetic shift n >> bits and ceil is -((-n) >> bits) (C++20
+  // defines >> on negative values as flooring); |n| < 2^61, so -n cannot overflow.
+  const std::int64_t min_x = std::min(v0.x, std::min(v1.x, v2.x));
+  const std::int64_t max_x = std::max(v0.x, std::max(v1.x, v2.x));
+  const std::int64_t min_y = std::min(v0.y, std::min(v1.y, v2.y));
+  const std::int64_t max_y = std::max(v0.y, std::max(v1.y, v2.y));
+  auto clamp = [](std::int64_t n, int lo, int hi) {
+    return static_cast<int>(n < lo ? lo : n > hi ? hi : n);
+  };
+  return PixelBox{clamp(-((-min_x) >> subpixel_bits), clip.x0, clip.x1),
+                  clamp((max_x >> subpixel_bits) + 1, clip.x0, clip.x1),
+                  clamp(-((-min_y) >> subpixel_bits), clip.y0, clip.y1),
+                  clamp((max_y >> subpixel_bits) + 1, clip.y0, clip.y1)};
+}
+
 class TriangleCoverage {
  public:
   // Prepares the edge functions of a triangle with non-zero snapped area (either winding)
@@ -162,21 +190,12 @@ inline bool TriangleCoverage::setup(const FixedVertex& v0, const FixedVertex& v1
     edges_[i].b = B * (std::int64_t{1} << subpixel_bits);
     edges_[i].c = -A * p.x - B * p.y + (includes_ties ? 1 : 0);
   }
-  // Pixel centres inside the snapped bounding box, within the clip rectangle. floor(n /
-  // 2^bits) is the arithmetic shift n >> bits and ceil is -((-n) >> bits) (C++20 defines
-  // >> on negative values as flooring); |n| < 2^61, so -n cannot overflow.
-  const std::int64_t min_x = std::min(v0.x, std::min(v1.x, v2.x));
-  const std::int64_t max_x = std::max(v0.x, std::max(v1.x, v2.x));
-  const std::int64_t min_y = std::min(v0.y, std::min(v1.y, v2.y));
-  const std::int64_t max_y = std::max(v0.y, std::max(v1.y, v2.y));
-  auto clamp = [](std::int64_t n, int lo, int hi) {
-    return static_cast<int>(n < lo ? lo : n > hi ? hi : n);
-  };
-  col_begin_ = clamp(-((-min_x) >> subpixel_bits), clip.x0, clip.x1);
-  col_end_ = clamp((max_x >> subpixel_bits) + 1, clip.x0, clip.x1);
-  row_begin_ = clamp(-((-min_y) >> subpixel_bits), clip.y0, clip.y1);
-  row_end_ = clamp((max_y >> subpixel_bits) + 1, clip.y0, clip.y1);
-  return col_begin_ < col_end_ && row_begin_ < row_end_;
+  const PixelBox box = snappedPixelBox(v0, v1, v2, subpixel_bits, clip);
+  col_begin_ = box.col_begin;
+  col_end_ = box.col_end;
+  row_begin_ = box.row_begin;
+  row_end_ = box.row_end;
+  return !box.empty();
 }
 
 }  // namespace rc::ref

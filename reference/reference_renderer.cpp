@@ -453,12 +453,15 @@ Frame Renderer::run() {
   edges_.clear();
 
   transformVertices();
+  // Prefetch only where the planes the fragments touch can be out of the cache: colour,
+  // depth key and id, and with the channels the tracker's.
+  constexpr std::size_t kPlainBytes = 4 * sizeof(float) + 2 * sizeof(std::uint32_t);
+  const std::size_t frame_bytes =
+      frame_.pixelCount() *
+      (kPlainBytes + (uncertainty_ ? UncertaintyTracker::kPrefetchedBytesPerPixel : 0));
+  const bool prefetch = frame_bytes >= PrefetchBox::kMinFrameBytes;
   for (const DrawPass& pass : drawPasses(scene_, options_.force_painter)) {
     const std::vector<PrimitiveRef>& prims = pass.primitives;
-    // Only where the frame's planes can be out of the cache: colour, depth key and id,
-    // and the tracker's eight planes (stored_z_ double) with the channels.
-    const std::size_t frame_bytes = frame_.pixelCount() * (uncertainty_ ? 24 + 36 : 24);
-    const bool prefetch = frame_bytes >= PrefetchBox::kMinFrameBytes;
     for (std::size_t j = 0; j < prims.size(); ++j) {
       if (prefetch && j + PrefetchBox::kAhead < prims.size())
         prefetchRows(prims[j + PrefetchBox::kAhead]);
@@ -615,8 +618,8 @@ inline void Renderer::prefetchRows(const PrimitiveRef& prim) {
   constexpr unsigned kFastPath = VertexWindow::kInside | VertexWindow::kDrawable;
   if ((a.flags & b.flags & c.flags & kFastPath) != kFastPath) return;
   const FixedVertex fixed[3] = {a.fixed, b.fixed, c.fixed};
-  PrefetchBox box{};
-  if (!box.set(fixed, options_.subpixel_bits, clip_.x0, clip_.x1, clip_.y0, clip_.y1)) return;
+  PixelBox box{};
+  if (!PrefetchBox::worthPrefetching(fixed, options_.subpixel_bits, clip_, box)) return;
   // Rows are stored top down (fillSpans()): pixel (x, y) at (clip.y1 - 1 - y) * width + x -
   // clip.x0, so each row up is `width` elements back.
   const auto width = static_cast<std::ptrdiff_t>(fb_width_);

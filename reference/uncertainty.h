@@ -213,6 +213,8 @@ class UncertaintyTracker {
   // Prefetches pixels [begin, end) of the planes a fragment there will touch: those every
   // fragment touches, and those of the frame-wide groups once they are written
   // (Renderer::prefetchRows()).
+  // What prefetch() always asks for, per pixel: stored_z_ and seven float planes.
+  static constexpr std::size_t kPrefetchedBytesPerPixel = sizeof(double) + 7 * sizeof(float);
   void prefetch(std::size_t begin, std::size_t end) const {
     const auto span = [=](const auto* plane) { prefetchSpan(plane, begin, end); };
     span(stored_z_.data());

@@ -340,8 +340,8 @@ TEST(PrefetchBox, HoldsEveryCoveredPixel) {
       const FixedVertex fixed[3] = {snapVertex(t.v[0].x, t.v[0].y, bits),
                                     snapVertex(t.v[1].x, t.v[1].y, bits),
                                     snapVertex(t.v[2].x, t.v[2].y, bits)};
-      PrefetchBox box{};
-      if (!box.set(fixed, bits, x0, x1, y0, y1)) continue;
+      PixelBox box{};
+      if (!PrefetchBox::worthPrefetching(fixed, bits, PixelRect{x0, y0, x1, y1}, box)) continue;
       ++boxes;
       for (int py = y0; py < y1; ++py) {
         for (int px = x0; px < x1; ++px) {
@@ -358,23 +358,24 @@ TEST(PrefetchBox, HoldsEveryCoveredPixel) {
 }
 
 TEST(PrefetchBox, IsTheSnappedBoxAndRefusesLargeOrOutsideTriangles) {
-  PrefetchBox box{};
+  PixelBox box{};
   const int bits = 4;
+  const PixelRect clip{0, 0, 64, 64};
   const FixedVertex small[3] = {snapVertex(10.2, 20.4, bits), snapVertex(12.2, 20.4, bits),
                                 snapVertex(10.2, 22.4, bits)};
-  ASSERT_TRUE(box.set(small, bits, 0, 64, 0, 64));
+  ASSERT_TRUE(PrefetchBox::worthPrefetching(small, bits, clip, box));
   EXPECT_EQ(box.col_begin, 10);  // centres 10.5 and 11.5
   EXPECT_EQ(box.col_end, 12);
   EXPECT_EQ(box.row_begin, 20);  // centres 20.5 and 21.5
   EXPECT_EQ(box.row_end, 22);
   const FixedVertex wide[3] = {snapVertex(0.0, 0.0, bits), snapVertex(40.0, 0.0, bits),
                                snapVertex(0.0, 2.0, bits)};
-  EXPECT_FALSE(box.set(wide, bits, 0, 64, 0, 64));
+  EXPECT_FALSE(PrefetchBox::worthPrefetching(wide, bits, clip, box));
   const FixedVertex tall[3] = {snapVertex(0.0, 0.0, bits), snapVertex(2.0, 0.0, bits),
                                snapVertex(0.0, 30.0, bits)};
-  EXPECT_FALSE(box.set(tall, bits, 0, 64, 0, 64));
+  EXPECT_FALSE(PrefetchBox::worthPrefetching(tall, bits, clip, box));
   // Outside the clip rectangle altogether: nothing to fetch.
-  EXPECT_FALSE(box.set(small, bits, 30, 64, 0, 64));
+  EXPECT_FALSE(PrefetchBox::worthPrefetching(small, bits, PixelRect{30, 0, 64, 64}, box));
 }
 
 }  // namespace
