@@ -24,4 +24,16 @@ double storedDepth(std::uint32_t key, DepthFormat format) {
   return key / depthStepsPerUnit(format);
 }
 
+void storedDepthPlane(const std::uint32_t* keys, std::size_t count, DepthFormat format,
+                      float* out) {
+  if (format == DepthFormat::D32F) {
+    for (std::size_t i = 0; i < count; ++i) out[i] = std::bit_cast<float>(keys[i]);
+    return;
+  }
+  const double per_step = 1.0 / depthStepsPerUnit(format);
+  // Integer keys are below 2^24: through int32 the conversion vectorizes (cvtdq2pd).
+  for (std::size_t i = 0; i < count; ++i)
+    out[i] = static_cast<float>(static_cast<std::int32_t>(keys[i]) * per_step);
+}
+
 }  // namespace rc::ref

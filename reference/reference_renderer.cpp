@@ -8,11 +8,13 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <type_traits>
 #include <utility>
 
+#include "fixtures/big_buffer.h"
 #include "fixtures/errors.h"
 #include "fixtures/multisample.h"
 #include "fixtures/scene_geometry.h"
@@ -446,8 +448,8 @@ Frame Renderer::run() {
   float clear_rgba[4];
   for (int c = 0; c < 4; ++c) clear_rgba[c] = storeColor(scene_.clear_color[c], color_format_);
   const std::uint32_t clear_key = depthKey(clampDepth(scene_.clear_depth), depth_format_);
-  frame_.allocate(fb_width_, fb_height_, clear_rgba,
-                  static_cast<float>(storedDepth(clear_key, depth_format_)), uncertainty_);
+  // The depth plane is written once, from the keys, when the frame is drawn.
+  frame_.allocate(fb_width_, fb_height_, clear_rgba, std::nullopt, uncertainty_);
   depth_.assign(frame_.pixelCount(), clear_key);
   if (uncertainty_) gaps_.reset(frame_, depth_format_, clampDepth(scene_.clear_depth));
   edges_.clear();
@@ -475,14 +477,13 @@ Frame Renderer::run() {
     gaps_.finish(frame_);
   }
 
-  // Stored depth back to [0, 1] (one simple loop per format, so that it vectorizes).
-  const std::size_t n = frame_.pixelCount();
-  if (depth_format_ == DepthFormat::D32F) {
-    for (std::size_t i = 0; i < n; ++i) frame_.depth[i] = std::bit_cast<float>(depth_[i]);
-  } else {
-    const double steps = depthStepsPerUnit(depth_format_);
-    for (std::size_t i = 0; i < n; ++i) frame_.depth[i] = static_cast<float>(depth_[i] / steps);
-  }
+  // Stored depth back to [0, 1].
+  const std::uint32_t* keys = depth_.data();
+  assignBigChunked(
+      frame_.depth, frame_.pixelCount(),
+      [keys, format = depth_format_](float* out, std::size_t begin, std::size_t count) {
+        storedDepthPlane(keys + begin, count, format, out);
+      });
   if (depth_.capacity() > kMaxKeptScratchPixels) depth_ = {};
   if (gaps_.capacity() > kMaxKeptScratchPixels) gaps_.release();
   if (edges_.capacity() > kMaxKeptScratchPixels) edges_.release();

@@ -2,6 +2,7 @@
 // the EXR's channel names and types as DESIGN.md fixes them, byte-identical files, and
 // all-or-nothing writes (also when a rename fails midway).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -66,6 +67,24 @@ nlohmann::json readJson(const fs::path& file) {
 }
 
 }  // namespace
+
+// The clear values in every plane (a frame that had others first: kept storage must not
+// show through), and no depth plane when the caller writes it (the reference renderer).
+TEST(FrameIo, AllocateWritesTheClearValues) {
+  rc::Frame f = makeFrame(true);
+  const float clear[4] = {0.25f, 0.5f, -0.0f, 1.0f};
+  f.allocate(3, 2, clear, 0.75f, true);
+  ASSERT_EQ(f.color.size(), 24u);
+  for (std::size_t i = 0; i < f.color.size(); ++i)
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(f.color[i]), std::bit_cast<std::uint32_t>(clear[i % 4]));
+  EXPECT_EQ(f.depth, std::vector<float>(6, 0.75f));
+  EXPECT_EQ(f.id, std::vector<std::uint32_t>(6, 0u));
+  EXPECT_EQ(f.edge_dist.size(), 6u);
+  f.allocate(3, 2, clear, std::nullopt, false);
+  EXPECT_TRUE(f.depth.empty());
+  EXPECT_EQ(f.color.size(), 24u);
+  EXPECT_FALSE(f.hasUncertainty());
+}
 
 TEST(FrameIo, RoundTripsEveryChannelExactly) {
   for (bool unc : {false, true}) {

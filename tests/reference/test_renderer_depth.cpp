@@ -83,6 +83,37 @@ TEST(DepthQuantization, KeysOrderLikeStoredValuesAndRoundTrip) {
   EXPECT_EQ(ref::clampDepth(1.5), 1.0);
 }
 
+// The frame's depth plane (storedDepthPlane(): a product by 1 / steps) against the
+// float of storedDepth()'s quotient, for every key of both integer formats, and the bits of
+// some float keys. Fails if the product is taken in float, or with 1 / steps rounded to float.
+TEST(DepthKeys, PlaneIsStoredDepthForEveryKey) {
+  for (DepthFormat fmt : {DepthFormat::D16, DepthFormat::D24}) {
+    const auto last = static_cast<std::uint32_t>(ref::depthStepsPerUnit(fmt));
+    std::vector<std::uint32_t> keys(4096);
+    std::vector<float> plane(keys.size());
+    std::uint64_t wrong = 0;
+    for (std::uint64_t first = 0; first <= last; first += keys.size()) {
+      const std::size_t count = std::min<std::uint64_t>(keys.size(), last - first + 1);
+      for (std::size_t i = 0; i < count; ++i) keys[i] = static_cast<std::uint32_t>(first + i);
+      ref::storedDepthPlane(keys.data(), count, fmt, plane.data());
+      for (std::size_t i = 0; i < count; ++i) {
+        const auto expected = static_cast<float>(ref::storedDepth(keys[i], fmt));
+        if (std::bit_cast<std::uint32_t>(plane[i]) != std::bit_cast<std::uint32_t>(expected) &&
+            ++wrong <= 3)
+          ADD_FAILURE() << toString(fmt) << " key " << keys[i] << ": " << plane[i]
+                        << " != " << expected;
+      }
+    }
+    EXPECT_EQ(wrong, 0u) << toString(fmt);
+    EXPECT_EQ(plane[(last % keys.size())], 1.0f) << toString(fmt);  // the last key is 1
+  }
+  const std::uint32_t floats[] = {0u, std::bit_cast<std::uint32_t>(0.1f),
+                                  std::bit_cast<std::uint32_t>(1.0f), 0x00000001u};
+  float plane[4];
+  ref::storedDepthPlane(floats, 4, DepthFormat::D32F, plane);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(std::bit_cast<std::uint32_t>(plane[i]), floats[i]);
+}
+
 TEST(DepthTest, LessKeepsTheFirstOfEqualDepthsAndTheNearest) {
   Scene s = test::windowScene(8, 8);
   test::addRect(s, 0, 0, 8, 8, 0.5f);   // ids 1, 2
