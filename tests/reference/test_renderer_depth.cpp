@@ -370,7 +370,8 @@ TEST(EdgeDist, DistanceToEdgeSegmentsCappedAtOne) {
 // than the image (the short ones take the bounding-box rows, the long ones the per-row
 // band; in the batch, triangles up to 4 px across take the small-triangle pass, all three
 // edges over one box), in an image whose width is not a multiple of four (rows end inside a group
-// of four lanes), with and without reach, points on the segments and zero-length segments.
+// of four lanes), with and without reach, points on the segments, diagonals through pixel
+// centres and zero-length segments.
 TEST(EdgeDist, EqualsItsDefinitionAtEveryPixelBitForBit) {
   constexpr int kW = 37;
   constexpr int kH = 23;
@@ -409,7 +410,7 @@ TEST(EdgeDist, EqualsItsDefinitionAtEveryPixelBitForBit) {
     std::vector<float> got = want;
     std::vector<float> batched = want;
     ref::EdgeDistanceBatch batch;
-    for (int polygon = 0; polygon < 4; ++polygon) {
+    for (int polygon = 0; polygon < 5; ++polygon) {
       ref::WindowVertex v[3] = {};
       // Sizes from a tenth of a pixel to the whole image.
       const double size = std::pow(10.0, -1.0 + 2.5 * unit(rng));
@@ -424,6 +425,13 @@ TEST(EdgeDist, EqualsItsDefinitionAtEveryPixelBitForBit) {
         v[0].x = std::floor(v[0].x) + 0.5;
         v[0].y = std::floor(v[0].y) + 0.5;
         v[1].y = v[0].y;
+      }
+      if (polygon == 3) {  // a diagonal through centres, q exactly 0 on them (a mesh's grid)
+        v[0].x = std::floor(v[0].x) + 0.5;
+        v[0].y = std::floor(v[0].y) + 0.5;
+        const double m = std::ldexp(1.0, scene % 4);  // 1, 2, 4, 8 px: t = k / m exact
+        v[1].x = v[0].x + (unit(rng) < 0.5 ? m : -m);
+        v[1].y = v[0].y + (unit(rng) < 0.5 ? m : -m);
       }
       double reach[3] = {0.0, 0.0, 0.0};
       if (scene % 2 == 1)
