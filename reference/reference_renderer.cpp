@@ -314,9 +314,10 @@ class Renderer {
                          double& depth_reach) const;
   void vertexReach(const ClipVertex& c, double& reach, double& depth_reach) const;
   WindowSetup windowSetup() const;
-  // Window set-up (and the reaches, with the channels) of vertices [begin, end) of an object.
+  // Window set-up (and the reaches, with the channels) of vertices [begin, end) of an object,
+  // from their records (records[0] is vertex begin's).
   void setUpWindows(std::size_t object, const WindowSetup& setup, std::size_t begin,
-                    std::size_t end);
+                    std::size_t end, const TransformedVertex* records);
   void drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, const WindowVertex* wv,
                     const FixedVertex* fv, const double* reach, const double* depth_reach,
                     int count, bool clipped);
@@ -385,6 +386,7 @@ class Renderer {
   UncertaintyTracker& gaps_;           // scratch
   EdgeDistanceBatch& edges_;           // scratch
   std::vector<std::vector<VertexWindow>>& windows_;  // per object, per vertex, scratch
+  std::vector<TransformedVertex> piece_;             // transformVertices(): one piece's records
   const SampleShift shift_;                          // multisampling: the sample drawn
   // prefetchRows(): the first vertex of the last triangle it saw.
   double prefetch_x_ = -1e9;
@@ -428,13 +430,36 @@ void Renderer::transformVertices() {
     const ObjectTransform transform(obj, camera_, shading != Shading::Flat || trace_ != nullptr,
                                     uncertainty_);
     const PreparedShading& prepared = shading_[obj.material];
+    // Flat, unlit, untextured and not traced, nothing reads a vertex's record after its
+    // window set-up (prepareTriangle() and the fragment loops read the windows) unless one
+    // of its triangles is clipped (drawTriangle() reads the clip coordinates then). So while
+    // every vertex so far is inside the clip volume, each piece's records go to one buffer
+    // that stays in the cache instead of to the object's array: for a soup of small
+    // triangles that array is 128 bytes a vertex of memory written for nothing. At the first
+    // vertex outside, the pieces so far are transformed again into the array (the same
+    // bits) and the rest are written there as before.
+    bool records_unread = shading == Shading::Flat && trace_ == nullptr &&
+                          scene_.materials[obj.material].texture == nullptr &&
+                          prepared.lights.empty();
     // In pieces that stay in the cache from the transform to the window set-up (and
     // Gouraud's lighting): 512 x (128 + 72) bytes.
     constexpr std::size_t kPiece = 512;
+    if (records_unread) piece_.resize(kPiece);
     for (std::size_t begin = 0; begin < n; begin += kPiece) {
       const std::size_t end = std::min(n, begin + kPiece);
+      if (records_unread) {
+        transform.applyInto(begin, end, piece_.data());
+        setUpWindows(o, setup, begin, end, piece_.data());
+        const VertexWindow* w = windows_[o].data();
+        if (std::all_of(w + begin, w + end, [](const VertexWindow& v) {
+              return (v.flags & VertexWindow::kInside) != 0;
+            }))
+          continue;
+        records_unread = false;
+        transform.apply(0, begin, vertices_[o].data());
+      }
       transform.apply(begin, end, vertices_[o].data());
-      setUpWindows(o, setup, begin, end);
+      setUpWindows(o, setup, begin, end, vertices_[o].data() + begin);
       if (shading != Shading::Gouraud) continue;
       // Gouraud lights each original vertex once: AD and S, interpolated per fragment.
       for (std::size_t i = begin; i < end; ++i)
@@ -585,15 +610,15 @@ WindowSetup Renderer::windowSetup() const {
 }
 
 void Renderer::setUpWindows(std::size_t object, const WindowSetup& setup, std::size_t begin,
-                            std::size_t end) {
-  const TransformedVertex* verts = vertices_[object].data();
-  VertexWindow* out = windows_[object].data();
-  setUpVertexWindows(verts + begin, end - begin, setup, out + begin);
+                            std::size_t end, const TransformedVertex* records) {
+  VertexWindow* out = windows_[object].data() + begin;
+  const std::size_t count = end - begin;
+  setUpVertexWindows(records, count, setup, out);
   if (!uncertainty_) return;
-  for (std::size_t i = begin; i < end; ++i) {
+  for (std::size_t i = 0; i < count; ++i) {
     VertexWindow& w = out[i];
     if ((w.flags & VertexWindow::kDrawable) == 0) continue;
-    vertexReach(ClipVertex{verts[i].clip, glm::dvec3(0.0), verts[i].clip_err}, w.reach,
+    vertexReach(ClipVertex{records[i].clip, glm::dvec3(0.0), records[i].clip_err}, w.reach,
                 w.depth_reach);
   }
 }

@@ -95,16 +95,17 @@ ObjectTransform::ObjectTransform(const Object& object, const CameraTransform& ca
   normal_matrix_ = with_normals_ ? normalMatrix(object.model) : glm::dmat3(0.0);
 }
 
-void ObjectTransform::apply(std::size_t begin, std::size_t end, TransformedVertex* out) const {
+void ObjectTransform::applyInto(std::size_t begin, std::size_t end,
+                                TransformedVertex* first) const {
   const Mesh& mesh = object_->mesh;
   // x86-64's baseline or AVX2 (no FMA), whichever the CPU has: the bits are the same either
   // way (lanes.h).
   static const bool kAvx2 = __builtin_cpu_supports("avx2");
   (kAvx2 ? detail::transformPositionsAvx2 : detail::transformPositionsBaseline)(
       object_->model, camera_->view_projection, abs_vp_, mesh.positions.data() + begin, end - begin,
-      out + begin, errors_);
+      first, errors_);
   for (std::size_t i = begin; i < end; ++i) {
-    TransformedVertex& v = out[i];
+    TransformedVertex& v = first[i - begin];
     v.normal = with_normals_ && i < mesh.normals.size()
                    ? worldNormal(normal_matrix_, mesh.normals[i])
                    : glm::dvec3(0.0);

@@ -56,7 +56,11 @@ class ObjectTransform {
   ObjectTransform(const Object& object, const CameraTransform& camera, bool normals = true,
                   bool errors = false);
   // Vertices [begin, end) of the object into out[begin, end).
-  void apply(std::size_t begin, std::size_t end, TransformedVertex* out) const;
+  void apply(std::size_t begin, std::size_t end, TransformedVertex* out) const {
+    applyInto(begin, end, out + begin);
+  }
+  // Vertices [begin, end) of the object into first[0, end - begin) (a buffer for one piece).
+  void applyInto(std::size_t begin, std::size_t end, TransformedVertex* first) const;
 
  private:
   const Object* object_;
