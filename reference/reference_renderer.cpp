@@ -241,6 +241,7 @@ struct Scratch {
   std::vector<std::vector<TransformedVertex>> vertices;  // per object
   std::vector<std::vector<LitColor>> gouraud;            // per object, Gouraud only
   std::vector<std::vector<VertexWindow>> windows;        // per object, per vertex
+  std::vector<TransformedVertex> piece;                  // transformVertices(): one piece's records
 };
 thread_local Scratch t_scratch;
 constexpr std::size_t kMaxKeptScratchPixels = std::size_t{1} << 22;
@@ -287,6 +288,7 @@ class Renderer {
         gaps_(t_scratch.gaps),
         edges_(t_scratch.edges),
         windows_(t_scratch.windows),
+        piece_(t_scratch.piece),
         shift_(shift) {
     shading_.reserve(scene.materials.size());
     for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
@@ -386,7 +388,7 @@ class Renderer {
   UncertaintyTracker& gaps_;           // scratch
   EdgeDistanceBatch& edges_;           // scratch
   std::vector<std::vector<VertexWindow>>& windows_;  // per object, per vertex, scratch
-  std::vector<TransformedVertex> piece_;             // transformVertices(): one piece's records
+  std::vector<TransformedVertex>& piece_;            // transformVertices(), scratch
   const SampleShift shift_;                          // multisampling: the sample drawn
   // prefetchRows(): the first vertex of the last triangle it saw.
   double prefetch_x_ = -1e9;
@@ -455,8 +457,11 @@ void Renderer::transformVertices() {
               return (v.flags & VertexWindow::kInside) != 0;
             }))
           continue;
+        // This piece's windows are set; its records and the earlier pieces' now go to the
+        // array too, and the later pieces' straight there. (Flat: no lighting below.)
         records_unread = false;
-        transform.apply(0, begin, vertices_[o].data());
+        transform.apply(0, end, vertices_[o].data());
+        continue;
       }
       transform.apply(begin, end, vertices_[o].data());
       setUpWindows(o, setup, begin, end, vertices_[o].data() + begin);
