@@ -9,6 +9,10 @@
 #include "reference/fragment_ops.h"
 #include "reference/lanes.h"
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace rc::ref {
 
 double polygonArea2(const WindowVertex* polygon, int count) {
@@ -367,6 +371,177 @@ __attribute__((target_clones("avx2", "default"))) void addSmallTriangle(
   }
 }
 
+#if defined(__x86_64__)
+// The small-triangle pass eight centres at a time, on processors with AVX-512 (F, DQ, VL:
+// compares into masks and back): two rows of four. The narrow pass above gives each row's
+// four centres a vector of their own, and a triangle of 2 px with its band of 1 px spans
+// four or five rows of four or five centres, so most groups are one per row; here a group
+// takes two rows and the triangle's groups, divisions and square roots are about halved.
+// In each lane the operations of SegmentLanes::lower4() on the same operands (the
+// projection's row part, (cy - a.y) * dy, per half), so each pixel ends with the bits the
+// narrow pass and lowerRow() give (EdgeDist tests compare both passes with the definition).
+using Lane8w = double __attribute__((vector_size(64)));
+using Mask8w = std::int64_t __attribute__((vector_size(64)));
+using Float8 = float __attribute__((vector_size(32)));
+using Float8Mask = std::int32_t __attribute__((vector_size(32)));
+using Float4w = float __attribute__((vector_size(16)));
+
+#define RC_WIDE_TARGET __attribute__((target("avx512f,avx512dq,avx512vl")))
+
+RC_WIDE_TARGET [[gnu::always_inline]] inline Lane8w splat8(double v) {
+  return Lane8w{v, v, v, v, v, v, v, v};
+}
+RC_WIDE_TARGET [[gnu::always_inline]] inline Lane8w halves8(double lo, double hi) {
+  return Lane8w{lo, lo, lo, lo, hi, hi, hi, hi};
+}
+
+class SegmentLanes8 {
+ public:
+  RC_WIDE_TARGET SegmentLanes8(const Point& a, const Point& b, double reach)
+      : ay_(a.y),
+        dy_(b.y - a.y),
+        reach_(reach),
+        vdx_(splat8(b.x - a.x)),
+        vdy_(splat8(b.y - a.y)),
+        ax_(splat8(a.x)),
+        ay8_(splat8(a.y)),
+        vreach_(splat8(reach)) {
+    const double dx = b.x - a.x;
+    vlen2_ = splat8(dx * dx + dy_ * dy_);
+  }
+  // (cy - a.y) * dy of the two rows, each in its half.
+  RC_WIDE_TARGET [[gnu::always_inline]] Lane8w alongY(double cy0, double cy1) const {
+    return halves8((cy0 - ay_) * dy_, (cy1 - ay_) * dy_);
+  }
+  // lower4() of eight centres (cx, vcy) whose values are cur_f; lanes outside in_range
+  // returned unchanged.
+  RC_WIDE_TARGET [[gnu::always_inline]] Float8 lower8(Float8 cur_f, Lane8w cx, Lane8w vcy,
+                                                      Lane8w along_y, Mask8w in_range) const {
+    const Lane8w num = (cx - ax_) * vdx_ + along_y;
+    const Lane8w t = num >= vlen2_ ? splat8(1.0) : num <= splat8(0.0) ? splat8(0.0) : num / vlen2_;
+    const Lane8w qx = cx - (ax_ + t * vdx_);
+    const Lane8w qy = vcy - (ay8_ + t * vdy_);
+    const Lane8w cur = __builtin_convertvector(cur_f, Lane8w);
+    const Lane8w limit = cur + vreach_;
+    const Lane8w sum = qx * qx + qy * qy;
+    const Mask8w open = in_range & ~(sum >= limit * limit * splat8(1.0 + 0x1p-40));
+    if (!anyLane(open)) return cur_f;
+    const Mask8w interval = (sum >= splat8(0x1p-1000)) & (sum < splat8(kInfinity));
+    const Lane8w root =
+        reinterpret_cast<Lane8w>(_mm512_maskz_sqrt_pd(0xFF, reinterpret_cast<__m512d>(sum)));
+    const Lane8w lo = root * splat8(1.0 - 0x1p-48) - vreach_;
+    const Lane8w hi = root * splat8(1.0 + 0x1p-48) - vreach_;
+    const Mask8w lowers = lo < cur;
+    const Float8 stored = __builtin_convertvector(lo < splat8(0.0) ? splat8(0.0) : lo, Float8);
+    const Float8 stored_hi = __builtin_convertvector(hi < splat8(0.0) ? splat8(0.0) : hi, Float8);
+    const Mask8w same = __builtin_convertvector(stored == stored_hi, Mask8w);
+    const Mask8w decided = open & interval & lowers & (hi < cur) & same;
+    const Mask8w slow = open & ~(interval & (~lowers | decided));
+    const auto decided_f = __builtin_convertvector(decided, Float8Mask);
+    Float8 out = decided_f ? stored : cur_f;
+    if (!anyLane(slow)) return out;
+    for (int k = 0; k < 8; ++k) {
+      if (!slow[k]) continue;
+      const double d = std::hypot(qx[k], qy[k]) - reach_;
+      if (d < cur[k]) out[k] = static_cast<float>(std::max(d, 0.0));
+    }
+    return out;
+  }
+
+ private:
+  RC_WIDE_TARGET [[gnu::always_inline]] static bool anyLane(Mask8w m) {
+    return _mm512_test_epi64_mask(reinterpret_cast<__m512i>(m), reinterpret_cast<__m512i>(m)) != 0;
+  }
+  double ay_;
+  double dy_;
+  double reach_;
+  Lane8w vdx_;
+  Lane8w vdy_;
+  Lane8w ax_;
+  Lane8w ay8_;
+  Lane8w vreach_;
+  Lane8w vlen2_;
+};
+
+// addSmallTriangle() with SegmentLanes8: the same box, two rows per group.
+RC_WIDE_TARGET void addSmallTriangleWide(const Point& a, const Point& b, const Point& c,
+                                         const double* reach, const PixelRect& clip, int width,
+                                         int height, float* edge_dist) {
+  const double band = 1.0 + std::max({reach[0], reach[1], reach[2]});
+  int row_first = 0;
+  int row_end = 0;
+  int col_first = 0;
+  int col_end = 0;
+  if (!centreRange(std::min({a.y, b.y, c.y}) - band, std::max({a.y, b.y, c.y}) + band, clip.y0,
+                   clip.y1, row_first, row_end) ||
+      !centreRange(std::min({a.x, b.x, c.x}) - band, std::max({a.x, b.x, c.x}) + band, clip.x0,
+                   clip.x1, col_first, col_end))
+    return;
+  const SegmentLanes8 ab(a, b, reach[0]);
+  const SegmentLanes8 bc(b, c, reach[1]);
+  const SegmentLanes8 ca(c, a, reach[2]);
+  const Mask8w lane = {0, 1, 2, 3, 0, 1, 2, 3};
+  const Mask8w upper = {0, 0, 0, 0, -1, -1, -1, -1};
+  for (int py = row_first; py < row_end; py += 2) {
+    const bool two = py + 1 < row_end;  // else the upper half is out of range
+    const double cy0 = py + 0.5;
+    const double cy1 = py + 1.5;
+    // Rows are stored top down: row py + 1 is `width` floats before row py.
+    float* row0 = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
+    float* row1 = two ? row0 - width : row0;
+    const Lane8w vcy = halves8(cy0, cy1);
+    const Lane8w along_ab = ab.alongY(cy0, cy1);
+    const Lane8w along_bc = bc.alongY(cy0, cy1);
+    const Lane8w along_ca = ca.alongY(cy0, cy1);
+    const Mask8w rows = two ? ~Mask8w{} : ~upper;
+    for (int px = col_first; px < col_end; px += 4) {
+      const int n = std::min(4, col_end - px);
+      const bool whole = px + 4 <= width;
+      Float4w lo = {1.0f, 1.0f, 1.0f, 1.0f};
+      Float4w hi = lo;
+      if (whole) {
+        __builtin_memcpy(&lo, row0 + px, sizeof lo);
+        if (two) __builtin_memcpy(&hi, row1 + px, sizeof hi);
+      } else {
+        for (int k = 0; k < n; ++k) {
+          lo[k] = row0[px + k];
+          if (two) hi[k] = row1[px + k];
+        }
+      }
+      Float8 cur = __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+      const double c0 = px + 0.5;
+      const Lane8w cx = {c0, c0 + 1.0, c0 + 2.0, c0 + 3.0, c0, c0 + 1.0, c0 + 2.0, c0 + 3.0};
+      const Mask8w in_range = rows & (lane < Mask8w{n, n, n, n, n, n, n, n});
+      cur = ab.lower8(cur, cx, vcy, along_ab, in_range);
+      cur = bc.lower8(cur, cx, vcy, along_bc, in_range);
+      cur = ca.lower8(cur, cx, vcy, along_ca, in_range);
+      lo = __builtin_shufflevector(cur, cur, 0, 1, 2, 3);
+      hi = __builtin_shufflevector(cur, cur, 4, 5, 6, 7);
+      if (whole) {
+        __builtin_memcpy(row0 + px, &lo, sizeof lo);
+        if (two) __builtin_memcpy(row1 + px, &hi, sizeof hi);
+      } else {
+        for (int k = 0; k < n; ++k) {
+          row0[px + k] = lo[k];
+          if (two) row1[px + k] = hi[k];
+        }
+      }
+    }
+  }
+}
+#undef RC_WIDE_TARGET
+
+bool wideLanesSupported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+         __builtin_cpu_supports("avx512vl");
+}
+#else
+bool wideLanesSupported() { return false; }
+// Not called (wideLanesSupported() is false): the narrow pass under the wide pass's name.
+constexpr auto addSmallTriangleWide = addSmallTriangle;
+#endif
+
 }  // namespace
 
 void addEdgeDistances(const WindowVertex* polygon, int count, const PixelRect& clip, int width,
@@ -416,6 +591,11 @@ void EdgeDistanceBatch::add(const WindowVertex* polygon, int count, const double
   }
 }
 
+bool EdgeDistanceBatch::wideLanesAvailable() {
+  static const bool supported = wideLanesSupported();
+  return supported;
+}
+
 void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, float* edge_dist) {
   // Counting sort by key (keys in [0, 65536]).
   int max_key = 0;
@@ -436,9 +616,11 @@ void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, floa
   sorted_triangles_.resize(triangles_.size());
   for (const SmallTriangle& t : triangles_)
     sorted_triangles_[starts_[static_cast<std::size_t>(t.key)]++] = t;
+  auto* const add_triangle =
+      wide_lanes_ && wideLanesAvailable() ? addSmallTriangleWide : addSmallTriangle;
   for (const SmallTriangle& t : sorted_triangles_)
-    addSmallTriangle(Point{t.x[0], t.y[0]}, Point{t.x[1], t.y[1]}, Point{t.x[2], t.y[2]}, t.reach,
-                     clip, width, height, edge_dist);
+    add_triangle(Point{t.x[0], t.y[0]}, Point{t.x[1], t.y[1]}, Point{t.x[2], t.y[2]}, t.reach, clip,
+                 width, height, edge_dist);
   clear();
 }
 

@@ -395,7 +395,15 @@ class EdgeDistanceBatch {
   // addEdgeDistances() of every added polygon into edge_dist, then clear().
   void apply(const PixelRect& clip, int width, int height, float* edge_dist);
   std::size_t capacity() const { return segments_.capacity() + triangles_.capacity(); }
-  void release() { *this = {}; }
+  void release() {
+    const bool wide = wide_lanes_;
+    *this = {};
+    wide_lanes_ = wide;
+  }
+  // Whether this processor runs the small-triangle pass eight centres at a time (AVX-512);
+  // allowWideLanes(false) keeps this batch to four (the same bits: tests run both).
+  static bool wideLanesAvailable();
+  void allowWideLanes(bool allowed) { wide_lanes_ = allowed; }
 
  private:
   // One boundary segment with its reach (the larger of its end points'), kept whole so
@@ -421,6 +429,7 @@ class EdgeDistanceBatch {
   std::vector<SmallTriangle> triangles_;
   std::vector<SmallTriangle> sorted_triangles_;
   std::vector<std::uint32_t> starts_;
+  bool wide_lanes_ = true;
 };
 
 }  // namespace rc::ref

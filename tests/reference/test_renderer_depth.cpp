@@ -409,7 +409,10 @@ TEST(EdgeDist, EqualsItsDefinitionAtEveryPixelBitForBit) {
     std::vector<float> want(static_cast<std::size_t>(kW) * kH, 1.0f);
     std::vector<float> got = want;
     std::vector<float> batched = want;
+    std::vector<float> narrow = want;  // four centres at a time wherever AVX-512 is
     ref::EdgeDistanceBatch batch;
+    ref::EdgeDistanceBatch narrow_batch;
+    narrow_batch.allowWideLanes(false);
     for (int polygon = 0; polygon < 5; ++polygon) {
       ref::WindowVertex v[3] = {};
       // Sizes from a tenth of a pixel to the whole image.
@@ -439,18 +442,24 @@ TEST(EdgeDist, EqualsItsDefinitionAtEveryPixelBitForBit) {
       oracle(want, v, 3, reach);
       ref::addEdgeDistances(v, 3, clip, kW, kH, got.data(), reach);
       batch.add(v, 3, reach);
+      narrow_batch.add(v, 3, reach);
     }
     batch.apply(clip, kW, kH, batched.data());
+    narrow_batch.apply(clip, kW, kH, narrow.data());
     for (std::size_t i = 0; i < want.size(); ++i) {
       ASSERT_EQ(std::bit_cast<std::uint32_t>(got[i]), std::bit_cast<std::uint32_t>(want[i]))
           << "scene " << scene << " pixel " << i % kW << "," << i / kW << ": " << got[i] << " want "
           << want[i];
       ASSERT_EQ(std::bit_cast<std::uint32_t>(batched[i]), std::bit_cast<std::uint32_t>(want[i]))
           << "batched, scene " << scene << " pixel " << i;
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(narrow[i]), std::bit_cast<std::uint32_t>(want[i]))
+          << "batched four at a time, scene " << scene << " pixel " << i;
       lowered += want[i] < 1.0f;
     }
   }
   EXPECT_GT(lowered, 5000);  // the segments came near many centres
+  if (!ref::EdgeDistanceBatch::wideLanesAvailable())
+    std::cout << "[ NOTE ] no AVX-512 here: the batch ran four centres at a time both ways\n";
 }
 
 // A triangle cut by the near plane becomes a quadrilateral drawn as a fan; edge_dist
