@@ -387,11 +387,10 @@ using Float8Mask = std::int32_t __attribute__((vector_size(32)));
 using Float4w = float __attribute__((vector_size(16)));
 
 #define RC_WIDE_TARGET __attribute__((target("avx512f,avx512dq,avx512vl")))
+#define RC_WIDE_INLINE __attribute__((always_inline, target("avx512f,avx512dq,avx512vl")))
 
-RC_WIDE_TARGET [[gnu::always_inline]] inline Lane8w splat8(double v) {
-  return Lane8w{v, v, v, v, v, v, v, v};
-}
-RC_WIDE_TARGET [[gnu::always_inline]] inline Lane8w halves8(double lo, double hi) {
+RC_WIDE_INLINE inline Lane8w splat8(double v) { return Lane8w{v, v, v, v, v, v, v, v}; }
+RC_WIDE_INLINE inline Lane8w halves8(double lo, double hi) {
   return Lane8w{lo, lo, lo, lo, hi, hi, hi, hi};
 }
 
@@ -410,13 +409,13 @@ class SegmentLanes8 {
     vlen2_ = splat8(dx * dx + dy_ * dy_);
   }
   // (cy - a.y) * dy of the two rows, each in its half.
-  RC_WIDE_TARGET [[gnu::always_inline]] Lane8w alongY(double cy0, double cy1) const {
+  RC_WIDE_INLINE Lane8w alongY(double cy0, double cy1) const {
     return halves8((cy0 - ay_) * dy_, (cy1 - ay_) * dy_);
   }
   // lower4() of eight centres (cx, vcy) whose values are cur_f; lanes outside in_range
   // returned unchanged.
-  RC_WIDE_TARGET [[gnu::always_inline]] Float8 lower8(Float8 cur_f, Lane8w cx, Lane8w vcy,
-                                                      Lane8w along_y, Mask8w in_range) const {
+  RC_WIDE_INLINE Float8 lower8(Float8 cur_f, Lane8w cx, Lane8w vcy, Lane8w along_y,
+                               Mask8w in_range) const {
     const Lane8w num = (cx - ax_) * vdx_ + along_y;
     const Lane8w t = num >= vlen2_ ? splat8(1.0) : num <= splat8(0.0) ? splat8(0.0) : num / vlen2_;
     const Lane8w qx = cx - (ax_ + t * vdx_);
@@ -449,7 +448,7 @@ class SegmentLanes8 {
   }
 
  private:
-  RC_WIDE_TARGET [[gnu::always_inline]] static bool anyLane(Mask8w m) {
+  RC_WIDE_INLINE static bool anyLane(Mask8w m) {
     return _mm512_test_epi64_mask(reinterpret_cast<__m512i>(m), reinterpret_cast<__m512i>(m)) != 0;
   }
   double ay_;
@@ -530,6 +529,7 @@ RC_WIDE_TARGET void addSmallTriangleWide(const Point& a, const Point& b, const P
   }
 }
 #undef RC_WIDE_TARGET
+#undef RC_WIDE_INLINE
 
 bool wideLanesSupported() {
   __builtin_cpu_init();
