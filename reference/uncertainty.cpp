@@ -322,6 +322,20 @@ __attribute__((target_clones("avx2", "default"))) void addSegment(const Point& a
 constexpr double kSmallTrianglePx = 4.0;
 constexpr double kSmallTriangleReachPx = 1.0;
 
+// The centres a small triangle's pass visits: its bounding box widened by the band of its
+// widest-reaching edge, within clip ([row_first, row_end) x [col_first, col_end)); false
+// when empty.
+[[gnu::always_inline]] inline bool smallTriangleBox(const Point& a, const Point& b, const Point& c,
+                                                    const double* reach, const PixelRect& clip,
+                                                    int& row_first, int& row_end, int& col_first,
+                                                    int& col_end) {
+  const double band = 1.0 + std::max({reach[0], reach[1], reach[2]});
+  return centreRange(std::min({a.y, b.y, c.y}) - band, std::max({a.y, b.y, c.y}) + band, clip.y0,
+                     clip.y1, row_first, row_end) &&
+         centreRange(std::min({a.x, b.x, c.x}) - band, std::max({a.x, b.x, c.x}) + band, clip.x0,
+                     clip.x1, col_first, col_end);
+}
+
 // The three edges of a small triangle (a -> b -> c -> a, each with its reach) lowered over
 // the triangle's bounding box widened by the band: a superset of each edge's own visits
 // (addSegment()), and visiting more centres changes nothing (lowerRow()), so each pixel
@@ -330,16 +344,11 @@ constexpr double kSmallTriangleReachPx = 1.0;
 __attribute__((target_clones("avx2", "default"))) void addSmallTriangle(
     const Point& a, const Point& b, const Point& c, const double* reach, const PixelRect& clip,
     int width, int height, float* edge_dist) {
-  const double band = 1.0 + std::max({reach[0], reach[1], reach[2]});
   int row_first = 0;
   int row_end = 0;
   int col_first = 0;
   int col_end = 0;
-  if (!centreRange(std::min({a.y, b.y, c.y}) - band, std::max({a.y, b.y, c.y}) + band, clip.y0,
-                   clip.y1, row_first, row_end) ||
-      !centreRange(std::min({a.x, b.x, c.x}) - band, std::max({a.x, b.x, c.x}) + band, clip.x0,
-                   clip.x1, col_first, col_end))
-    return;
+  if (!smallTriangleBox(a, b, c, reach, clip, row_first, row_end, col_first, col_end)) return;
   const SegmentLanes ab(a, b, reach[0]);
   const SegmentLanes bc(b, c, reach[1]);
   const SegmentLanes ca(c, a, reach[2]);
@@ -466,16 +475,11 @@ class SegmentLanes8 {
 RC_WIDE_TARGET void addSmallTriangleWide(const Point& a, const Point& b, const Point& c,
                                          const double* reach, const PixelRect& clip, int width,
                                          int height, float* edge_dist) {
-  const double band = 1.0 + std::max({reach[0], reach[1], reach[2]});
   int row_first = 0;
   int row_end = 0;
   int col_first = 0;
   int col_end = 0;
-  if (!centreRange(std::min({a.y, b.y, c.y}) - band, std::max({a.y, b.y, c.y}) + band, clip.y0,
-                   clip.y1, row_first, row_end) ||
-      !centreRange(std::min({a.x, b.x, c.x}) - band, std::max({a.x, b.x, c.x}) + band, clip.x0,
-                   clip.x1, col_first, col_end))
-    return;
+  if (!smallTriangleBox(a, b, c, reach, clip, row_first, row_end, col_first, col_end)) return;
   const SegmentLanes8 ab(a, b, reach[0]);
   const SegmentLanes8 bc(b, c, reach[1]);
   const SegmentLanes8 ca(c, a, reach[2]);
