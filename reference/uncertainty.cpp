@@ -9,9 +9,7 @@
 #include "reference/fragment_ops.h"
 #include "reference/lanes.h"
 
-#if defined(__x86_64__)
 #include <immintrin.h>
-#endif
 
 namespace rc::ref {
 
@@ -323,17 +321,18 @@ constexpr double kSmallTrianglePx = 4.0;
 constexpr double kSmallTriangleReachPx = 1.0;
 
 // The centres a small triangle's pass visits: its bounding box widened by the band of its
-// widest-reaching edge, within clip ([row_first, row_end) x [col_first, col_end)); false
-// when empty.
-[[gnu::always_inline]] inline bool smallTriangleBox(const Point& a, const Point& b, const Point& c,
-                                                    const double* reach, const PixelRect& clip,
-                                                    int& row_first, int& row_end, int& col_first,
-                                                    int& col_end) {
+// widest-reaching edge, within clip (empty() when there are none).
+[[gnu::always_inline]] inline PixelBox smallTriangleBox(const Point& a, const Point& b,
+                                                        const Point& c, const double* reach,
+                                                        const PixelRect& clip) {
   const double band = 1.0 + std::max({reach[0], reach[1], reach[2]});
-  return centreRange(std::min({a.y, b.y, c.y}) - band, std::max({a.y, b.y, c.y}) + band, clip.y0,
-                     clip.y1, row_first, row_end) &&
-         centreRange(std::min({a.x, b.x, c.x}) - band, std::max({a.x, b.x, c.x}) + band, clip.x0,
-                     clip.x1, col_first, col_end);
+  PixelBox box{0, 0, 0, 0};
+  if (!centreRange(std::min({a.y, b.y, c.y}) - band, std::max({a.y, b.y, c.y}) + band, clip.y0,
+                   clip.y1, box.row_begin, box.row_end) ||
+      !centreRange(std::min({a.x, b.x, c.x}) - band, std::max({a.x, b.x, c.x}) + band, clip.x0,
+                   clip.x1, box.col_begin, box.col_end))
+    return PixelBox{0, 0, 0, 0};
+  return box;
 }
 
 // The three edges of a small triangle (a -> b -> c -> a, each with its reach) lowered over
@@ -344,23 +343,20 @@ constexpr double kSmallTriangleReachPx = 1.0;
 __attribute__((target_clones("avx2", "default"))) void addSmallTriangle(
     const Point& a, const Point& b, const Point& c, const double* reach, const PixelRect& clip,
     int width, int height, float* edge_dist) {
-  int row_first = 0;
-  int row_end = 0;
-  int col_first = 0;
-  int col_end = 0;
-  if (!smallTriangleBox(a, b, c, reach, clip, row_first, row_end, col_first, col_end)) return;
+  const PixelBox box = smallTriangleBox(a, b, c, reach, clip);
+  if (box.empty()) return;
   const SegmentLanes ab(a, b, reach[0]);
   const SegmentLanes bc(b, c, reach[1]);
   const SegmentLanes ca(c, a, reach[2]);
-  for (int py = row_first; py < row_end; ++py) {
+  for (int py = box.row_begin; py < box.row_end; ++py) {
     const double cy = py + 0.5;
     float* row = edge_dist + static_cast<std::size_t>(height - 1 - py) * width;
     const Lane4 vcy = splat4(cy);
     const Lane4 along_ab = ab.alongY(cy);
     const Lane4 along_bc = bc.alongY(cy);
     const Lane4 along_ca = ca.alongY(cy);
-    for (int px = col_first; px < col_end; px += 4) {
-      const int n = std::min(4, col_end - px);
+    for (int px = box.col_begin; px < box.col_end; px += 4) {
+      const int n = std::min(4, box.col_end - px);
       const bool whole = px + 4 <= width;  // four floats of the row to load and store
       SegmentLanes::Float4 cur = {1.0f, 1.0f, 1.0f, 1.0f};
       if (whole) {
@@ -380,7 +376,6 @@ __attribute__((target_clones("avx2", "default"))) void addSmallTriangle(
   }
 }
 
-#if defined(__x86_64__)
 // The small-triangle pass eight centres at a time, on processors with AVX-512 (F, DQ, VL:
 // compares into masks and back): two rows of four. The narrow pass above gives each row's
 // four centres a vector of their own, and a triangle of 2 px with its band of 1 px spans
@@ -402,6 +397,8 @@ RC_WIDE_INLINE inline Lane8w splat8(double v) { return Lane8w{v, v, v, v, v, v, 
 RC_WIDE_INLINE inline Lane8w halves8(double lo, double hi) {
   return Lane8w{lo, lo, lo, lo, hi, hi, hi, hi};
 }
+// maxWithZero4() in eight lanes.
+RC_WIDE_INLINE inline Lane8w maxWithZero8(Lane8w x) { return x < splat8(0.0) ? splat8(0.0) : x; }
 
 class SegmentLanes8 {
  public:
@@ -410,13 +407,11 @@ class SegmentLanes8 {
         dy_(b.y - a.y),
         reach_(reach),
         vdx_(splat8(b.x - a.x)),
-        vdy_(splat8(b.y - a.y)),
+        vdy_(splat8(dy_)),
+        vlen2_(splat8((b.x - a.x) * (b.x - a.x) + dy_ * dy_)),  // SegmentLanes' len2_
         ax_(splat8(a.x)),
         ay8_(splat8(a.y)),
-        vreach_(splat8(reach)) {
-    const double dx = b.x - a.x;
-    vlen2_ = splat8(dx * dx + dy_ * dy_);
-  }
+        vreach_(splat8(reach)) {}
   // (cy - a.y) * dy of the two rows, each in its half.
   RC_WIDE_INLINE Lane8w alongY(double cy0, double cy1) const {
     return halves8((cy0 - ay_) * dy_, (cy1 - ay_) * dy_);
@@ -440,8 +435,8 @@ class SegmentLanes8 {
     const Lane8w lo = root * splat8(1.0 - 0x1p-48) - vreach_;
     const Lane8w hi = root * splat8(1.0 + 0x1p-48) - vreach_;
     const Mask8w lowers = lo < cur;
-    const Float8 stored = __builtin_convertvector(lo < splat8(0.0) ? splat8(0.0) : lo, Float8);
-    const Float8 stored_hi = __builtin_convertvector(hi < splat8(0.0) ? splat8(0.0) : hi, Float8);
+    const Float8 stored = __builtin_convertvector(maxWithZero8(lo), Float8);
+    const Float8 stored_hi = __builtin_convertvector(maxWithZero8(hi), Float8);
     const Mask8w same = __builtin_convertvector(stored == stored_hi, Mask8w);
     const Mask8w decided = open & interval & lowers & (hi < cur) & same;
     const Mask8w slow = open & ~(interval & (~lowers | decided));
@@ -465,28 +460,25 @@ class SegmentLanes8 {
   double reach_;
   Lane8w vdx_;
   Lane8w vdy_;
+  Lane8w vlen2_;
   Lane8w ax_;
   Lane8w ay8_;
   Lane8w vreach_;
-  Lane8w vlen2_;
 };
 
 // addSmallTriangle() with SegmentLanes8: the same box, two rows per group.
 RC_WIDE_TARGET void addSmallTriangleWide(const Point& a, const Point& b, const Point& c,
                                          const double* reach, const PixelRect& clip, int width,
                                          int height, float* edge_dist) {
-  int row_first = 0;
-  int row_end = 0;
-  int col_first = 0;
-  int col_end = 0;
-  if (!smallTriangleBox(a, b, c, reach, clip, row_first, row_end, col_first, col_end)) return;
+  const PixelBox box = smallTriangleBox(a, b, c, reach, clip);
+  if (box.empty()) return;
   const SegmentLanes8 ab(a, b, reach[0]);
   const SegmentLanes8 bc(b, c, reach[1]);
   const SegmentLanes8 ca(c, a, reach[2]);
   const Mask8w lane = {0, 1, 2, 3, 0, 1, 2, 3};
   const Mask8w upper = {0, 0, 0, 0, -1, -1, -1, -1};
-  for (int py = row_first; py < row_end; py += 2) {
-    const bool two = py + 1 < row_end;  // else the upper half is out of range
+  for (int py = box.row_begin; py < box.row_end; py += 2) {
+    const bool two = py + 1 < box.row_end;  // else the upper half is out of range
     const double cy0 = py + 0.5;
     const double cy1 = py + 1.5;
     // Rows are stored top down: row py + 1 is `width` floats before row py.
@@ -497,8 +489,8 @@ RC_WIDE_TARGET void addSmallTriangleWide(const Point& a, const Point& b, const P
     const Lane8w along_bc = bc.alongY(cy0, cy1);
     const Lane8w along_ca = ca.alongY(cy0, cy1);
     const Mask8w rows = two ? ~Mask8w{} : ~upper;
-    for (int px = col_first; px < col_end; px += 4) {
-      const int n = std::min(4, col_end - px);
+    for (int px = box.col_begin; px < box.col_end; px += 4) {
+      const int n = std::min(4, box.col_end - px);
       const bool whole = px + 4 <= width;
       Float4w lo = {1.0f, 1.0f, 1.0f, 1.0f};
       Float4w hi = lo;
@@ -534,17 +526,6 @@ RC_WIDE_TARGET void addSmallTriangleWide(const Point& a, const Point& b, const P
 }
 #undef RC_WIDE_TARGET
 #undef RC_WIDE_INLINE
-
-bool wideLanesSupported() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-         __builtin_cpu_supports("avx512vl");
-}
-#else
-bool wideLanesSupported() { return false; }
-// Not called (wideLanesSupported() is false): the narrow pass under the wide pass's name.
-constexpr auto addSmallTriangleWide = addSmallTriangle;
-#endif
 
 }  // namespace
 
@@ -596,8 +577,10 @@ void EdgeDistanceBatch::add(const WindowVertex* polygon, int count, const double
 }
 
 bool EdgeDistanceBatch::wideLanesAvailable() {
-  static const bool supported = wideLanesSupported();
-  return supported;
+  static const bool kWide = __builtin_cpu_supports("avx512f") &&
+                            __builtin_cpu_supports("avx512dq") &&
+                            __builtin_cpu_supports("avx512vl");
+  return kWide;
 }
 
 void EdgeDistanceBatch::apply(const PixelRect& clip, int width, int height, float* edge_dist) {
