@@ -43,6 +43,11 @@ struct ReferenceOptions {
   // the pixel's id is its nearest blended fragment. Opaque passes are unchanged. Multisampled,
   // each sample keeps its own lists.
   bool abuffer = false;
+  // Every fragment through the fragment loop's scalar definition (fragmentColor() and
+  // writeColor() in reference/fragment_loop.cpp) instead of its specialised forms (one stored
+  // colour per flat triangle, Gouraud written out, Phong eight fragments at a time in vector
+  // lanes). The same bits, slower: tests render both ways and compare (FragmentLoop.*).
+  bool fragment_definition_only = false;
 };
 
 // Renders the scene. Throws InputError for options out of range (subpixel_bits outside

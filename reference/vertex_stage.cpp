@@ -14,6 +14,18 @@ CameraTransform cameraTransform(const Scene& scene) {
   return t;
 }
 
+TransformedVertex transformPositionDefinition(const glm::dmat4& model,
+                                              const glm::dmat4& view_projection,
+                                              const glm::dmat4& abs_vp, const glm::vec3& position,
+                                              bool errors) {
+  TransformedVertex v;
+  v.world = worldPosition(model, position);
+  v.clip = view_projection * glm::dvec4(v.world, 1.0);
+  if (errors)
+    v.clip_err = (kClipRoundingUlps * kUlp32) * (abs_vp * glm::dvec4(glm::abs(v.world), 1.0));
+  return v;
+}
+
 namespace {
 
 // Lane4 values stay inside transformPositions() (everything it calls on them is inlined):

@@ -71,6 +71,15 @@ class ObjectTransform {
   bool errors_;
 };
 
+// The definition of the positions' part of one vertex (world, clip and, with `errors`,
+// clip_err; normal and uv left zero), scalar and in GLM's own operations: what the vector
+// builds below compute four matrix rows at a time. The renderer does not call it; the tests
+// hold both builds equal to it bit for bit (tests/reference/test_vertex_stage.cpp).
+TransformedVertex transformPositionDefinition(const glm::dmat4& model,
+                                              const glm::dmat4& view_projection,
+                                              const glm::dmat4& abs_vp, const glm::vec3& position,
+                                              bool errors);
+
 namespace detail {
 // The two builds transformObject() chooses between for the positions' part (world, clip,
 // clip_err; abs_vp: |view_projection| per entry), for the tests to run each (the AVX2 one

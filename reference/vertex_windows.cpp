@@ -2,9 +2,11 @@
 #include "reference/vertex_windows.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "reference/lanes.h"
+#include "reference/viewport.h"
 
 namespace rc::ref {
 namespace {
@@ -108,6 +110,36 @@ __attribute__((target("avx2"))) void setUpVertexWindowsAvx2(const TransformedVer
   setUpLanes(verts, count, setup, out);
 }
 }  // namespace detail
+
+VertexWindow vertexWindowDefinition(const glm::dvec4& c, const WindowSetup& setup) {
+  VertexWindow w{};
+  if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z) || !std::isfinite(c.w))
+    return w;
+  w.flags = VertexWindow::kFinite;
+  const ClipVolume& v = setup.volume;
+  // classifyTriangle()'s planes: near and far, then the guard band.
+  if (!(std::fabs(c.z) <= c.w && std::fabs(c.x) <= v.guard_x * c.w &&
+        std::fabs(c.y) <= v.guard_y * c.w))
+    return w;
+  w.flags |= VertexWindow::kInside;
+  // Beyond which side of the reject band (a triangle with every vertex beyond one is dropped).
+  const unsigned beyond = (c.x > v.reject_x * c.w ? 1u : 0u) | (c.x < -v.reject_x * c.w ? 2u : 0u) |
+                          (c.y > v.reject_y * c.w ? 4u : 0u) | (c.y < -v.reject_y * c.w ? 8u : 0u);
+  w.flags |= static_cast<std::uint8_t>(beyond << VertexWindow::kRejectShift);
+  if (!(c.w > 0.0)) return w;
+  const WindowVertex wv =
+      toWindow(ClipVertex{c, glm::dvec3(0.0), glm::dvec4(0.0)}, setup.width, setup.height);
+  if (!std::isfinite(wv.x) || !std::isfinite(wv.y) || !std::isfinite(wv.z)) return w;
+  w.flags |= VertexWindow::kDrawable;
+  w.x = wv.x;
+  w.y = wv.y;
+  w.z = wv.z;
+  w.inv_w = wv.inv_w;
+  w.fixed = snapVertexScaled(wv.x, wv.y, setup.snap_scale);
+  w.fixed.x -= setup.shift_x;
+  w.fixed.y -= setup.shift_y;
+  return w;
+}
 
 // x86-64's baseline or AVX2 (no FMA), whichever the CPU has: the bits are the same either
 // way (lanes.h); AVX2 does four lanes per instruction where SSE2 does two.

@@ -47,6 +47,13 @@ struct WindowSetup {
 void setUpVertexWindows(const TransformedVertex* verts, std::size_t count, const WindowSetup& setup,
                         VertexWindow* out);
 
+// The definition of one VertexWindow, scalar: the clip tests classifyTriangle() makes of a
+// vertex, and toWindow() and snapVertexScaled() (less the sample shift) of a drawable one;
+// fields setUpVertexWindows() leaves unspecified are zero here, the reaches always. The
+// renderer does not call it; the tests hold both builds below equal to it bit for bit
+// (tests/reference/test_vertex_stage.cpp).
+VertexWindow vertexWindowDefinition(const glm::dvec4& clip, const WindowSetup& setup);
+
 namespace detail {
 // The two builds setUpVertexWindows() chooses between, for the tests to run each (the AVX2
 // one only where the CPU has AVX2).

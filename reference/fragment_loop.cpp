@@ -1,0 +1,484 @@
+// The reference renderer's fragment loop: for each covered pixel centre of a fan triangle
+// the depth, the depth test, the colour (shading.h) and the writes; the tracing loop of
+// `explain` beside it, the same expressions with a record per fragment.
+#include "reference/renderer.h"
+
+#include <type_traits>
+
+#include "fixtures/scene_geometry.h"
+#include "reference/fragment_ops.h"
+#include "reference/shading_lanes.h"
+#include "reference/texture_sampling.h"
+
+// Lane4 and Lane8 values stay inside shadePhongQuad() (everything it calls is inlined):
+// -Wpsabi's note on passing 32-byte vectors without AVX does not apply (for the rest of the
+// file: GCC also gives it at the end of the translation unit).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace rc::ref {
+namespace {
+
+struct PhongQuad {
+  static constexpr int kMax = 8;
+  const FragmentInterpolator* interp = nullptr;
+  const PreparedShading* shading = nullptr;
+  glm::dvec3 world[3];   // the original vertices' world positions
+  glm::dvec3 normal[3];  // and normals
+  float* colors = nullptr;
+  bool rgba8 = false;
+  float alpha = 0.0f;  // the stored opacity
+  int count = 0;       // fragments pending
+  std::size_t index[kMax] = {};
+  double dx[kMax] = {};
+};
+
+using Float4 = float __attribute__((vector_size(16)));
+
+// Lanes 4h .. 4h + 3 of v.
+template <class V>
+[[gnu::always_inline]] inline Lane4 quarterOf(V v, int h) {
+  if constexpr (std::is_same_v<V, Lane8>) {
+    return h == 0 ? v.lo : v.hi;
+  } else {
+    return v;
+  }
+}
+
+// rgba32f: fragments 0 .. n-1 of four (channels r, g, b per lane, each float(c) as the
+// scalar cast rounds it), each fragment's four channels stored as one vector.
+[[gnu::always_inline]] inline void storeRgba32f(float* colors, const std::size_t* index, int n,
+                                                Lane4 cr, Lane4 cg, Lane4 cb, float alpha) {
+  const Float4 r = __builtin_convertvector(cr, Float4);
+  const Float4 g = __builtin_convertvector(cg, Float4);
+  const Float4 b = __builtin_convertvector(cb, Float4);
+  const Float4 a = {alpha, alpha, alpha, alpha};
+  const Float4 rg_lo = __builtin_shufflevector(r, g, 0, 4, 1, 5);  // r0 g0 r1 g1
+  const Float4 rg_hi = __builtin_shufflevector(r, g, 2, 6, 3, 7);  // r2 g2 r3 g3
+  const Float4 ba_lo = __builtin_shufflevector(b, a, 0, 4, 1, 5);  // b0 a b1 a
+  const Float4 ba_hi = __builtin_shufflevector(b, a, 2, 6, 3, 7);  // b2 a b3 a
+  const Float4 px[4] = {__builtin_shufflevector(rg_lo, ba_lo, 0, 1, 4, 5),
+                        __builtin_shufflevector(rg_lo, ba_lo, 2, 3, 6, 7),
+                        __builtin_shufflevector(rg_hi, ba_hi, 0, 1, 4, 5),
+                        __builtin_shufflevector(rg_hi, ba_hi, 2, 3, 6, 7)};
+  for (int lane = 0; lane < n; ++lane)
+    __builtin_memcpy(colors + 4 * index[lane], &px[lane], sizeof px[lane]);
+}
+
+// The pending fragments in the lanes of V (Lane4 for up to four, Lane8 for more).
+template <class V>
+[[gnu::always_inline]] inline void shadePhongLanes(const PhongQuad& q,
+                                                   const FragmentInterpolator::Row& row) {
+  // One load (a loop over the lanes compiled to a call of memcpy); unused lanes repeat the
+  // first fragment.
+  V dx;
+  __builtin_memcpy(&dx, q.dx, sizeof dx);
+  dx = selectLanes(lanesBelow<V>(q.count), dx, splatAs<V>(q.dx[0]));
+  V b[3];
+  q.interp->barycentricAtLanes(row, dx, b);
+  const Vec3L<V> p = combineLanes(b[0], b[1], b[2], q.world[0], q.world[1], q.world[2]);
+  const Vec3L<V> n =
+      safeNormalizeLanes(combineLanes(b[0], b[1], b[2], q.normal[0], q.normal[1], q.normal[2]));
+  const LitColorL<V> lit = shadePreparedLanes(*q.shading, p, n);
+  const Vec3L<V> c = lit.ambient_diffuse + lit.specular;
+  if (q.rgba8) {
+    for (int k = 0; k < q.count; ++k) {
+      float* out = q.colors + 4 * q.index[k];
+      out[0] = storeColor(c.x[k], ColorFormat::RGBA8);
+      out[1] = storeColor(c.y[k], ColorFormat::RGBA8);
+      out[2] = storeColor(c.z[k], ColorFormat::RGBA8);
+      out[3] = q.alpha;
+    }
+    return;
+  }
+  for (int h = 0; 4 * h < q.count; ++h)
+    storeRgba32f(q.colors, &q.index[static_cast<std::size_t>(4 * h)], std::min(4, q.count - 4 * h),
+                 quarterOf(c.x, h), quarterOf(c.y, h), quarterOf(c.z, h), q.alpha);
+}
+
+// The colour of the pending fragments: with b = barycentricAt(row, dx), the scalar form is
+// store(ambient_diffuse + specular of shadePrepared(shading, b.x * w0 + b.y * w1 + b.z *
+// w2, safeNormalize(b.x * n0 + b.y * n1 + b.z * n2))); here lane by lane the same
+// operations (shading_lanes.h), in four lanes up to four fragments and in eight above (two
+// independent halves the processor overlaps: the chain of divisions and square roots of
+// one quad is long). Compiled twice, for x86-64's baseline and for AVX2 (no FMA), and
+// picked at load time: the bits are the same either way, AVX2 only does four lanes per
+// instruction where SSE2 does two.
+__attribute__((target_clones("avx2", "default"))) void shadePhongQuad(
+    const PhongQuad& q, const FragmentInterpolator::Row& row) {
+  if (q.count <= 4) {
+    shadePhongLanes<Lane4>(q, row);
+  } else {
+    shadePhongLanes<Lane8>(q, row);
+  }
+}
+
+// The shade functor of fillSpans() for untextured, unblended Phong: fragments that passed
+// are collected and coloured eight at a time, the rest at the end of each span (fillSpans()
+// calls flush()). Deferring a colour write past later fragments of the span changes
+// nothing: nothing in the loop reads colour, and a span's pixels are distinct.
+class PhongQuads {
+ public:
+  PhongQuads(const TriangleContext& t, const FragmentInterpolator& interp, float* colors,
+             bool rgba8, float alpha) {
+    q_.interp = &interp;
+    q_.shading = t.shading;
+    for (int k = 0; k < 3; ++k) {
+      q_.world[k] = t.v[k]->world;
+      q_.normal[k] = t.v[k]->normal;
+    }
+    q_.colors = colors;
+    q_.rgba8 = rgba8;
+    q_.alpha = alpha;
+  }
+  TexelNote operator()(std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+    q_.index[q_.count] = index;
+    q_.dx[q_.count] = dx;
+    if (++q_.count == PhongQuad::kMax) flush(row);
+    return TexelNote{};
+  }
+  void flush(const FragmentInterpolator::Row& row) {
+    if (q_.count != 0) shadePhongQuad(q_, row);
+    q_.count = 0;
+  }
+
+ private:
+  PhongQuad q_;
+};
+
+}  // namespace
+
+template <Shading kShading>
+inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::dvec3& b,
+                                          ShadingTerms* terms, TexelNote* note,
+                                          const FragmentInterpolator* interp,
+                                          const FragmentInterpolator::Row* row, double dx) const {
+  glm::dvec3 tex(1.0);
+  glm::dvec2 uv(0.0);
+  if (t.texture) {
+    uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
+    tex = glm::dvec3(
+        sampleTexture(*t.texture, uv, scene_.state.texture_filter, scene_.state.texture_wrap));
+  }
+  LitColor lit;
+  if constexpr (kShading == Shading::Flat) {
+    lit = t.flat;
+  } else if constexpr (kShading == Shading::Gouraud) {
+    lit.ambient_diffuse = b.x * t.gouraud[0]->ambient_diffuse +
+                          b.y * t.gouraud[1]->ambient_diffuse + b.z * t.gouraud[2]->ambient_diffuse;
+    lit.specular =
+        b.x * t.gouraud[0]->specular + b.y * t.gouraud[1]->specular + b.z * t.gouraud[2]->specular;
+  } else {
+    const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
+    const glm::dvec3 n =
+        safeNormalize(b.x * t.v[0]->normal + b.y * t.v[1]->normal + b.z * t.v[2]->normal);
+    lit = shadePrepared(*t.shading, p, n, terms);
+  }
+  const glm::dvec4 color = finalColor(lit, tex, t.material->opacity);
+  if (note && t.texel_choice) *note = texelNote(t, uv, b, lit.ambient_diffuse, *interp, *row, dx);
+  if constexpr (kShading == Shading::Gouraud) {
+    if (note && t.thin) note->shade = gouraudReach(t, b, lit, tex, *interp, *row, dx);
+  } else if constexpr (kShading == Shading::Phong) {
+    if (note && t.thin) note->shade = phongReach(t, b, tex, lit, *interp, *row, dx);
+    if (note && t.short_normals) {
+      const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
+      note->normal = normalReach(t, b, p, *interp, *row, dx);
+    }
+  }
+  if (terms) {
+    if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
+    terms->texture = tex;
+    terms->uv = uv;
+    terms->color = color;
+  }
+  return color;
+}
+
+// The ambient and per-light terms of flat and Gouraud fragments (Phong records them
+// while lighting). Gouraud interpolates each vertex's terms like AD and S.
+void Renderer::traceTerms(const TriangleContext& t, const glm::dvec3& b,
+                          ShadingTerms& terms) const {
+  if (scene_.state.shading == Shading::Flat) {
+    shadePrepared(*t.shading, t.centroid, t.face_normal, &terms);
+    return;
+  }
+  ShadingTerms vt[3];
+  for (int k = 0; k < 3; ++k) shadePrepared(*t.shading, t.v[k]->world, t.v[k]->normal, &vt[k]);
+  terms.points.clear();
+  for (int k = 0; k < 3; ++k) {
+    terms.points.push_back(std::move(vt[k].points.front()));
+    terms.points.back().weight = b[k];
+  }
+  terms.ambient = b.x * vt[0].ambient + b.y * vt[1].ambient + b.z * vt[2].ambient;
+  terms.lights.assign(vt[0].lights.size(), LightTerms{});
+  for (std::size_t i = 0; i < terms.lights.size(); ++i) {
+    terms.lights[i].diffuse = b.x * vt[0].lights[i].diffuse + b.y * vt[1].lights[i].diffuse +
+                              b.z * vt[2].lights[i].diffuse;
+    terms.lights[i].specular = b.x * vt[0].lights[i].specular + b.y * vt[1].lights[i].specular +
+                               b.z * vt[2].lights[i].specular;
+  }
+}
+
+glm::dvec4 Renderer::storedColor(std::size_t index) const {
+  const float* c = &frame_.color[4 * index];
+  return glm::dvec4(loadColor(c[0], color_format_), loadColor(c[1], color_format_),
+                    loadColor(c[2], color_format_), loadColor(c[3], color_format_));
+}
+
+void Renderer::writeColor(std::size_t index, const glm::dvec4& src, bool blend) {
+  if (blend && defer_blends_) {  // the fragment loop has just kept this fragment
+    kept_.back().color = src;
+    return;
+  }
+  float* c = &frame_.color[4 * index];
+  if (!blend) {
+    for (int k = 0; k < 4; ++k) c[k] = storeColor(src[k], color_format_);
+    return;
+  }
+  const glm::dvec4 out = blendSourceOver(src, storedColor(index), color_format_);
+  for (int k = 0; k < 4; ++k) c[k] = storeColor(out[k], color_format_);
+}
+
+// The fragment loop: for every covered pixel centre, depth (from the unsnapped plane,
+// clamped, quantized), the depth test, the uncertainty bookkeeping, then depth, id and
+// colour writes. `shade(index, row, dx)` writes the colour of a fragment that passed.
+// Everything constant along a row is computed once per row (FragmentInterpolator::Row).
+template <DepthFormat kFormat, bool kGaps, bool kBarycentrics, class Shade>
+void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                         const FragmentInterpolator& interp, Shade&& shade) {
+  const bool always = t.pass->depth_func == DepthFunc::Always;
+  const bool depth_write = t.pass->depth_write;
+  const bool blend = t.pass->blend;
+  const bool keep = blend && defer_blends_;
+  const float slope = t.depth_slope;
+  const auto alpha = static_cast<float>(std::clamp(t.material->opacity, 0.0, 1.0));
+  const std::uint32_t id = t.prim->id;
+  std::uint32_t* const depth = depth_.data();
+  std::uint32_t* const ids = frame_.id.data();
+  ++triangles_drawn_;
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    fragments_ += static_cast<std::uint64_t>(x_end - x_begin);
+    const double cy = py + 0.5;  // pixel centres
+    const FragmentInterpolator::Row row = kBarycentrics ? interp.row(cy) : interp.depthRow(cy);
+    const std::size_t row_index =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    // In a local: the depth and id stores (std::uint32_t) may alias clip_.x0 (int), so the
+    // member would be reloaded for every fragment.
+    const int x0 = clip_.x0;
+    for (int px = x_begin; px < x_end; ++px) {
+      const double dx = interp.dx(px + 0.5);
+      const std::size_t index = row_index + static_cast<std::size_t>(px - x0);
+      const double z = clampDepth(interp.depthAt(row, dx));
+      const std::uint32_t key = depthKey(z, kFormat);  // kFormat constant: the switch folds
+      const bool pass = always || key < depth[index];
+      if constexpr (kGaps) {
+        const float reach = t.depth_reach.at(px + 0.5, cy);
+        if (pass) {
+          gaps_.passed(index, z, slope, reach, !always, depth_write, blend);
+        } else {
+          gaps_.failed(index, z, slope, reach, blend);
+        }
+      }
+      if (!pass) continue;
+      if (depth_write) depth[index] = key;
+      if (keep) {  // blended later, in depth order (resolveABuffer)
+        kept_.push_back({static_cast<std::uint32_t>(index), blend_seq_, id, slope, z});
+        KeptFragment& kept = kept_.back();
+        kept.alpha = alpha;
+        kept.note = shade(index, row, dx);  // its colour goes to kept.color
+        continue;
+      }
+      ids[index] = id;
+      const TexelNote note = shade(index, row, dx);
+      if constexpr (kGaps)
+        gaps_.colourWritten(index, blend, alpha, note.dist, note.alt, note.gain, note.reach,
+                            note.shade, note.normal);
+    }
+    if constexpr (requires { shade.flush(row); }) shade.flush(row);
+  });
+}
+
+template <DepthFormat kFormat>
+void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
+                              const FragmentInterpolator& interp) {
+  auto fill = [&](auto&& shade) {
+    if (uncertainty_) {
+      fillSpans<kFormat, true, true>(t, coverage, interp, shade);
+    } else {
+      fillSpans<kFormat, false, true>(t, coverage, interp, shade);
+    }
+  };
+  float* const colors = frame_.color.data();
+  const bool blend = t.pass->blend;
+  if (t.constant) {  // one stored colour for the whole triangle
+    const float c0 = t.constant_stored[0];
+    const float c1 = t.constant_stored[1];
+    const float c2 = t.constant_stored[2];
+    const float c3 = t.constant_stored[3];
+    auto shade = [=](std::size_t index, const FragmentInterpolator::Row&, double) {
+      float* c = colors + 4 * index;
+      c[0] = c0;
+      c[1] = c1;
+      c[2] = c2;
+      c[3] = c3;
+      return TexelNote{};
+    };
+    if (uncertainty_) {  // only the depth plane was set up
+      fillSpans<kFormat, true, false>(t, coverage, interp, shade);
+    } else {
+      fillSpans<kFormat, false, false>(t, coverage, interp, shade);
+    }
+    return;
+  }
+  // Untextured, unblended Gouraud and Phong: fragmentColor() and writeColor() written out
+  // with the triangle's constants in locals (the same expressions: an untextured colour is
+  // (ambient + diffuse) * 1 + specular, and x * 1 == x exactly).
+  // (Phong fans that record shade_reach take the general path.)
+  if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat &&
+      !options_.fragment_definition_only &&
+      !(uncertainty_ && (t.thin || t.short_normals) && scene_.state.shading == Shading::Phong)) {
+    const bool rgba8 = color_format_ == ColorFormat::RGBA8;
+    const float alpha = storeColor(t.material->opacity, color_format_);
+    auto store = [=](std::size_t index, const glm::dvec3& c) {
+      float* out = colors + 4 * index;
+      if (rgba8) {
+        out[0] = storeColor(c.x, ColorFormat::RGBA8);
+        out[1] = storeColor(c.y, ColorFormat::RGBA8);
+        out[2] = storeColor(c.z, ColorFormat::RGBA8);
+      } else {
+        out[0] = static_cast<float>(c.x);
+        out[1] = static_cast<float>(c.y);
+        out[2] = static_cast<float>(c.z);
+      }
+      out[3] = alpha;
+    };
+    if (scene_.state.shading == Shading::Gouraud) {
+      const LitColor g0 = *t.gouraud[0];
+      const LitColor g1 = *t.gouraud[1];
+      const LitColor g2 = *t.gouraud[2];
+      // Two loops: the shade_reach of thin triangles (uncertainty channels) in its own, so
+      // that every other triangle's loop is the one without it.
+      auto gouraud = [&](auto reach) {
+        fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+          const glm::dvec3 b = interp.barycentricAt(row, dx);
+          const glm::dvec3 ad =
+              b.x * g0.ambient_diffuse + b.y * g1.ambient_diffuse + b.z * g2.ambient_diffuse;
+          const glm::dvec3 sp = b.x * g0.specular + b.y * g1.specular + b.z * g2.specular;
+          store(index, ad + sp);
+          TexelNote note;
+          if constexpr (decltype(reach)::value)
+            note.shade = gouraudReach(t, b, LitColor{ad, sp}, glm::dvec3(1.0), interp, row, dx);
+          return note;
+        });
+      };
+      if (uncertainty_ && t.thin) {
+        gouraud(std::true_type{});
+      } else {
+        gouraud(std::false_type{});
+      }
+    } else {
+      // Phong: four fragments at a time (shadePhongQuad() has the scalar form).
+      PhongQuads quads(t, interp, colors, rgba8, alpha);
+      fill(quads);
+    }
+    return;
+  }
+  // The general path, the definition the forms above are held to (FragmentLoop.* tests);
+  // the texel note only where the uncertainty channels are kept.
+  const bool notes = uncertainty_;
+  auto general = [&](auto shading) {
+    constexpr Shading kShading = decltype(shading)::value;
+    fill([&](std::size_t index, const FragmentInterpolator::Row& row, double dx) {
+      TexelNote note;
+      const glm::dvec3 b = interp.barycentricAt(row, dx);
+      writeColor(index,
+                 fragmentColor<kShading>(t, b, nullptr, notes ? &note : nullptr, &interp, &row, dx),
+                 blend);
+      return note;
+    });
+  };
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      general(std::integral_constant<Shading, Shading::Flat>{});
+      break;
+    case Shading::Gouraud:
+      general(std::integral_constant<Shading, Shading::Gouraud>{});
+      break;
+    case Shading::Phong:
+      general(std::integral_constant<Shading, Shading::Phong>{});
+      break;
+  }
+}
+
+void Renderer::shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
+                        const FragmentInterpolator& interp) {
+  switch (depth_format_) {
+    case DepthFormat::D16:
+      shadeFanFormat<DepthFormat::D16>(t, coverage, interp);
+      break;
+    case DepthFormat::D24:
+      shadeFanFormat<DepthFormat::D24>(t, coverage, interp);
+      break;
+    case DepthFormat::D32F:
+      shadeFanFormat<DepthFormat::D32F>(t, coverage, interp);
+      break;
+  }
+}
+
+void Renderer::traceFan(const TriangleContext& t, const TriangleCoverage& coverage,
+                        const FragmentInterpolator& interp) {
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      traceSpans<Shading::Flat>(t, coverage, interp);
+      break;
+    case Shading::Gouraud:
+      traceSpans<Shading::Gouraud>(t, coverage, interp);
+      break;
+    case Shading::Phong:
+      traceSpans<Shading::Phong>(t, coverage, interp);
+      break;
+  }
+}
+
+// The fragment loop of tracePixel(): the same depth, test and writes as fillSpans() (the
+// same expressions; FragmentInterpolator's per-pixel forms equal its row forms), with a
+// FragmentTrace per fragment. The uncertainty channels are not computed when tracing.
+template <Shading kShading>
+void Renderer::traceSpans(const TriangleContext& t, const TriangleCoverage& coverage,
+                          const FragmentInterpolator& interp) {
+  const bool always = t.pass->depth_func == DepthFunc::Always;
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    const double cy = py + 0.5;
+    const std::size_t row =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    for (int px = x_begin; px < x_end; ++px) {
+      const double cx = px + 0.5;
+      const std::size_t index = row + static_cast<std::size_t>(px - clip_.x0);
+      const double z = clampDepth(interp.depth(cx, cy));
+      const std::uint32_t key = depthKey(z, depth_format_);
+      const std::uint32_t against = depth_[index];
+      const bool pass = always || key < against;
+      FragmentTrace f;
+      f.primitive = t.prim->id;
+      f.object = t.prim->object;
+      f.barycentric = interp.barycentric(cx, cy);
+      f.window_z = z;
+      f.stored_z = storedDepth(key, depth_format_);
+      f.depth_pass = pass;
+      f.depth_against = storedDepth(against, depth_format_);
+      const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading);
+      if (pass) {
+        if (t.pass->depth_write) depth_[index] = key;
+        if (t.pass->blend && defer_blends_) {
+          kept_.push_back({static_cast<std::uint32_t>(index), blend_seq_, t.prim->id, 0.0f, z});
+        } else {
+          frame_.id[index] = t.prim->id;
+        }
+        writeColor(index, color, t.pass->blend);
+      }
+      f.color_written = storedColor(index);
+      trace_->push_back(std::move(f));
+    }
+  });
+}
+
+}  // namespace rc::ref
