@@ -327,7 +327,7 @@ class UncertaintyTracker {
   // blended fragment has been written, every blend_count is 0. (A blended write of initial
   // texel values over initial ones leaves them too: min(1, 1), max(0, 0), (1 - a) 0 + 0 =
   // +0 for a in [0, 1].) In an untextured, opaque frame the five planes are not touched per
-  // fragment at all (docs/performance.md, tenth pass).
+  // fragment at all (docs/performance.md, "Why the hot code looks the way it does").
   bool texel_active_ = false;
   bool blend_active_ = false;
   static bool sameBits(float a, float b) {

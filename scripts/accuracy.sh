@@ -2,7 +2,9 @@
 # Regenerates docs/accuracy.md: runs the catalog against the four GL backends (each
 # compared with the reference), softpipe and zink against llvmpipe, and the reference and
 # the four backends on the `oit` fixtures against ref:abuffer (exact transparency), then
-# tabulates the three runs with `rastercheck accuracy`.
+# tabulates the three runs with `rastercheck accuracy`, puts who the page is for after its
+# title, and ends it with a list of docs/results/ (findings.md and the kept campaign and
+# mutation summaries).
 # Usage: scripts/accuracy.sh [--keep DIR]   (--keep: leave the three run folders in DIR)
 # RASTERCHECK names the binary (default: build/release/app/rastercheck); BACKENDS the
 # comma-separated backends to compare with the reference (default: the four below); DRIVERS
@@ -43,21 +45,59 @@ run fixtures/scenes/transparency/oit_*.json --backends "ref,$backends" --against
   --command "\`scripts/accuracy.sh\` (\`rastercheck run fixtures/scenes --backends $backends --flip\`, \`rastercheck run fixtures/scenes --backends $drivers --against gl:egl:llvmpipe --flip\` and \`rastercheck run fixtures/scenes/transparency/oit_*.json --backends ref,$backends --against ref:abuffer\`, then \`rastercheck accuracy\` on the three run folders)" \
   --out docs/accuracy.md
 
-# The random-scene campaigns and mutation studies (scripts/campaign.sh, scripts/mutations.sh)
-# write their results to docs/results/; the document lists them.
+# Who the page is for, after its title (`rastercheck accuracy` writes everything else).
+audience() {
+  echo "For anyone choosing a Mesa driver or judging a change to one: how far each driver is"
+  echo "from the reference (and softpipe and zink from llvmpipe) on the fixture catalog, which"
+  echo "differences are known and why, and where the random-scene campaigns stand."
+}
+{
+  head -n 1 docs/accuracy.md
+  echo
+  audience
+  tail -n +2 docs/accuracy.md
+} >docs/accuracy.md.tmp
+mv docs/accuracy.md.tmp docs/accuracy.md
+
+# docs/results/ keeps findings.md and the latest full campaign and mutation summaries
+# (scripts/campaign.sh and scripts/mutations.sh with RESULTS_DIR=docs/results write them);
+# the document lists them and says what each is.
 results_section() {
   echo
   echo "## Random-scene campaigns and the mutation study"
   echo
   echo "How they are run, what a group and its signature are, and how the mutation study"
-  echo "counts a fault as caught: [campaigns.md](campaigns.md). Latest results:"
+  echo "counts a fault as caught: [campaigns.md](campaigns.md)."
   echo
-  local any=0 f
-  for f in docs/results/findings.md docs/results/campaign-*.md docs/results/mutations-*.md; do
+  local f name any=0
+  if [[ -f docs/results/findings.md ]]; then
+    echo "- [results/findings.md](results/findings.md): every driver difference the campaigns"
+    echo "  found, with its cause, reduced fixture, expectations entry and the command that"
+    echo "  shows it, and the apparent differences that were gaps in the harness"
+  fi
+  for f in docs/results/campaign-*.md docs/results/mutations-*.md; do
     [[ -f $f ]] || continue
     any=1
-    echo "- [${f#docs/}](${f#docs/})"
+    name=${f#docs/results/}
+    if [[ $name =~ ^(campaign|mutations)-s([0-9]+)-n([0-9]+)\.md$ ]]; then
+      if [[ ${BASH_REMATCH[1]} == campaign ]]; then
+        echo "- [${f#docs/}](${f#docs/}):"
+        echo "  the latest full campaign (${BASH_REMATCH[3]} scenes, seed ${BASH_REMATCH[2]}): pass, warn"
+        echo "  and fail per backend, the failures grouped by signature, and the known difference"
+        echo "  covering each group"
+      else
+        echo "- [${f#docs/}](${f#docs/}):"
+        echo "  the latest mutation study (${BASH_REMATCH[3]} scenes, seed ${BASH_REMATCH[2]}): per backend"
+        echo "  and fault, how often the fault is caught in its class where it changes a pixel"
+        echo "  beyond its allowance"
+      fi
+    else
+      echo "- [${f#docs/}](${f#docs/})"
+    fi
   done
-  [[ $any -eq 1 ]] || echo "- none yet (run scripts/campaign.sh and scripts/mutations.sh)"
+  if [[ $any -eq 0 ]]; then
+    echo "- no campaign or mutation summary kept (scripts/campaign.sh and scripts/mutations.sh"
+    echo "  with RESULTS_DIR=docs/results write one)"
+  fi
 }
 results_section >>docs/accuracy.md

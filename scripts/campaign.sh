@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # The long random-scene campaign of docs/campaigns.md: `rastercheck campaign` over many
-# random scenes on the given backends, then its summary copied to
-# docs/results/campaign-s<SEED>-n<COUNT>.md (with the command and the date) for
-# docs/accuracy.md to cite. Interrupt it at any time; running it again continues.
+# random scenes on the given backends, then its summary copied, with the command and the
+# date, to RESULTS_DIR/campaign-s<SEED>-n<COUNT>.md. Interrupt it at any time; running it
+# again continues.
 # Usage: scripts/campaign.sh [BACKENDS] [COUNT] [SEED] [extra rastercheck campaign options]
 #   BACKENDS  comma-separated SPECs (default gl:egl:llvmpipe,gl:egl:softpipe, plus
 #             gl:egl:zink where it starts)
 #   COUNT     scenes (default 2000);  SEED  (default 20261201)
 # RASTERCHECK names the binary (default: build/release/app/rastercheck, built if missing);
 # the campaign folder is out/campaign-s<SEED>-n<COUNT> unless CAMPAIGN_OUT names another.
+# RESULTS_DIR is where the summary copy goes (default: out/, beside the campaign folder);
+# RESULTS_DIR=docs/results replaces the campaign summary docs/accuracy.md cites (do that
+# only for a full campaign of the current code, and remove the summary it replaces).
 # Exit code: the campaign's (0 no failure, 1 failures, 2 bad input, 3 a backend could not run).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -32,7 +35,7 @@ status=0
 "$exe" campaign --seed "$seed" --count "$count" --backends "$backends" --out "$out" "$@" ||
   status=$?
 if [[ $status -eq 2 || ! -f $out/summary.md ]]; then exit "$status"; fi
-results=$root/docs/results
+results=${RESULTS_DIR:-$root/out}
 mkdir -p "$results"
 name=campaign-s$seed-n$count
 {

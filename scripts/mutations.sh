@@ -3,14 +3,17 @@
 # each test-only GL fault (move_vertex, depth_bias, light_scale, texel_offset,
 # drop_primitive, blend_factor) into every random scene and reports, per fault, the
 # fraction caught in its class among the scenes where it changes a pixel beyond its
-# allowance. The report is copied to docs/results/mutations-s<SEED>-n<COUNT>.md for
-# docs/accuracy.md to cite. Interruptible and resumable like scripts/campaign.sh.
+# allowance. The report is copied, with the command and the date, to
+# RESULTS_DIR/mutations-s<SEED>-n<COUNT>.md. Interruptible and resumable like
+# scripts/campaign.sh.
 # Usage: scripts/mutations.sh [BACKENDS] [COUNT] [SEED] [extra rastercheck campaign options]
 #   BACKENDS  comma-separated GL SPECs (default gl:egl:llvmpipe)
 #   COUNT     scenes (default 500);  SEED  (default 20261202)
 # RASTERCHECK names the binary; the study folder is out/mutations-s<SEED>-n<COUNT> unless
-# CAMPAIGN_OUT names another. Exit code: 0 every counted fault caught, 1 some missed, 2 bad
-# input, 3 a render failed.
+# CAMPAIGN_OUT names another. RESULTS_DIR is where the report copy goes (default: out/,
+# beside the study folder); RESULTS_DIR=docs/results replaces the mutation summary
+# docs/accuracy.md cites (remove the one it replaces). Exit code: 0 every counted fault
+# caught, 1 some missed, 2 bad input, 3 a render failed.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 exe=${RASTERCHECK:-}
@@ -26,7 +29,7 @@ status=0
 "$exe" campaign --mutations --seed "$seed" --count "$count" --backends "$backends" \
   --out "$out" "$@" || status=$?
 if [[ $status -eq 2 || ! -f $out/mutations.md ]]; then exit "$status"; fi
-results=$root/docs/results
+results=${RESULTS_DIR:-$root/out}
 mkdir -p "$results"
 name=mutations-s$seed-n$count
 {

@@ -7,7 +7,7 @@
 #   bench/compare/compare_vs_idiff.sh [BUILD_DIR] [ROUNDS]     (default build/release, 7)
 #
 # RC_COMPARE_ARGS adds arguments to every `rastercheck compare`, e.g. "--flip" to time it
-# with LDR-FLIP (opt-in since issue 14). RC_BASELINE=EXE times another build's `compare`
+# with LDR-FLIP (opt-in). RC_BASELINE=EXE times another build's `compare`
 # (e.g. main's) in the same rounds. Each command's CPU time (user + sys) is printed too.
 # RC_EXR_COMPRESSION=LIST re-encodes the two frame.exr files with oiiotool before timing,
 # one measurement per entry ("asis" keeps what `render` wrote), e.g. "asis zip none".

@@ -214,7 +214,7 @@ TEST(CliCompare, AFailingPairExitsOne) {
   expectReportFiles(dir / "report");
 }
 
-// LDR-FLIP is opt-in (its cost is over issue 13's budget of compare <= idiff): a plain
+// LDR-FLIP is opt-in (with it a compare takes about twice idiff's time): a plain
 // compare has no flip block and no flip_heat.png, --flip adds both, --flip-threshold
 // implies it; CIEDE2000 is in every compared pair.
 TEST(CliCompare, FlipIsOptInAndCiede2000AlwaysThere) {

@@ -347,7 +347,8 @@ TEST(Flip, ThresholdFailsAPairWhoseMeanExceedsIt) {
   EXPECT_EQ(img.rgb[3], std::round(0.30f * 255.0f) / 255.0f);
 }
 
-// FLIP is opt-in (`--flip`, issue 13's time budget): compareFrames computes it only when
+// FLIP is opt-in (`--flip`: on a 1080p pair it costs more than the rest of the comparison,
+// docs/performance.md): compareFrames computes it only when
 // the maps ask for it or a threshold is set; CIEDE2000 comes with every comparison.
 TEST(Flip, OnlyComputedWhenAskedFor) {
   Frame e, a;

@@ -16,7 +16,6 @@
 
 #include <fmt/format.h>
 
-#include "fixtures/random_scene.h"
 #include "reference/reference_renderer.h"
 #include "tests/reference/corpus.h"
 #include "tests/reference/test_scenes.h"
@@ -81,8 +80,8 @@ TEST(Determinism, IdenticalAcrossOptimisationLevels) {
 // of the frame (colour, depth, id and every uncertainty channel, frameBytes()) per
 // catalog fixture, random scene (`generate --seed 1 --count 10` under four profiles; their
 // files are pinned by RandomScenes.GoldenHash) and benchmark scene, each under the four
-// option sets of renderCorpus(). It was recorded before the reference's speed work of
-// issue 13 (docs/performance.md) so that this test proves that work changed no bit.
+// option sets of renderCorpus(). It was recorded before any of the reference's speed work
+// (docs/performance.md) so that this test proves that work changed no bit.
 // An intended change of the reference's output re-records it:
 //   RC_UPDATE_GOLDEN=1 build/release/tests/reference/test_reference (with
 //   --gtest_filter=Determinism.GoldenFrames)
@@ -93,18 +92,7 @@ std::string goldenListing() {
   const fs::path random = fs::path(RC_BINARY_DIR) / "tests" / "reference" / "golden_random";
   std::vector<fs::path> files = corpusFixtures();
   const std::size_t catalog = files.size();
-  fs::remove_all(random);
-  for (const RandomProfile profile :
-       {RandomProfile::All, RandomProfile::Textures, RandomProfile::Blend, RandomProfile::Soups}) {
-    RandomSceneOptions o;
-    o.seed = 1;
-    o.count = 10;
-    o.profile = profile;
-    fs::create_directories(random / toString(profile));
-    writeRandomFixtures(o, random / toString(profile));
-  }
-  for (const fs::path& f : test::fixtureFiles(random))
-    if (f.filename() != "generate.json") files.push_back(f);
+  for (const fs::path& f : test::writeRandomCorpus(random, 1, 10)) files.push_back(f);
   EXPECT_GE(files.size(), catalog + 40);
   std::string out;
   test::renderCorpus(files, true, [&](const std::string& name, const Frame& frame) {

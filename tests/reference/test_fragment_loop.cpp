@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "fixtures/loader.h"
-#include "fixtures/random_scene.h"
 #include "reference/reference_renderer.h"
 #include "tests/reference/corpus.h"
 #include "tests/reference/test_scenes.h"
@@ -75,19 +74,7 @@ TEST(FragmentLoop, FastFormsEqualTheDefinitionOnBuiltScenes) {
 TEST(FragmentLoop, FastFormsEqualTheDefinitionOnRandomAndCatalogScenes) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::path(RC_BINARY_DIR) / "tests" / "reference" / "fragment_loop_random";
-  fs::remove_all(dir);
-  std::vector<fs::path> files;
-  for (const RandomProfile profile :
-       {RandomProfile::All, RandomProfile::Textures, RandomProfile::Blend, RandomProfile::Soups}) {
-    RandomSceneOptions o;
-    o.seed = 20261204;
-    o.count = 8;
-    o.profile = profile;
-    fs::create_directories(dir / toString(profile));
-    writeRandomFixtures(o, dir / toString(profile));
-  }
-  for (const fs::path& f : test::fixtureFiles(dir))
-    if (f.filename() != "generate.json") files.push_back(f);
+  std::vector<fs::path> files = test::writeRandomCorpus(dir, 20261204, 8);
   ASSERT_GE(files.size(), 32u);
   const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
   for (const char* folder : {"shading", "lighting", "transparency", "textures", "msaa"}) {
