@@ -50,5 +50,6 @@ function(rc_package_module target module)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${module}/
           DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rastercheck/${module}
           FILES_MATCHING PATTERN "*.h"
+          PATTERN "*_internal.h" EXCLUDE  # shared between a module's own files, not an API
           PATTERN "scenes" EXCLUDE)
 endfunction()

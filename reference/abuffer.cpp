@@ -1,7 +1,7 @@
 // ref:abuffer: exact order-independent transparency. The blended fragments the fragment
 // loop kept are sorted per pixel and blended far to near; frame.json "abuffer" says where the
 // draw order was not the depth order.
-#include "reference/renderer.h"
+#include "reference/renderer_internal.h"
 
 namespace rc::ref {
 namespace {

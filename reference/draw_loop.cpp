@@ -1,7 +1,7 @@
 // The reference renderer's draw loop: the scene's vertices transformed and set up once, then
 // every pass of fixtures/scene_logic.h drawPasses() triangle by triangle through clipping,
 // window set-up, snapping and culling to each fan triangle's coverage (docs/reference.md).
-#include "reference/renderer.h"
+#include "reference/renderer_internal.h"
 
 #include <chrono>
 #include <optional>

@@ -1,7 +1,7 @@
 // The reference renderer's fragment loop: for each covered pixel centre of a fan triangle
 // the depth, the depth test, the colour (shading.h) and the writes; the tracing loop of
 // `explain` beside it, the same expressions with a record per fragment.
-#include "reference/renderer.h"
+#include "reference/renderer_internal.h"
 
 #include <type_traits>
 
@@ -297,9 +297,16 @@ void Renderer::fillSpans(const TriangleContext& t, const TriangleCoverage& cover
   });
 }
 
+// Flattened: everything it calls that the compiler can see is inlined into each fragment
+// loop. The renderer's lambdas and templates have external linkage (Renderer is shared by
+// the files of renderer_internal.h), so GCC no longer inlines them as local functions called
+// once, and the loops then reload what they capture on every fragment (Gouraud layers: 116
+// -> 132 instructions a fragment). Flattened, every benchmark scene is as fast or faster
+// than with the renderer in one file (docs/performance.md), at about twice the code size.
 template <DepthFormat kFormat>
-void Renderer::shadeFanFormat(const TriangleContext& t, const TriangleCoverage& coverage,
-                              const FragmentInterpolator& interp) {
+__attribute__((flatten)) void Renderer::shadeFanFormat(const TriangleContext& t,
+                                                       const TriangleCoverage& coverage,
+                                                       const FragmentInterpolator& interp) {
   auto fill = [&](auto&& shade) {
     if (uncertainty_) {
       fillSpans<kFormat, true, true>(t, coverage, interp, shade);

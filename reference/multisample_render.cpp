@@ -1,6 +1,6 @@
 // Multisampling: the scene rendered once per sample position and resolved (colour mean,
 // owners, the channels reduced over the samples).
-#include "reference/renderer.h"
+#include "reference/renderer_internal.h"
 
 #include <chrono>
 

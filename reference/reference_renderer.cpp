@@ -1,5 +1,5 @@
 // The reference renderer's entry points: the input checks only the reference makes, then one
-// Renderer (renderer.h) per frame, sample or traced pixel. See reference_renderer.h and
+// Renderer (renderer_internal.h) per frame, sample or traced pixel. See reference_renderer.h and
 // docs/reference.md.
 #include "reference/reference_renderer.h"
 
@@ -7,7 +7,7 @@
 #include <string>
 
 #include "fixtures/errors.h"
-#include "reference/renderer.h"
+#include "reference/renderer_internal.h"
 
 namespace rc {
 namespace {

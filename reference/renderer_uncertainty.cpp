@@ -1,7 +1,7 @@
 // What the reference renderer adds to the uncertainty channels per fan triangle and per
 // fragment: the depth-reach plane, the shade, normal and texel reaches (the derivations are
 // docs/tolerances.md's; uncertainty.h keeps the per-pixel planes they go into).
-#include "reference/renderer.h"
+#include "reference/renderer_internal.h"
 
 #include "reference/texture_sampling.h"
 
