@@ -38,6 +38,7 @@
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
+#include "fixtures/mesh_import.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -196,6 +197,8 @@ int runCommand(const RunArgs& args) {
 
   std::vector<fs::path> inputs = args.inputs;
   if (inputs.empty()) inputs.push_back(defaultCatalogDir());
+  // The validation below imports every mesh file once; the workers read those imports back.
+  const SharedImportCache shared_meshes;
   // Validate every fixture before rendering anything: bad input exits 2 with no output.
   std::vector<FixtureEntry> fixtures;
   std::set<std::string> slugs;

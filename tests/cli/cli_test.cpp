@@ -2,10 +2,13 @@
 // render, compare and run, one-line errors that name the file and JSON path, no output
 // left after a failure, the closing summary and report path.
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -508,3 +511,76 @@ TEST(ResampleReference, RendersAgainAtTheDriversPositions) {
 }
 
 }  // namespace
+
+namespace {
+
+std::vector<fs::path> cachedImports(const fs::path& dir) {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".rcmesh") out.push_back(e.path());
+  return out;
+}
+
+std::string fileText(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+nlohmann::json frameMeta(const fs::path& dir) {
+  std::ifstream in(dir / "frame.json");
+  return nlohmann::json::parse(in);
+}
+
+}  // namespace
+
+// Mesh imports shared between processes (fixtures/mesh_import.h, SharedImportCache, which
+// `run` sets up for its workers): with RASTERCHECK_MESH_CACHE naming a folder, a render
+// leaves each mesh file's import there, and a later process reads it back instead of
+// starting the importer. Shown by swapping the cube's cached stream for the spider's (the
+// cube's key line kept): the next render of the cube scene then draws the spider. Without
+// the variable nothing is shared and the cube is the cube again.
+TEST(Cli, MeshImportsAreSharedThroughTheCacheFolder) {
+  const fs::path dir = scratch("mesh_cache");
+  const fs::path cache = dir / "cache";
+  fs::create_directories(cache);
+  const std::string env = "RASTERCHECK_MESH_CACHE=" + cache.string();
+  ASSERT_EQ(run("render " + catalog("real-mesh/ply_mesh.json") + " --backend ref --out " +
+                    (dir / "cube").string(),
+                env)
+                .code,
+            0);
+  const std::vector<fs::path> after_cube = cachedImports(cache);
+  ASSERT_EQ(after_cube.size(), 1u);
+  ASSERT_EQ(run("render " + catalog("real-mesh/stl_mesh.json") + " --backend ref --out " +
+                    (dir / "spider").string(),
+                env)
+                .code,
+            0);
+  std::vector<fs::path> after_spider = cachedImports(cache);
+  ASSERT_EQ(after_spider.size(), 2u);
+  const fs::path& cube_file = after_cube.front();
+  const fs::path spider_file = after_spider[0] == cube_file ? after_spider[1] : after_spider[0];
+  const std::string cube_text = fileText(cube_file);
+  const std::string spider_text = fileText(spider_file);
+  ASSERT_EQ(cube_text.rfind("rastercheck mesh import|", 0), 0u);
+  const std::string swapped = cube_text.substr(0, cube_text.find('\n') + 1) +
+                              spider_text.substr(spider_text.find('\n') + 1);
+  std::ofstream(cube_file, std::ios::binary | std::ios::trunc) << swapped;
+
+  ASSERT_EQ(run("render " + catalog("real-mesh/ply_mesh.json") + " --backend ref --out " +
+                    (dir / "swapped").string(),
+                env)
+                .code,
+            0);
+  ASSERT_EQ(run("render " + catalog("real-mesh/ply_mesh.json") + " --backend ref --out " +
+                (dir / "alone").string())
+                .code,
+            0);
+  const auto triangles = [&](const char* name) {
+    return frameMeta(dir / name).at("triangles_rasterized").get<std::uint64_t>();
+  };
+  EXPECT_NE(triangles("swapped"), triangles("cube")) << "the shared stream was not read";
+  EXPECT_GT(triangles("swapped"), 100u);  // the spider's, not the cube's 12
+  EXPECT_EQ(triangles("alone"), triangles("cube"));
+  fs::remove_all(dir);
+}

@@ -351,6 +351,7 @@ TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
   ASSERT_GE(files.size(), 30u);
 
   std::vector<Scene> scenes;
+  scenes.reserve(files.size());
   for (const fs::path& f : files) scenes.push_back(loadScene(f));
   auto planes = [](const Frame& f) {
     std::string out;
