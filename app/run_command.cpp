@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -208,15 +209,45 @@ int runCommand(const RunArgs& args) {
                       std::any_of(backends.begin(), backends.end(), [](const BackendSpec& b) {
                         return b.kind == BackendSpec::Kind::Gl;
                       });
-  for (const fs::path& file : findFixtures(inputs)) {
-    const Scene scene = loadScene(file);
-    checkResources(scene, RendererKind::Reference, limits);
-    if (any_gl) checkResources(scene, RendererKind::Gl, limits);
-    checkComparison(file.string(), scene.width, scene.height, limits);
-    std::string slug = fixtureSlug(scene.name);
+  // Loaded on every core (a mesh file's import is a child process of its own, and a
+  // catalog's images and meshes are read one after another otherwise); the first fixture in
+  // order that fails is the one reported, as when they were loaded one by one.
+  const std::vector<fs::path> files = findFixtures(inputs);
+  struct Checked {
+    FixtureEntry entry;
+    std::exception_ptr error;
+  };
+  std::vector<Checked> checked(files.size());
+  {
+    std::atomic<std::size_t> next{0};
+    auto validate = [&] {
+      for (std::size_t i = next++; i < files.size(); i = next++) {
+        try {
+          const Scene scene = loadScene(files[i]);
+          checkResources(scene, RendererKind::Reference, limits);
+          if (any_gl) checkResources(scene, RendererKind::Gl, limits);
+          checkComparison(files[i].string(), scene.width, scene.height, limits);
+          checked[i].entry = {fs::absolute(files[i]), scene.name, "", scene.tolerance,
+                              rasterCost(scene)};
+        } catch (...) {
+          checked[i].error = std::current_exception();
+        }
+      }
+    };
+    const std::size_t threads =
+        std::min<std::size_t>(files.size(), std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(validate);
+    validate();
+    for (std::thread& t : pool) t.join();
+  }
+  for (Checked& c : checked) {
+    if (c.error) std::rethrow_exception(c.error);
+    std::string slug = fixtureSlug(c.entry.name);
     for (int k = 2; !slugs.insert(slug).second; ++k)
-      slug = fixtureSlug(scene.name) + "~" + std::to_string(k);
-    fixtures.push_back({fs::absolute(file), scene.name, slug, scene.tolerance, rasterCost(scene)});
+      slug = fixtureSlug(c.entry.name) + "~" + std::to_string(k);
+    c.entry.slug = slug;
+    fixtures.push_back(std::move(c.entry));
   }
   if (fixtures.empty()) throw InputError("run: no fixtures found in the given paths");
 

@@ -584,3 +584,26 @@ TEST(Cli, MeshImportsAreSharedThroughTheCacheFolder) {
   EXPECT_EQ(triangles("alone"), triangles("cube"));
   fs::remove_all(dir);
 }
+
+// `run` loads its fixtures on every core, but reports the first bad one in file order, as
+// one by one: of two broken fixtures among good ones, the first (by name) is named, every
+// time, and nothing is written.
+TEST(Cli, RunNamesTheFirstBadFixtureInOrder) {
+  const fs::path dir = scratch("first_bad");
+  const fs::path in = dir / "in";
+  fs::create_directories(in);
+  for (int i = 0; i < 6; ++i)
+    fs::copy_file(catalog("coverage/triangle_fan.json"),
+                  in / ("a" + std::to_string(i) + "_good.json"));
+  std::ofstream(in / "b_bad.json") << "{\"format\": \"rastercheck-scene/1\", \"width\": -3}";
+  std::ofstream(in / "c_bad.json") << "{\"format\": \"rastercheck-scene/1\", \"zzz\": 1}";
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    const Result r =
+        run("run " + in.string() + " --backends ref:painter --out " + (dir / "out").string());
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("b_bad.json"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("c_bad.json"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir / "out"));
+  }
+  fs::remove_all(dir);
+}
