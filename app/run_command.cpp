@@ -209,7 +209,11 @@ int runCommand(const RunArgs& args) {
                       std::any_of(backends.begin(), backends.end(), [](const BackendSpec& b) {
                         return b.kind == BackendSpec::Kind::Gl;
                       });
-  // Loaded on every core (a mesh file's import is a child process of its own, and a
+  // Renders (and, before them, fixture loads) at a time: --jobs, else one per core.
+  const int parallel = args.jobs > 0
+                           ? args.jobs
+                           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // Loaded `parallel` at a time (a mesh file's import is a child process of its own, and a
   // catalog's images and meshes are read one after another otherwise); the first fixture in
   // order that fails is the one reported, as when they were loaded one by one.
   const std::vector<fs::path> files = findFixtures(inputs);
@@ -234,8 +238,7 @@ int runCommand(const RunArgs& args) {
         }
       }
     };
-    const std::size_t threads =
-        std::min<std::size_t>(files.size(), std::max(1u, std::thread::hardware_concurrency()));
+    const std::size_t threads = std::min<std::size_t>(files.size(), parallel);
     std::vector<std::thread> pool;
     for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(validate);
     validate();
@@ -307,9 +310,6 @@ int runCommand(const RunArgs& args) {
 
   ReportFolder folder(args.out);
   const fs::path frames_dir = folder.staging() / "frames";
-  const int parallel = args.jobs > 0
-                           ? args.jobs
-                           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   Report report;
   report.tool_version = kVersion;
   report.command = "run";

@@ -175,9 +175,8 @@ struct Session {
   Scratch scratch;
   GLuint sample_program = 0;  // reads one sample of the ids / depth (multisampled renders)
   GLuint empty_vertex_array = 0;
-  // zink on Mesa 22 must never see a context destroyed (keepsOneContext): the next render
-  // reuses this one, and a render that did not finish leaves it to be abandoned.
-  bool keep_context = false;
+  // A render that did not finish (its context state unknown): the next gets a new context
+  // even where contexts are reused (reusesContext).
   bool render_unfinished = false;
   const char* context_use = "new";       // frame.json "context": new, reused or replaced
   const char* program_use = "compiled";  // frame.json "program": compiled or reused
@@ -333,7 +332,6 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
     s->vulkan_query_ms = msSince(start);
   }
   chooseSubpixelBits(*s);
-  s->keep_context = reusesContext(*s);
   s->stack = describeStack(*s, loaded);
   enableDebugOutput(*s);
   checkGl(*s, "context creation");
@@ -410,9 +408,9 @@ Session& acquireSession(const GlSpec& spec) {
         spec.driver, have.driver, toString(spec)));
   }
   Session& s = *g_session;
-  s.keep_context = reusesContext(s);
-  s.context_use = !s.keep_context ? "new" : s.render_unfinished ? "replaced" : "reused";
-  if (!s.keep_context) {
+  const bool reuse = reusesContext(s);
+  s.context_use = !reuse ? "new" : s.render_unfinished ? "replaced" : "reused";
+  if (!reuse) {
     renewContext(s);
   } else if (s.render_unfinished) {
     // The last render threw halfway: its state is unknown, so the next starts from a new
@@ -1197,7 +1195,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
           "and integer texture limits included)",
           samples, usable, max_samples));
   }
-  s.render_unfinished = true;  // until the frame is read back (keep_context)
+  s.render_unfinished = true;  // until the frame is read back
   bindFramebuffer(s, scene);
   checkGl(s, "framebuffer setup");
   MultisampleTargets ms(gl);

@@ -20,9 +20,9 @@
 #include <gtest/gtest.h>
 
 #include "fixtures/loader.h"
-#include "fixtures/random_scene.h"
 #include "gl_backend/gl_testing.h"
 #include "tests/gl/gl_test_util.h"
+#include "tests/support/random_fixtures.h"
 
 namespace rc::gltest {
 namespace {
@@ -327,23 +327,7 @@ TEST_F(GlBackend, ContextIsReusedWhereIsolationIsShown) {
 TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
   const fs::path dir =
       fs::path(::testing::TempDir()) / ("rc_isolation_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  std::vector<fs::path> files;
-  for (const RandomProfile profile :
-       {RandomProfile::All, RandomProfile::Textures, RandomProfile::Blend, RandomProfile::Soups}) {
-    RandomSceneOptions o;
-    o.seed = 20261204;
-    o.count = 8;
-    o.max_width = 96;
-    o.max_height = 72;
-    o.profile = profile;
-    const fs::path sub = dir / toString(profile);
-    fs::create_directories(sub);
-    writeRandomFixtures(o, sub);
-    for (const auto& e : fs::directory_iterator(sub))
-      if (e.path().extension() == ".json" && e.path().filename() != "generate.json")
-        files.push_back(e.path());
-  }
+  std::vector<fs::path> files = test::writeRandomProfiles(dir, 20261204, 8, 96, 72);
   const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
   for (const auto& e : fs::recursive_directory_iterator(catalog))
     if (e.path().extension() == ".json") files.push_back(e.path());
@@ -353,21 +337,9 @@ TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
   std::vector<Scene> scenes;
   scenes.reserve(files.size());
   for (const fs::path& f : files) scenes.push_back(loadScene(f));
-  auto planes = [](const Frame& f) {
-    std::string out;
-    auto add = [&out](const auto& v) {
-      out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(v[0]));
-    };
-    add(f.color);
-    add(f.depth);
-    add(f.id);
-    add(f.sample_id);
-    add(f.sample_depth);
-    return out;
-  };
   auto frameOf = [&](const Scene& scene) {
     try {
-      return planes(render(scene));
+      return test::framePlanes(render(scene));
     } catch (const NotSupportedError&) {
       return std::string("not supported");  // e.g. more samples than the driver has
     }

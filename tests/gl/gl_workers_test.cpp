@@ -18,8 +18,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/worker_pool.h"
-#include "fixtures/random_scene.h"
 #include "tests/support/command.h"
+#include "tests/support/random_fixtures.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -194,38 +194,13 @@ TEST(GlWorkers, ARequestsFaultAppliesToThatRenderAlone) {
 TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
   const fs::path dir = scratch("isolation");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
-  std::vector<fs::path> files;
-  for (const rc::RandomProfile profile : {rc::RandomProfile::All, rc::RandomProfile::Textures,
-                                          rc::RandomProfile::Blend, rc::RandomProfile::Soups}) {
-    rc::RandomSceneOptions o;
-    o.seed = 20261205;
-    o.count = 4;
-    o.max_width = 96;
-    o.max_height = 72;
-    o.profile = profile;
-    const fs::path sub = dir / rc::toString(profile);
-    fs::create_directories(sub);
-    rc::writeRandomFixtures(o, sub);
-    for (const auto& e : fs::directory_iterator(sub))
-      if (e.path().extension() == ".json" && e.path().filename() != "generate.json")
-        files.push_back(e.path());
-  }
+  std::vector<fs::path> files = rc::test::writeRandomProfiles(dir / "random", 20261205, 4, 96, 72);
   for (const auto& e : fs::recursive_directory_iterator(catalog("")))
     if (e.path().extension() == ".json") files.push_back(e.path());
   std::sort(files.begin(), files.end());
   ASSERT_GE(files.size(), 60u);
   auto bytes = [](const rc::RenderOutcome& o) {
-    if (!o.ok) return "error: " + o.error;
-    std::string out;
-    auto add = [&out](const auto& v) {
-      out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(v[0]));
-    };
-    add(o.frame.color);
-    add(o.frame.depth);
-    add(o.frame.id);
-    add(o.frame.sample_id);
-    add(o.frame.sample_depth);
-    return out;
+    return o.ok ? rc::test::framePlanes(o.frame) : "error: " + o.error;
   };
   for (const char* spec :
        {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:egl:zink", "gl:osmesa:llvmpipe"}) {

@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 
 #include "fixtures/loader.h"
-#include "fixtures/random_scene.h"
 #include "reference/reference_renderer.h"
 #include "tests/reference/test_scenes.h"
 
@@ -19,25 +18,6 @@ std::vector<std::filesystem::path> fixtureFiles(const std::filesystem::path& dir
     if (entry.is_regular_file() && entry.path().extension() == ".json")
       files.push_back(entry.path());
   std::sort(files.begin(), files.end());
-  return files;
-}
-
-std::vector<std::filesystem::path> writeRandomCorpus(const std::filesystem::path& dir,
-                                                     std::uint64_t seed, int count) {
-  namespace fs = std::filesystem;
-  fs::remove_all(dir);
-  for (const RandomProfile profile :
-       {RandomProfile::All, RandomProfile::Textures, RandomProfile::Blend, RandomProfile::Soups}) {
-    RandomSceneOptions o;
-    o.seed = seed;
-    o.count = count;
-    o.profile = profile;
-    fs::create_directories(dir / toString(profile));
-    writeRandomFixtures(o, dir / toString(profile));
-  }
-  std::vector<fs::path> files;
-  for (const fs::path& f : fixtureFiles(dir))
-    if (f.filename() != "generate.json") files.push_back(f);
   return files;
 }
 

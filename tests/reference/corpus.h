@@ -19,12 +19,6 @@ namespace rc::test {
 // Fixture files under `dir` (recursively, *.json), sorted: the catalog part of the corpus.
 std::vector<std::filesystem::path> fixtureFiles(const std::filesystem::path& dir);
 
-// `count` random fixtures of `seed` under each of the profiles all, textures, blend and
-// soups, written to dir/<profile>/ (dir emptied first): their files, sorted, without the
-// generate.json records.
-std::vector<std::filesystem::path> writeRandomCorpus(const std::filesystem::path& dir,
-                                                     std::uint64_t seed, int count);
-
 // Renders the feature scenes, then every fixture file in order (loaded with loadScene),
 // then, when with_bench is set, the benchmark scenes, each with every option set (default;
 // subpixel 4; subpixel 12 with painter's forced; default without uncertainty channels),

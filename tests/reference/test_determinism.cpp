@@ -19,6 +19,7 @@
 #include "reference/reference_renderer.h"
 #include "tests/reference/corpus.h"
 #include "tests/reference/test_scenes.h"
+#include "tests/support/random_fixtures.h"
 
 namespace rc {
 namespace {
@@ -92,7 +93,7 @@ std::string goldenListing() {
   const fs::path random = fs::path(RC_BINARY_DIR) / "tests" / "reference" / "golden_random";
   std::vector<fs::path> files = corpusFixtures();
   const std::size_t catalog = files.size();
-  for (const fs::path& f : test::writeRandomCorpus(random, 1, 10)) files.push_back(f);
+  for (const fs::path& f : test::writeRandomProfiles(random, 1, 10)) files.push_back(f);
   EXPECT_GE(files.size(), catalog + 40);
   std::string out;
   test::renderCorpus(files, true, [&](const std::string& name, const Frame& frame) {

@@ -15,6 +15,7 @@
 #include "reference/reference_renderer.h"
 #include "tests/reference/corpus.h"
 #include "tests/reference/test_scenes.h"
+#include "tests/support/random_fixtures.h"
 
 namespace rc {
 namespace {
@@ -74,7 +75,7 @@ TEST(FragmentLoop, FastFormsEqualTheDefinitionOnBuiltScenes) {
 TEST(FragmentLoop, FastFormsEqualTheDefinitionOnRandomAndCatalogScenes) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::path(RC_BINARY_DIR) / "tests" / "reference" / "fragment_loop_random";
-  std::vector<fs::path> files = test::writeRandomCorpus(dir, 20261204, 8);
+  std::vector<fs::path> files = test::writeRandomProfiles(dir, 20261204, 8);
   ASSERT_GE(files.size(), 32u);
   const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
   for (const char* folder : {"shading", "lighting", "transparency", "textures", "msaa"}) {
