@@ -121,6 +121,7 @@ void tally(float v, int channel, NonFiniteCounts& counts) {
 
 void Comparator::run(ClassMaps* maps) {
   maps_ = maps;
+  compareStencil();
   if (e_.multisampled()) {
     allocateMaps();
     for (int y = 0; y < e_.height; ++y) runMultisampleRow(y);
@@ -184,7 +185,10 @@ void Comparator::runRange(int y, int x0, int x1) {
       if (kMaps) maps->pixel_class[i] = cls;
       continue;
     }
-    if (a == 0) continue;  // background on both sides
+    if (a == 0) {  // background on both sides: the clear values
+      clearedPixel(i, za[x], zb[x], pa, pb);
+      continue;
+    }
     ++vis_match_;
     if (kMaps) maps->pixel_class[i] = PixelClass::Match;
 
@@ -288,8 +292,23 @@ void Comparator::runRowFast(int y) {
     const V4i same = reinterpret_cast<V4i>(a == b);
     const V4i drawn = reinterpret_cast<V4i>(a != 0u);
     if (any(bad) || !all(same & drawn)) {
-      if (any(bad) || any(drawn | ~same)) runRange<kMaps>(y, x, x + 4);
-      continue;  // else background on both sides
+      if (any(bad) || any(drawn | ~same)) {
+        runRange<kMaps>(y, x, x + 4);
+        continue;
+      }
+      // Background on both sides: bit-identical clear values pass at once, anything else
+      // goes through clearedPixel().
+      bool identical = all(reinterpret_cast<V4i>(z_a) == reinterpret_cast<V4i>(z_b));
+      for (int k = 0; k < 4; ++k)
+        identical =
+            identical && all(reinterpret_cast<V4i>(c_a[k]) == reinterpret_cast<V4i>(c_b[k]));
+      if (identical) {
+        r_.depth.cleared_checked += 4;
+        r_.shading.cleared_checked += 4;
+      } else {
+        runRange<kMaps>(y, x, x + 4);
+      }
+      continue;
     }
     matched += 4;
     if (kMaps) std::memset(&maps->pixel_class[row + x], static_cast<int>(PixelClass::Match), 4);
@@ -363,6 +382,62 @@ void Comparator::runRowFast(int y) {
   shade_sq_ += shade_sq[0] + shade_sq[1];
   for (int c = 0; c < 4; ++c) shade_max_rgba_[c] = std::max(shade_max_rgba_[c], channel_max[c]);
   if (x < w) runRange<kMaps>(y, x, w);
+}
+
+void Comparator::clearedPixel(std::size_t i, float za, float zb, const float* pa, const float* pb) {
+  DepthStats& d = r_.depth;
+  ++d.cleared_checked;
+  const double dz = std::fabs(scale_(za) - scale_(zb));
+  const double depth_rounding = scale_.quantized ? 1.0 : 0.0;
+  if (!(dz <= depth_rounding)) {  // NaN too
+    ++d.cleared_mismatched;
+    ++d.over_tolerance;
+    ++d.over_fail;
+    depth_worst_.offer(std::isnan(dz) ? kInf : dz - depth_rounding, i, dz, depth_rounding);
+  }
+  ShadingStats& s = r_.shading;
+  ++s.cleared_checked;
+  const float color_rounding = quantized_color_ ? 1.0f : 0.0f;
+  float worst = 0.0f;
+  for (int c = 0; c < 4; ++c) {
+    const float e = colorError(pa[c], pb[c]);
+    if (!(e <= worst)) worst = e;  // NaN wins
+  }
+  if (!(worst <= color_rounding)) {
+    ++s.cleared_mismatched;
+    ++s.over_tolerance;
+    ++s.over_fail;
+    shade_worst_.offer(std::isnan(worst) ? kInf : worst - color_rounding, i, worst, color_rounding);
+  }
+}
+
+void Comparator::compareStencil() {
+  StencilStats& st = r_.depth.stencil;
+  const std::size_t n = e_.pixelCount();
+  if (e_.stencil.size() != n || a_.stencil.size() != n) return;
+  st.compared = true;
+  st.pixels = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (e_.stencil[i] == a_.stencil[i]) continue;
+    ++st.mismatched;
+    // A fragment there may go either way: near an edge, or a depth test (against another
+    // fragment or the clear depth) within its tolerance.
+    const bool ambiguous =
+        have_uncertainty_ && (static_cast<double>(u_.edge_dist[i]) <= band_ ||
+                              ambiguousByDepth(i, 1, 1) || ambiguousByDepth(i, 0, 1));
+    if (ambiguous) {
+      ++st.ambiguous;
+      continue;
+    }
+    ++st.hard;
+    ++r_.depth.over_tolerance;
+    ++r_.depth.over_fail;
+    if (!st.worst.valid()) {
+      st.worst = pixelAt(i);
+      st.worst_expected = static_cast<int>(e_.stencil[i]);
+      st.worst_actual = static_cast<int>(a_.stencil[i]);
+    }
+  }
 }
 
 // ---- Multisampled frames (docs/tolerances.md "Multisampling") ----
@@ -464,7 +539,10 @@ void Comparator::runMultisampleRow(int y) {
           record(i, e_.sample_id[k], a_.sample_id[k], true, first_gap, first_edge);
       if (maps_) maps_->pixel_class[i] = cls;
     } else if (!any_primitive) {
-      continue;  // background on both sides
+      // Background on both sides. Only the colour: a multisampled GL frame's depth comes
+      // through a shader's float arithmetic (docs/gl_backend.md), not exact near 1.
+      clearedPixel(i, e_.depth[i], e_.depth[i], pa, pb);
+      continue;
     } else if (maps_) {
       maps_->pixel_class[i] = PixelClass::Match;
     }

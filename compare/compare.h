@@ -52,6 +52,22 @@ struct VisibilityStats {
   double worst_edge_dist = 0.0;  // its edge_dist (1 = capped; +inf without uncertainty)
 };
 
+// The stencil buffers, compared exactly where both frames have one (state.stencil_format):
+// a differing pixel is ambiguous where the reference says a fragment there may legally
+// go either way (edge_dist within the band, or a depth test within its tolerance: the
+// stencil op can follow the depth test), else hard. Hard ones count in the depth class's
+// over_tolerance and over_fail (the stencil is part of the depth-stencil buffer).
+struct StencilStats {
+  bool compared = false;
+  std::uint64_t pixels = 0;
+  std::uint64_t mismatched = 0;
+  std::uint64_t ambiguous = 0;
+  std::uint64_t hard = 0;
+  PixelRef worst;  // the first hard mismatch in row order (none: no hard mismatch)
+  int worst_expected = 0;
+  int worst_actual = 0;
+};
+
 struct DepthStats {
   Status status = Status::Pass;
   std::uint64_t compared = 0;  // pixels with a = b != 0 (including non-finite ones)
@@ -73,6 +89,13 @@ struct DepthStats {
   double worst_allowance = 0.0;  // the slope allowance there (steps)
   double max_slope = 0.0;        // largest slope met while checking pixels (steps/px)
   ErrorHistogram histogram{1.0, true};
+  // Pixels where neither side drew anything (background on both): their depth must be the
+  // clear depth on both sides, to format rounding (a step for d16 and d24, exact for d32f);
+  // each that is not counts in over_tolerance and over_fail (docs/tolerances.md "Cleared
+  // buffers").
+  std::uint64_t cleared_checked = 0;
+  std::uint64_t cleared_mismatched = 0;
+  StencilStats stencil;
 };
 
 // PSNR of identical images (rmse 0) and the cap of every PSNR: 20 log10(255 / rmse) for
@@ -99,6 +122,11 @@ struct ShadingStats {
   // Multisampled pairs: pixels not compared because a sample there may legally show
   // another primitive by a depth tie (docs/tolerances.md "5. Multisampling").
   std::uint64_t depth_tied = 0;
+  // Pixels where neither side drew anything: the clear colour on both sides, to format
+  // rounding (a unit for rgba8, exact for rgba32f); each that is not counts in
+  // over_tolerance and over_fail.
+  std::uint64_t cleared_checked = 0;
+  std::uint64_t cleared_mismatched = 0;
   std::array<double, 4> max_abs_rgba{};
   // The pixel furthest over its tolerance when any is over (a non-finite one first), else
   // the largest per-pixel error (first in row order on ties); none when all are equal.

@@ -246,6 +246,21 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
   ds.worst = r.pixel(d, "worst", dat).value_or(PixelRef{});
   ds.worst_steps = finiteOr(r, d, "worst_steps", dat, ds.worst.valid());
   ds.worst_allowance = finiteOr(r, d, "worst_allowance", dat, ds.worst.valid());
+  // Reports written before cleared buffers and stencil were compared lack these.
+  if (d.contains("cleared") && d["cleared"].is_object()) {
+    ds.cleared_checked = r.count(d["cleared"], "checked", dat + ".cleared");
+    ds.cleared_mismatched = r.count(d["cleared"], "mismatched", dat + ".cleared");
+  }
+  if (d.contains("stencil") && d["stencil"].is_object()) {
+    const json& st = d["stencil"];
+    const std::string stat = dat + ".stencil";
+    ds.stencil.compared = st.value("compared", false);
+    ds.stencil.pixels = r.count(st, "pixels", stat);
+    ds.stencil.mismatched = r.count(st, "mismatched", stat);
+    ds.stencil.ambiguous = r.count(st, "ambiguous", stat);
+    ds.stencil.hard = r.count(st, "hard", stat);
+    ds.stencil.worst = r.pixel(st, "worst", stat).value_or(PixelRef{});
+  }
   ds.histogram = histogramFrom(r, d.contains("histogram") ? d["histogram"] : json(),
                                dat + ".histogram", ds.histogram);
 
@@ -264,6 +279,10 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
   ss.nonfinite = r.count(s, "nonfinite", sat);
   ss.texel_choice = r.count(s, "texel_choice", sat);
   ss.blend_uncertain = r.count(s, "blend_uncertain", sat);
+  if (s.contains("cleared") && s["cleared"].is_object()) {
+    ss.cleared_checked = r.count(s["cleared"], "checked", sat + ".cleared");
+    ss.cleared_mismatched = r.count(s["cleared"], "mismatched", sat + ".cleared");
+  }
   if (s.contains("depth_tied")) ss.depth_tied = r.count(s, "depth_tied", sat);
   if (s.contains("max_abs_rgba") && s["max_abs_rgba"].is_array() && s["max_abs_rgba"].size() == 4) {
     for (std::size_t c = 0; c < 4; ++c)

@@ -32,6 +32,17 @@ namespace rc::gl {
   X(PFNGLCOLORMASKPROC, ColorMask)                                                     \
   X(PFNGLBLENDFUNCPROC, BlendFunc)                                                     \
   X(PFNGLBLENDEQUATIONPROC, BlendEquation)                                             \
+  X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate)                                     \
+  X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate)                             \
+  X(PFNGLBLENDCOLORPROC, BlendColor)                                                   \
+  X(PFNGLCOLORMASKIPROC, ColorMaski)                                                   \
+  X(PFNGLSTENCILFUNCSEPARATEPROC, StencilFuncSeparate)                                 \
+  X(PFNGLSTENCILOPSEPARATEPROC, StencilOpSeparate)                                     \
+  X(PFNGLSTENCILMASKSEPARATEPROC, StencilMaskSeparate)                                 \
+  X(PFNGLSTENCILMASKPROC, StencilMask)                                                 \
+  X(PFNGLSCISSORPROC, Scissor)                                                         \
+  X(PFNGLPOLYGONOFFSETPROC, PolygonOffset)                                             \
+  X(PFNGLCLEARBUFFERIVPROC, ClearBufferiv)                                             \
   X(PFNGLFRONTFACEPROC, FrontFace)                                                     \
   X(PFNGLCULLFACEPROC, CullFace)                                                       \
   X(PFNGLPOLYGONMODEPROC, PolygonMode)                                                 \

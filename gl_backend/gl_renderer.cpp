@@ -138,11 +138,12 @@ struct Program {
 // allocating 1080p attachments costs more than the rest of the upload.
 struct Framebuffer {
   GLuint framebuffer = 0;
-  GLuint renderbuffers[3] = {0, 0, 0};  // colour, ids, depth
+  GLuint renderbuffers[4] = {0, 0, 0, 0};  // colour, ids, depth (and stencil), d16's stencil
   int width = 0;
   int height = 0;
   ColorFormat color = ColorFormat::RGBA32F;
   DepthFormat depth = DepthFormat::D24;
+  StencilFormat stencil = StencilFormat::None;
 };
 
 // Readback of the formats that need converting (d16, rgba8) lands here first (warm
@@ -562,7 +563,7 @@ AttachmentFormat depthFormat(DepthFormat f) {
 void deleteFramebuffer(const gl::Functions& gl, Framebuffer& fb) {
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (fb.framebuffer != 0) gl.DeleteFramebuffers(1, &fb.framebuffer);
-  gl.DeleteRenderbuffers(3, fb.renderbuffers);
+  gl.DeleteRenderbuffers(4, fb.renderbuffers);
   fb = Framebuffer{};
 }
 
@@ -570,13 +571,30 @@ void deleteFramebuffer(const gl::Functions& gl, Framebuffer& fb) {
 // driver gave exactly the asked formats (no silent substitution).
 void createFramebuffer(const gl::Functions& gl, Framebuffer& fb, const Scene& scene) {
   const AttachmentFormat color = colorFormat(scene.state.color_format);
-  const AttachmentFormat depth = depthFormat(scene.state.depth_format);
+  AttachmentFormat depth = depthFormat(scene.state.depth_format);
+  const bool stencil = scene.state.stencil_format == StencilFormat::S8;
   gl.GenFramebuffers(1, &fb.framebuffer);
   gl.BindFramebuffer(GL_FRAMEBUFFER, fb.framebuffer);
-  gl.GenRenderbuffers(3, fb.renderbuffers);
-  const GLenum internal[3] = {color.internal, GL_R32UI, depth.internal};
-  const GLenum attachment[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_DEPTH_ATTACHMENT};
-  for (int i = 0; i < 3; ++i) {
+  gl.GenRenderbuffers(4, fb.renderbuffers);
+  GLenum internal[4] = {color.internal, GL_R32UI, depth.internal, GL_STENCIL_INDEX8};
+  GLenum attachment[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_DEPTH_ATTACHMENT,
+                          GL_STENCIL_ATTACHMENT};
+  int count = 3;
+  // A stencil buffer: packed with d24 and d32f (the formats GL requires); beside d16 as a
+  // separate GL_STENCIL_INDEX8 attachment, which a driver may refuse (unsupported).
+  if (stencil && scene.state.depth_format == DepthFormat::D24) {
+    internal[2] = GL_DEPTH24_STENCIL8;
+    attachment[2] = GL_DEPTH_STENCIL_ATTACHMENT;
+    depth.name = "d24 + s8";
+  } else if (stencil && scene.state.depth_format == DepthFormat::D32F) {
+    internal[2] = GL_DEPTH32F_STENCIL8;
+    attachment[2] = GL_DEPTH_STENCIL_ATTACHMENT;
+    depth.name = "d32f + s8";
+  } else if (stencil) {
+    count = 4;
+    depth.name = "d16 + s8";
+  }
+  for (int i = 0; i < count; ++i) {
     gl.BindRenderbuffer(GL_RENDERBUFFER, fb.renderbuffers[i]);
     gl.RenderbufferStorage(GL_RENDERBUFFER, internal[i], scene.width, scene.height);
     gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, attachment[i], GL_RENDERBUFFER, fb.renderbuffers[i]);
@@ -611,8 +629,15 @@ void createFramebuffer(const gl::Functions& gl, Framebuffer& fb, const Scene& sc
   }
   fb.width = scene.width;
   fb.height = scene.height;
+  if (stencil) {
+    const int stencil_bits = query(GL_STENCIL_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE);
+    if (stencil_bits != 8)
+      throw BackendError(
+          fmt::format("asked for an s8 stencil buffer, the driver gave {} bits", stencil_bits));
+  }
   fb.color = scene.state.color_format;
   fb.depth = scene.state.depth_format;
+  fb.stencil = scene.state.stencil_format;
 }
 
 // Binds an FBO for the scene, reusing the last one when size and formats match.
@@ -621,7 +646,8 @@ void bindFramebuffer(Session& s, const Scene& scene) {
   Framebuffer& fb = s.framebuffer;
   const bool reusable = fb.framebuffer != 0 && fb.width == scene.width &&
                         fb.height == scene.height && fb.color == scene.state.color_format &&
-                        fb.depth == scene.state.depth_format;
+                        fb.depth == scene.state.depth_format &&
+                        fb.stencil == scene.state.stencil_format;
   if (reusable) {
     gl.BindFramebuffer(GL_FRAMEBUFFER, fb.framebuffer);
   } else {
@@ -773,46 +799,140 @@ void setFixedState(const gl::Functions& gl, const Scene& scene) {
   gl.PolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   gl.Enable(GL_DEPTH_TEST);  // also for "no depth test": ALWAYS keeps depth writes on
-  if (scene.state.cull == Cull::None) {
-    gl.Disable(GL_CULL_FACE);
-  } else {
-    gl.Enable(GL_CULL_FACE);
-    gl.CullFace(scene.state.cull == Cull::Back ? GL_BACK : GL_FRONT);
-  }
-  gl.FrontFace(scene.state.front_face == FrontFace::CW ? GL_CW : GL_CCW);
   gl.BlendEquation(GL_FUNC_ADD);
   gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   gl.Disablei(GL_BLEND, 1);  // R32UI ids never blend (GL ignores blending on integer buffers)
 }
 
-// The test-only fault blend_factor: the classic wrong blend functions.
-void setFaultedBlend(const gl::Functions& gl, const gl::testing::Faults& faults) {
+GLenum glCompare(CompareFunc f) {
+  constexpr std::array<GLenum, 8> kFuncs{GL_NEVER,   GL_LESS,     GL_EQUAL,  GL_LEQUAL,
+                                         GL_GREATER, GL_NOTEQUAL, GL_GEQUAL, GL_ALWAYS};
+  return kFuncs.at(static_cast<std::size_t>(f));
+}
+GLenum glStencilOp(StencilOp op) {
+  constexpr std::array<GLenum, 8> kOps{GL_KEEP,      GL_ZERO, GL_REPLACE,   GL_INCR,
+                                       GL_INCR_WRAP, GL_DECR, GL_DECR_WRAP, GL_INVERT};
+  return kOps.at(static_cast<std::size_t>(op));
+}
+GLenum glBlendEquationOf(BlendEquation e) {
+  constexpr std::array<GLenum, 5> kEquations{GL_FUNC_ADD, GL_FUNC_SUBTRACT,
+                                             GL_FUNC_REVERSE_SUBTRACT, GL_MIN, GL_MAX};
+  return kEquations.at(static_cast<std::size_t>(e));
+}
+GLenum glBlendFactorOf(BlendFactor f) {
+  constexpr std::array<GLenum, 15> kFactors{GL_ZERO,
+                                            GL_ONE,
+                                            GL_SRC_COLOR,
+                                            GL_ONE_MINUS_SRC_COLOR,
+                                            GL_DST_COLOR,
+                                            GL_ONE_MINUS_DST_COLOR,
+                                            GL_SRC_ALPHA,
+                                            GL_ONE_MINUS_SRC_ALPHA,
+                                            GL_DST_ALPHA,
+                                            GL_ONE_MINUS_DST_ALPHA,
+                                            GL_CONSTANT_COLOR,
+                                            GL_ONE_MINUS_CONSTANT_COLOR,
+                                            GL_CONSTANT_ALPHA,
+                                            GL_ONE_MINUS_CONSTANT_ALPHA,
+                                            GL_SRC_ALPHA_SATURATE};
+  return kFactors.at(static_cast<std::size_t>(f));
+}
+
+void setStencilFace(const gl::Functions& gl, GLenum face, const StencilFace& f) {
+  gl.StencilFuncSeparate(face, glCompare(f.func), f.ref, f.read_mask);
+  gl.StencilOpSeparate(face, glStencilOp(f.fail), glStencilOp(f.depth_fail), glStencilOp(f.pass));
+  gl.StencilMaskSeparate(face, f.write_mask);
+}
+
+// One pass's fixed-function state (DrawPass): culling, depth, stencil, scissor, offset,
+// blending and the colour mask of the colour attachment (never the ids').
+void setPassState(const gl::Functions& gl, const DrawPass& pass,
+                  const gl::testing::Faults& faults) {
+  if (pass.cull == Cull::None) {
+    gl.Disable(GL_CULL_FACE);
+  } else {
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(pass.cull == Cull::Back ? GL_BACK : GL_FRONT);
+  }
+  gl.FrontFace(pass.front_face == FrontFace::CW ? GL_CW : GL_CCW);
+  gl.DepthFunc(glCompare(pass.depth_func));
+  gl.DepthMask(pass.depth_write ? GL_TRUE : GL_FALSE);
+  const FragmentOps& ops = pass.ops;
+  gl.DepthRange(ops.depth_range.x, ops.depth_range.y);
+  if (ops.polygon_offset) {
+    gl.Enable(GL_POLYGON_OFFSET_FILL);
+    gl.PolygonOffset(static_cast<GLfloat>(ops.polygon_offset->factor),
+                     static_cast<GLfloat>(ops.polygon_offset->units));
+  } else {
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+  }
+  if (ops.stencil) {
+    gl.Enable(GL_STENCIL_TEST);
+    setStencilFace(gl, GL_FRONT, ops.stencil->front);
+    setStencilFace(gl, GL_BACK, ops.stencil->back);
+  } else {
+    gl.Disable(GL_STENCIL_TEST);
+  }
+  if (ops.scissor) {
+    gl.Enable(GL_SCISSOR_TEST);
+    gl.Scissor(ops.scissor->x, ops.scissor->y, ops.scissor->width, ops.scissor->height);
+  } else {
+    gl.Disable(GL_SCISSOR_TEST);
+  }
+  const auto& m = ops.color_mask;
+  gl.ColorMaski(0, m[0] ? GL_TRUE : GL_FALSE, m[1] ? GL_TRUE : GL_FALSE, m[2] ? GL_TRUE : GL_FALSE,
+                m[3] ? GL_TRUE : GL_FALSE);
+  if (!pass.blend) {
+    gl.Disablei(GL_BLEND, 0);
+    return;
+  }
+  gl.Enablei(GL_BLEND, 0);
+  if (pass.blend_function) {
+    const BlendFunction& b = ops.blend_function;
+    gl.BlendEquationSeparate(glBlendEquationOf(b.equation), glBlendEquationOf(b.equation_alpha));
+    gl.BlendFuncSeparate(glBlendFactorOf(b.src), glBlendFactorOf(b.dst),
+                         glBlendFactorOf(b.src_alpha), glBlendFactorOf(b.dst_alpha));
+    gl.BlendColor(static_cast<GLfloat>(b.constant.r), static_cast<GLfloat>(b.constant.g),
+                  static_cast<GLfloat>(b.constant.b), static_cast<GLfloat>(b.constant.a));
+  } else {
+    gl.BlendEquation(GL_FUNC_ADD);
+    gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  }
+  // The test-only fault blend_factor: the classic wrong blend functions.
   using Blend = gl::testing::Faults::Blend;
   if (faults.blend_factor == Blend::One) gl.BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   if (faults.blend_factor == Blend::Swapped) gl.BlendFunc(GL_ONE_MINUS_SRC_ALPHA, GL_SRC_ALPHA);
 }
 
+// Back to the state the readback draws expect (multisampling's sample copies).
+void resetPassState(const gl::Functions& gl) {
+  for (GLenum cap : {GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_POLYGON_OFFSET_FILL}) gl.Disable(cap);
+  gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  gl.DepthRange(0.0, 1.0);
+}
+
 void clearFramebuffer(const gl::Functions& gl, const Scene& scene) {
   gl.DepthMask(GL_TRUE);
+  resetPassState(gl);
   const glm::vec4 clear_color(scene.clear_color);
   gl.ClearBufferfv(GL_COLOR, 0, glm::value_ptr(clear_color));
   const GLuint zero_ids[4] = {0, 0, 0, 0};
   gl.ClearBufferuiv(GL_COLOR, 1, zero_ids);
   const auto clear_depth = static_cast<GLfloat>(scene.clear_depth);
   gl.ClearBufferfv(GL_DEPTH, 0, &clear_depth);
+  if (scene.state.stencil_format != StencilFormat::None) {
+    gl.StencilMask(0xff);
+    const GLint clear_stencil = scene.clear_stencil;
+    gl.ClearBufferiv(GL_STENCIL, 0, &clear_stencil);
+  }
 }
 
 void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
-                  const gl::VertexData& data, const std::vector<GLuint>& textures) {
+                  const gl::VertexData& data, const std::vector<GLuint>& textures,
+                  const gl::testing::Faults& faults) {
   std::uint32_t bound_material = UINT32_MAX;
   for (const gl::PassRuns& pass : data.passes) {
-    gl.DepthFunc(pass.depth_func == DepthFunc::Less ? GL_LESS : GL_ALWAYS);
-    gl.DepthMask(pass.depth_write ? GL_TRUE : GL_FALSE);
-    if (pass.blend) {
-      gl.Enablei(GL_BLEND, 0);
-    } else {
-      gl.Disablei(GL_BLEND, 0);
-    }
+    setPassState(gl, pass.state, faults);
     for (const gl::DrawRun& run : pass.runs) {
       if (run.material != bound_material) {
         setMaterialUniforms(gl, p, scene.materials[run.material], textures[run.material]);
@@ -905,6 +1025,14 @@ void readBack(Session& s, const Scene& scene, Frame& frame) {
     case DepthFormat::D32F:
       readRows(gl, inverted, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth, row * 4);
       break;
+  }
+
+  if (scene.state.stencil_format != StencilFormat::None) {
+    std::uint8_t* bytes = scratchFor(scratch.bytes, n);
+    readRows(gl, inverted, w, h, GL_STENCIL_INDEX, GL_UNSIGNED_BYTE, bytes, row);
+    frame.stencil.assign(bytes, bytes + n);
+  } else {
+    frame.stencil.clear();
   }
 
   gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
@@ -1241,10 +1369,10 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
 
   start = Clock::now();
   setFixedState(gl, scene);
-  setFaultedBlend(gl, faults);
   if (samples > 1) gl.Enable(GL_MULTISAMPLE);  // multisample rasterization into `ms`
   clearFramebuffer(gl, scene);
-  drawPassesGl(gl, program, scene, data, textures);
+  drawPassesGl(gl, program, scene, data, textures, faults);
+  resetPassState(gl);
   gl.Finish();
   injectStall(faults, scene.name);
   checkGl(s, "draw");

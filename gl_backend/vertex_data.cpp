@@ -82,6 +82,8 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
     out.depth_func = pass.depth_func;
     out.depth_write = pass.depth_write;
     out.blend = pass.blend;
+    out.state = pass;
+    out.state.primitives.clear();
     for (const PrimitiveRef& prim : pass.primitives) {
       if (prim.id == faults.drop_primitive) continue;  // the fault drop_primitive=ID
       const Object& obj = scene.objects[prim.object];

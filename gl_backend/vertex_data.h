@@ -35,6 +35,7 @@ struct PassRuns {
   DepthFunc depth_func = DepthFunc::Less;
   bool depth_write = true;
   bool blend = false;
+  DrawPass state;  // the pass's whole fixed-function state (its primitives left out)
   std::vector<DrawRun> runs;
 };
 

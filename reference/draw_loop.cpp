@@ -4,7 +4,9 @@
 #include "reference/renderer_internal.h"
 
 #include <chrono>
+#include <functional>
 #include <optional>
+#include <string_view>
 
 #include "fixtures/big_buffer.h"
 #include "fixtures/scene_geometry.h"
@@ -155,7 +157,16 @@ Frame Renderer::run() {
       frame_.pixelCount() *
       (kPlainBytes + (uncertainty_ ? UncertaintyTracker::kPrefetchedBytesPerPixel : 0));
   const bool prefetch = frame_bytes >= PrefetchBox::kMinFrameBytes;
-  for (const DrawPass& pass : drawPasses(scene_, options_.force_painter)) {
+  const std::vector<DrawPass> passes = drawPasses(scene_, options_.force_painter);
+  general_ops_ =
+      std::any_of(passes.begin(), passes.end(), [](const DrawPass& p) { return p.extended(); });
+  if (general_ops_) {
+    defer_blends_ = false;  // ref:abuffer sorts only the original transparency pass
+    plane_keys_.assign(frame_.pixelCount(), 0);
+  }
+  if (scene_.state.stencil_format != StencilFormat::None)
+    stencil_.assign(frame_.pixelCount(), static_cast<std::uint8_t>(scene_.clear_stencil));
+  for (const DrawPass& pass : passes) {
     const std::vector<PrimitiveRef>& prims = pass.primitives;
     for (std::size_t j = 0; j < prims.size(); ++j) {
       if (prefetch && j + PrefetchBox::kAhead < prims.size())
@@ -167,8 +178,13 @@ Frame Renderer::run() {
   if (options_.abuffer) resolveABuffer();
   if (uncertainty_) {
     edges_.apply(clip_, fb_width_, fb_height_, frame_.edge_dist.data());
-    gaps_.finish(frame_);
+    if (general_ops_) {
+      gaps_.finishConservative(frame_);
+    } else {
+      gaps_.finish(frame_);
+    }
   }
+  if (!stencil_.empty()) frame_.stencil.assign(stencil_.begin(), stencil_.end());
 
   // Stored depth back to [0, 1].
   const std::uint32_t* keys = depth_.data();
@@ -387,8 +403,8 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
 void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, const WindowVertex* wv,
                             const FixedVertex* fv, const double* reach, const double* depth_reach,
                             int count, bool clipped) {
-  const bool ccw_is_front = scene_.state.front_face == FrontFace::CCW;
-  const Cull cull = scene_.state.cull;
+  const bool ccw_is_front = pass.front_face == FrontFace::CCW;
+  const Cull cull = pass.cull;
   auto culled = [&](bool ccw) {
     const bool front = ccw == ccw_is_front;
     return (cull == Cull::Back && !front) || (cull == Cull::Front && front);
@@ -438,12 +454,55 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
     if (uncertainty_) {
       setUpFanChannels(t, interp, wv, depth_reach, i, clipped);
     }
+    if (general_ops_) {
+      setUpGeneralFan(t, interp, wv[0], wv[i], wv[i + 1], (area2 > 0) == ccw_is_front);
+      shadeFanGeneral(t, coverage, interp);
+      continue;
+    }
     if (trace_ != nullptr) {
       traceFan(t, coverage, interp);
       continue;
     }
     shadeFan(t, coverage, interp);
   }
+}
+
+void Renderer::setUpGeneralFan(TriangleContext& t, const FragmentInterpolator& interp,
+                               const WindowVertex& a, const WindowVertex& b, const WindowVertex& c,
+                               bool front_facing) {
+  const DrawPass& pass = *t.pass;
+  t.front_facing = front_facing;
+  const glm::dvec2 range = pass.ops.depth_range;
+  const double scale = range.y - range.x;  // window z = n + (f - n) z01
+  t.offset = 0.0;
+  double offset_reach = 0.0;  // steps
+  if (pass.ops.polygon_offset) {
+    // m = max(|dz/dx|, |dz/dy|): the estimate GL allows at the low end, and what Mesa's
+    // drivers use; the spec's upper bound |dz/dx| + |dz/dy| is the rest of the reach.
+    const glm::dvec2 g = interp.depthGradient() * scale;
+    const double m = std::max(std::fabs(g.x), std::fabs(g.y));
+    const double max_z =
+        std::max({range.x + scale * a.z, range.x + scale * b.z, range.x + scale * c.z});
+    const double r = minimumResolvableDepth(depth_format_, max_z);
+    const PolygonOffset& o = *pass.ops.polygon_offset;
+    t.offset = m * o.factor + r * o.units;
+    offset_reach = std::fabs(o.factor) * (std::fabs(g.x) + std::fabs(g.y) - m) * depth_steps_;
+    // d32f: r follows the exponent of the depth, which implementations may take per
+    // fragment instead of per polygon.
+    if (depth_format_ == DepthFormat::D32F) offset_reach += std::fabs(o.units) * r * depth_steps_;
+    // The offset added in float32 to a depth below 1: a rounding of at most a step.
+    offset_reach += 1.0;
+  }
+  // A depth range other than [0, 1]: the viewport's z scale and bias in float32.
+  if (range != glm::dvec2(0.0, 1.0)) offset_reach += 1.0;
+  if (uncertainty_ && offset_reach > 0.0) t.depth_reach.widen(offset_reach);
+  // The bits of what decides the plane's depths, hashed (a collision can only make one
+  // comparison count as invariant: 1 in 2^64).
+  const double planes[12] = {a.x, a.y, a.z, b.x,     b.y,     b.z,
+                             c.x, c.y, c.z, range.x, range.y, t.offset};
+  const std::size_t h = std::hash<std::string_view>{}(
+      std::string_view(reinterpret_cast<const char*>(planes), sizeof planes));
+  t.plane_key = h == 0 ? 1 : h;
 }
 
 }  // namespace rc::ref

@@ -416,6 +416,141 @@ __attribute__((flatten)) void Renderer::shadeFanFormat(const TriangleContext& t,
   }
 }
 
+// GL's per-fragment operations in order (glspec 4.6 chapter 14.9 and 17.3): scissor,
+// stencil test, depth test (window z mapped by the depth range, polygon offset added,
+// clamped, quantized), the stencil op its outcome selects, depth write, id, blending and
+// the colour mask. Every fragment's colour is fragmentColor() (the definition); the
+// uncertainty channels count every depth comparison (UncertaintyTracker::compared()).
+template <Shading kShading>
+void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
+                                const FragmentInterpolator& interp) {
+  const DrawPass& pass = *t.pass;
+  const FragmentOps& ops = pass.ops;
+  const StencilFace* face = nullptr;
+  if (ops.stencil && !stencil_.empty())
+    face = t.front_facing ? &ops.stencil->front : &ops.stencil->back;
+  const double near = ops.depth_range.x;
+  const double scale = ops.depth_range.y - ops.depth_range.x;
+  const bool mapped = ops.depth_range != glm::dvec2(0.0, 1.0);
+  const bool tested = pass.depth_func != DepthFunc::Always && pass.depth_func != DepthFunc::Never;
+  const bool masked = ops.color_mask != std::array<bool, 4>{true, true, true, true};
+  // What the channels weigh the old colour by: alpha-over (1 - alpha); a blend function or
+  // a masked write keeps any part of it (the conservative 0).
+  const auto alpha = static_cast<float>(
+      pass.blend && !pass.blend_function ? std::clamp(t.material->opacity, 0.0, 1.0) : 0.0);
+  const bool composited = pass.blend || masked;
+  const bool notes = uncertainty_;
+  const std::uint32_t id = t.prim->id;
+  ++triangles_drawn_;
+  coverage.forEachSpan([&](int py, int x_begin, int x_end) {
+    const double cy = py + 0.5;
+    const FragmentInterpolator::Row row = interp.row(cy);
+    const std::size_t row_index =
+        static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
+    for (int px = x_begin; px < x_end; ++px) {
+      ++fragments_;
+      const double dx = interp.dx(px + 0.5);
+      const std::size_t index = row_index + static_cast<std::size_t>(px - clip_.x0);
+      FragmentTrace f;
+      if (trace_ != nullptr) {
+        f.primitive = id;
+        f.object = t.prim->object;
+        f.barycentric = interp.barycentric(px + 0.5, cy);
+        f.offset = t.offset;
+      }
+      auto traced = [&] {
+        if (trace_ == nullptr) return;
+        f.color_written = storedColor(index);
+        trace_->push_back(std::move(f));
+      };
+      if (ops.scissor) {
+        const Scissor& box = *ops.scissor;
+        if (px < box.x || py < box.y || px - box.x >= box.width || py - box.y >= box.height) {
+          f.scissor_pass = false;
+          traced();
+          continue;
+        }
+      }
+      double z = interp.depthAt(row, dx);
+      if (mapped) z = near + scale * z;
+      z = clampDepth(z + t.offset);
+      const std::uint32_t key = depthKey(z, depth_format_);
+      const std::uint32_t stored = depth_[index];
+      f.window_z = z;
+      f.stored_z = storedDepth(key, depth_format_);
+      f.depth_against = storedDepth(stored, depth_format_);
+      const float reach = uncertainty_ ? t.depth_reach.at(px + 0.5, cy) : 0.0f;
+      if (face != nullptr) {
+        const std::uint8_t s = stencil_[index];
+        f.stencil_before = s;
+        const auto mask = static_cast<unsigned>(face->read_mask);
+        f.stencil_pass = compares(face->func, static_cast<unsigned>(face->ref) & mask, s & mask);
+        if (!f.stencil_pass) {
+          stencil_[index] = applyStencilOp(face->fail, s, face->ref, face->write_mask);
+          f.stencil_after = stencil_[index];
+          if (uncertainty_) gaps_.compared(index, z, t.depth_slope, reach, false, false, false);
+          if (trace_ != nullptr) fragmentColor<kShading>(t, f.barycentric, &f.shading);
+          traced();
+          continue;
+        }
+      }
+      const bool depth_pass = compares(pass.depth_func, key, stored);
+      f.depth_pass = depth_pass;
+      if (uncertainty_)
+        gaps_.compared(index, z, t.depth_slope, reach, tested, pass.blend,
+                       plane_keys_[index] == t.plane_key);
+      if (face != nullptr) {
+        const StencilOp op = depth_pass ? face->pass : face->depth_fail;
+        stencil_[index] = applyStencilOp(op, stencil_[index], face->ref, face->write_mask);
+        f.stencil_after = stencil_[index];
+      }
+      if (!depth_pass) {
+        if (trace_ != nullptr) fragmentColor<kShading>(t, f.barycentric, &f.shading);
+        traced();
+        continue;
+      }
+      if (pass.depth_write) {
+        depth_[index] = key;
+        plane_keys_[index] = t.plane_key;
+        if (uncertainty_) gaps_.storedDepth(index, z, t.depth_slope);
+      }
+      frame_.id[index] = id;
+      TexelNote note;
+      const glm::dvec3 b = interp.barycentricAt(row, dx);
+      const glm::dvec4 src = fragmentColor<kShading>(t, b, trace_ != nullptr ? &f.shading : nullptr,
+                                                     notes ? &note : nullptr, &interp, &row, dx);
+      glm::dvec4 out = src;
+      if (pass.blend) {
+        const glm::dvec4 dst = storedColor(index);
+        out = pass.blend_function ? blendWithFunction(ops.blend_function, src, dst, color_format_)
+                                  : blendSourceOver(src, dst, color_format_);
+      }
+      float* c = &frame_.color[4 * index];
+      for (int k = 0; k < 4; ++k)
+        if (ops.color_mask[static_cast<std::size_t>(k)]) c[k] = storeColor(out[k], color_format_);
+      if (uncertainty_)
+        gaps_.colourWritten(index, composited, alpha, note.dist, note.alt, note.gain, note.reach,
+                            note.shade, note.normal);
+      traced();
+    }
+  });
+}
+
+void Renderer::shadeFanGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
+                               const FragmentInterpolator& interp) {
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      fillSpansGeneral<Shading::Flat>(t, coverage, interp);
+      break;
+    case Shading::Gouraud:
+      fillSpansGeneral<Shading::Gouraud>(t, coverage, interp);
+      break;
+    case Shading::Phong:
+      fillSpansGeneral<Shading::Phong>(t, coverage, interp);
+      break;
+  }
+}
+
 void Renderer::shadeFan(const TriangleContext& t, const TriangleCoverage& coverage,
                         const FragmentInterpolator& interp) {
   switch (depth_format_) {

@@ -94,4 +94,17 @@ inline glm::dvec4 blendSourceOver(glm::dvec4 src, const glm::dvec4& dst, ColorFo
   return src * a + dst * (1.0 - a);
 }
 
+// GL's blending with a BlendFunction (glspec 4.6 17.3.6): per channel
+// s * S (op) d * D, with S and D the factors of src, dst and the constant colour, min/max
+// without factors. For rgba8 the source and constant are clamped to [0, 1] first (the
+// destination already is); for rgba32f nothing is clamped. `src` and `dst` are what the
+// fragment brings and what the buffer holds (loadColor()).
+glm::dvec4 blendWithFunction(const BlendFunction& b, glm::dvec4 src, const glm::dvec4& dst,
+                             ColorFormat format);
+
+// Polygon offset's r for a depth format (the smallest difference it resolves): 1 / (2^b - 1)
+// for d16 and d24; for d32f 2^(e - 23), e the exponent of the largest |z| of the polygon
+// (glspec 4.6 14.6.5). `max_z`: that z (d32f only).
+double minimumResolvableDepth(DepthFormat format, double max_z);
+
 }  // namespace rc::ref

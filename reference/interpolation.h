@@ -84,6 +84,8 @@ class FragmentInterpolator {
 
   // Depth gradient magnitude |grad z| of the plane (window-z units per px).
   double depthSlope() const { return std::hypot(z_.ddx, z_.ddy); }
+  // Its components (dz/dx, dz/dy): polygon offset's m.
+  glm::dvec2 depthGradient() const { return {z_.ddx, z_.ddy}; }
 
   // The screen-space derivatives of the perspective-correct barycentrics `b` (as
   // barycentricAt(r, dx) returned them): d/dx in [0], d/dy in [1]. From B = N / D with N

@@ -76,6 +76,13 @@ struct FragmentTrace {
   ShadingTerms shading;           // every term of its colour (computed even if it failed)
   glm::dvec4 color_written{0.0};  // the colour buffer after this fragment (blended and
                                   // converted; unchanged when the depth test failed)
+  // The general fragment operations (scenes with per-fragment state beyond LESS), in GL's
+  // order; the defaults where a scene has none of them.
+  bool scissor_pass = true;  // false: outside the scissor box, nothing else happened
+  int stencil_before = -1;   // the stored stencil value it was tested against (-1: no test)
+  bool stencil_pass = true;
+  int stencil_after = -1;  // the stencil value after its op
+  double offset = 0.0;     // polygon offset added to window_z (window-z units)
 };
 
 // A blended fragment of the A-buffer's sorted list at one pixel (`explain`).

@@ -117,6 +117,10 @@ struct TriangleContext {
   glm::dvec2 den_grad{0.0};
   glm::dvec2 uq_max{0.0};         // largest |u / w|, |v / w| over its three vertices
   glm::dvec4 texture_range{0.0};  // linear filtering: textureRange() of its texture
+  // The general fragment operations (Renderer::general_ops_), of the fan triangle:
+  bool front_facing = true;     // the stencil face it uses
+  double offset = 0.0;          // polygon offset, window-z units
+  std::uint64_t plane_key = 0;  // its depth plane (compared() `invariant`), never 0
 };
 
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
@@ -248,6 +252,19 @@ class Renderer {
                       const FragmentInterpolator::Row& row, double dx) const;
   void traceTerms(const TriangleContext& t, const glm::dvec3& b, ShadingTerms& terms) const;
   void writeColor(std::size_t index, const glm::dvec4& src, bool blend);
+  // The general fragment operations (fragment_loop.cpp): scissor, stencil, depth (with
+  // range and offset), blending, colour mask, in GL's order, every fragment through
+  // fragmentColor(); traced when trace_ is set.
+  template <Shading kShading>
+  void fillSpansGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
+                        const FragmentInterpolator& interp);
+  void shadeFanGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
+                       const FragmentInterpolator& interp);
+  // Per fan triangle: facing, polygon offset, the depth plane's key and what range and
+  // offset add to its depth reach (draw_loop.cpp).
+  void setUpGeneralFan(TriangleContext& t, const FragmentInterpolator& interp,
+                       const WindowVertex& a, const WindowVertex& b, const WindowVertex& c,
+                       bool front_facing);
   glm::dvec4 storedColor(std::size_t index) const;
   void resolveABuffer();
 
@@ -286,8 +303,13 @@ class Renderer {
   std::uint64_t triangles_drawn_ = 0;  // fan triangles that reached the fragment loop
   std::uint64_t fragments_ = 0;        // covered pixel centres (depth tested or not)
   std::vector<KeptFragment> kept_;     // A-buffer: blended fragments, in draw order
-  std::uint32_t blend_seq_ = 0;        // triangles of blending passes drawn so far
-  ABufferTally abuffer_;               // A-buffer: what the resolve found
+  // Some pass is DrawPass::extended(): every pass goes through fillSpansGeneral() and the
+  // tracker counts comparisons conservatively (UncertaintyTracker::compared()).
+  bool general_ops_ = false;
+  std::vector<std::uint8_t> stencil_;      // with a stencil format
+  std::vector<std::uint64_t> plane_keys_;  // general_ops_: the plane that stored each depth
+  std::uint32_t blend_seq_ = 0;            // triangles of blending passes drawn so far
+  ABufferTally abuffer_;                   // A-buffer: what the resolve found
   // textureRange() of each texture met so far (linear filtering with uncertainty).
   std::vector<std::pair<const Texture*, glm::dvec4>> texture_ranges_;
   const glm::dvec4& textureRangeOf(const Texture* texture);

@@ -141,6 +141,51 @@ class UncertaintyTracker {
       depth_slope_[index] = slope;
     }
   }
+  // The general fragment operations (a scene with extended() passes, fixtures/scene_logic.h)
+  // break the streaming rule's premises: other depth functions, no depth writes in opaque
+  // passes, stencil values that depend on depth tests, blend functions. There every depth
+  // comparison counts, whatever its outcome and order (a superset of those that decided,
+  // so never a smaller gap than the exact rule would give):
+  //  - compared(): a fragment tested against the stored depth (`tested`: the function
+  //    compares at all, not NEVER or ALWAYS). Against the clear depth it goes to clear_gap
+  //    (finishConservative() gives every pixel its smallest), else to depth_gap; blended,
+  //    to blend_gap too with what decided the pixel so far. `invariant`: the stored depth
+  //    came from the same depth plane (the same window vertices, range and offset): GL's
+  //    invariance rules make that comparison come out the same in every implementation
+  //    (equal-depth multipass), so it counts nowhere.
+  //  - storedDepth(): the fragment wrote its depth.
+  void compared(std::size_t index, double z, float slope, float reach, bool tested, bool blended,
+                bool invariant) {
+    depth_reach_[index] = std::max(depth_reach_[index], reach);
+    if (!tested || invariant) return;
+    const bool against_clear = std::isinf(stored_z_[index]);
+    const float g = toSteps(std::fabs(z - (against_clear ? clear_z_ : stored_z_[index])));
+    if (against_clear) {
+      clear_near_[index] = std::min(clear_near_[index], g);
+      clear_far_[index] = std::max(clear_far_[index], g);
+      clear_slope_[index] = std::max(clear_slope_[index], slope);
+    } else {
+      if (g < gap_[index]) gap_[index] = g;
+      gap_slope_[index] = std::max({gap_slope_[index], slope, depth_slope_[index]});
+    }
+    if (blended) {
+      float b = std::min(g, gap_[index]);
+      if (clear_far_[index] >= 0.0f) b = std::min(b, clear_near_[index]);
+      if (b < blend_gap_[index]) blend_gap_[index] = b;
+      blend_slope_[index] = std::max({blend_slope_[index], slope, gap_slope_[index]});
+    }
+  }
+  void storedDepth(std::size_t index, double z, float slope) {
+    stored_z_[index] = z;
+    depth_slope_[index] = slope;
+  }
+  // Ends a frame drawn with compared(): clear_gap is the closest comparison against the
+  // clear depth at every pixel, drawn or not.
+  void finishConservative(Frame& frame) {
+    for (std::size_t i = 0; i < frame.pixelCount(); ++i)
+      if (clear_far_[i] >= 0.0f) frame.clear_gap[i] = clear_near_[i];
+  }
+
   // Fragment at clamped window depth z failed the LESS test.
   void failed(std::size_t index, double z, float slope, float reach, bool blended) {
     depth_reach_[index] = std::max(depth_reach_[index], reach);

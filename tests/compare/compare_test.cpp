@@ -402,7 +402,8 @@ TEST_F(CompareTest, NonFiniteValuesAreCountedNeverCompared) {
   gl_.color[gl_.index(77, 30) * 4 + 2] = -inf;
   gl_.depth[gl_.index(78, 30)] = inf;
   gl_.depth[gl_.index(79, 30)] = nan;
-  gl_.color[gl_.index(kEmptyBlock.x0, kEmptyBlock.y0) * 4 + 1] = inf;  // background: counted only
+  // Background on both sides: counted, and not the clear colour (a cleared-buffer failure).
+  gl_.color[gl_.index(kEmptyBlock.x0, kEmptyBlock.y0) * 4 + 1] = inf;
   ref_.color[ref_.index(80, 31) * 4 + 3] = nan;
   const PairResult r = compare();
   EXPECT_EQ(r.nonfinite_actual.nan[0], 2u);
@@ -414,7 +415,8 @@ TEST_F(CompareTest, NonFiniteValuesAreCountedNeverCompared) {
   EXPECT_EQ(r.nonfinite_expected.nan[3], 1u);
   EXPECT_EQ(r.nonfinite_expected.total(), 1u);
   EXPECT_EQ(r.shading.nonfinite, 4u);  // three actual pixels and one expected pixel
-  EXPECT_EQ(r.shading.over_fail, 4u);
+  EXPECT_EQ(r.shading.cleared_mismatched, 1u);
+  EXPECT_EQ(r.shading.over_fail, 5u);
   EXPECT_EQ(r.shading.status, Status::Fail);
   EXPECT_EQ(r.shading.max_abs, 0.0);  // the finite pixels still agree
   EXPECT_EQ(r.shading.worst.y, 30);
