@@ -50,7 +50,14 @@ double Comparator::depthReach(std::size_t i) const {
 // depth gradient `slope` (steps/px): where snapping moves its plane, plus its vertices'
 // float32 reach (docs/tolerances.md section 2).
 double Comparator::depthAllowance(std::size_t i, double slope) const {
-  return depth_slope_band_ * slope + depthReach(i);
+  double allowance = depth_slope_band_ * slope + depthReach(i);
+  // Polygon offset: another implementation's r moves the offset by the spread of r times
+  // |units| x r_min (NaN or 0 where nothing offset was tested).
+  if (have_uncertainty_) {
+    const double offset = u_.offset_steps[i] * r_.depth.offset_r_spread;
+    if (offset > 0.0) allowance += offset;
+  }
+  return allowance;
 }
 
 // Whether the reference's depth comparisons at pixel i could legally go the other way,

@@ -4,6 +4,7 @@
 #include "compare/compare.h"
 
 #include <chrono>
+#include <cmath>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -128,6 +129,17 @@ PairResult compareFrames(const Frame& expected, const Frame& actual, const Frame
   band.width = expected.width;
   band.height = expected.height;
   r.visibility.band_px = snapBandPx(tolerances, band);
+  auto offsetR = [](const Frame& f) {
+    const auto it = f.meta.find("polygon_offset_r");
+    return it != f.meta.end() && it->is_number() ? it->get<double>()
+                                                 : std::numeric_limits<double>::quiet_NaN();
+  };
+  r.depth.offset_r_expected = offsetR(expected);
+  r.depth.offset_r_actual = offsetR(actual);
+  r.depth.offset_r_spread =
+      std::isnan(r.depth.offset_r_expected) || std::isnan(r.depth.offset_r_actual)
+          ? kUnknownOffsetSpread
+          : std::fabs(r.depth.offset_r_expected - r.depth.offset_r_actual);
   r.depth.band_px = slopeBandPx(tolerances, band);
 
   // Quantized formats have integer errors: exact percentiles (histogram.h).

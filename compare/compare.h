@@ -57,6 +57,10 @@ struct VisibilityStats {
 // go either way (edge_dist within the band, or a depth test within its tolerance: the
 // stencil op can follow the depth test), else hard. Hard ones count in the depth class's
 // over_tolerance and over_fail (the stencil is part of the depth-stencil buffer).
+// The spread of r assumed when a frame does not give its r: r from 1 to 4 times the
+// minimum (llvmpipe and softpipe measure 2 for d16/d24, zink 4).
+inline constexpr double kUnknownOffsetSpread = 3.0;
+
 struct StencilStats {
   bool compared = false;
   std::uint64_t pixels = 0;
@@ -96,6 +100,13 @@ struct DepthStats {
   std::uint64_t cleared_checked = 0;
   std::uint64_t cleared_mismatched = 0;
   StencilStats stencil;
+  // Polygon offset's r of each side (frame.json "polygon_offset_r", in units of the
+  // format's minimum resolvable difference; NaN: the frame does not say) and the spread
+  // the depth allowance takes: |r_expected - r_actual| x the pixel's offset_steps, or
+  // kUnknownOffsetSpread when a side does not say (docs/tolerances.md "Polygon offset").
+  double offset_r_expected = std::numeric_limits<double>::quiet_NaN();
+  double offset_r_actual = std::numeric_limits<double>::quiet_NaN();
+  double offset_r_spread = 0.0;
 };
 
 // PSNR of identical images (rmse 0) and the cap of every PSNR: 20 log10(255 / rmse) for

@@ -601,9 +601,13 @@ void createFramebuffer(const gl::Functions& gl, Framebuffer& fb, const Scene& sc
   }
   const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
-    throw BackendError(fmt::format(
+    const std::string what = fmt::format(
         "framebuffer incomplete: {} (colour {}, ids r32ui, depth {}, {}x{})",
-        framebufferStatusName(status), color.name, depth.name, scene.width, scene.height));
+        framebufferStatusName(status), color.name, depth.name, scene.width, scene.height);
+    // A combination of formats the driver refuses (d16 with a separate s8, for Mesa) is
+    // a limit of the driver, reported as not supported, not a failure.
+    if (status == GL_FRAMEBUFFER_UNSUPPORTED) throw NotSupportedError(what);
+    throw BackendError(what);
   }
   auto query = [&](GLenum att, GLenum pname) {
     GLint v = 0;
@@ -925,6 +929,63 @@ void clearFramebuffer(const gl::Functions& gl, const Scene& scene) {
     const GLint clear_stencil = scene.clear_stencil;
     gl.ClearBufferiv(GL_STENCIL, 0, &clear_stencil);
   }
+}
+
+// Polygon offset's r as this driver applies it (GL leaves r to the implementation,
+// docs/tolerances.md "Polygon offset"): a quad over the viewport at window depth 0.5 drawn
+// with factor 0 and kOffsetProbeUnits units, its depth read back at one pixel. r is given
+// in units of the format's minimum resolvable difference at that depth (the reference's
+// r: one step of d16 or d24, 2^-24 for d32f in [0.5, 1)). Drawn into the scene's
+// framebuffer before the scene; the caller clears it again.
+constexpr double kOffsetProbeUnits = 1024.0;
+constexpr std::size_t kOffsetProbeVertices = 6;
+
+void appendOffsetProbe(gl::VertexData& data) {
+  const float corners[kOffsetProbeVertices][2] = {{-1, -1}, {1, -1}, {1, 1},
+                                                  {-1, -1}, {1, 1},  {-1, 1}};
+  for (const auto& c : corners) {
+    gl::Vertex& v = data.vertices.emplace_back();
+    v = gl::Vertex{};
+    v.world_position[0] = c[0];
+    v.world_position[1] = c[1];
+  }
+}
+
+double measureOffsetR(const gl::Functions& gl, const Program& p, const Scene& scene,
+                      GLint first_vertex) {
+  const glm::mat4 identity(1.0f);
+  gl.UniformMatrix4fv(p.view_projection, 1, GL_FALSE, glm::value_ptr(identity));
+  DrawPass probe;
+  probe.depth_func = DepthFunc::Always;
+  probe.ops.polygon_offset = PolygonOffset{0.0, kOffsetProbeUnits};
+  setPassState(gl, probe, gl::testing::Faults{});
+  gl.DrawArrays(GL_TRIANGLES, first_vertex, static_cast<GLsizei>(kOffsetProbeVertices));
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  double offset_steps = 0.0;  // the offset in steps of r_min
+  switch (scene.state.depth_format) {
+    case DepthFormat::D16: {
+      GLushort q = 0;
+      gl.ReadPixels(0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, &q);
+      offset_steps = q - 0.5 * 65535.0;
+      break;
+    }
+    case DepthFormat::D24: {
+      GLuint v = 0;
+      gl.ReadPixels(0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, &v);
+      offset_steps = (v >> 8) - 0.5 * 16777215.0;
+      break;
+    }
+    case DepthFormat::D32F: {
+      GLfloat z = 0.0f;
+      gl.ReadPixels(0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &z);
+      offset_steps = std::ldexp(static_cast<double>(z) - 0.5, 24);
+      break;
+    }
+  }
+  const glm::mat4 view_projection(viewProjectionMatrix(scene));
+  gl.UniformMatrix4fv(p.view_projection, 1, GL_FALSE, glm::value_ptr(view_projection));
+  // To 1/64: the base depth's own rounding is half a step in kOffsetProbeUnits.
+  return std::round(offset_steps / kOffsetProbeUnits * 64.0) / 64.0;
 }
 
 void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
@@ -1352,7 +1413,15 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
 
   start = Clock::now();
   cpu_start = threadCpuMs();
-  const gl::VertexData data = gl::buildVertexData(scene, drawPasses(scene), faults);
+  const std::vector<DrawPass> passes = drawPasses(scene);
+  gl::VertexData data = gl::buildVertexData(scene, passes, faults);
+  // Scenes with polygon offset measure the driver's r first (single-sample frames).
+  const bool probe_offset =
+      samples == 1 && std::any_of(passes.begin(), passes.end(), [](const DrawPass& p) {
+        return p.ops.polygon_offset.has_value();
+      });
+  const auto probe_first = static_cast<GLint>(data.vertices.size());
+  if (probe_offset) appendOffsetProbe(data);
   if (data.vertices.size() > static_cast<std::size_t>(INT32_MAX)) {
     throw BackendError(
         fmt::format("{} vertices exceed what one glDrawArrays can address", data.vertices.size()));
@@ -1370,6 +1439,11 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   start = Clock::now();
   setFixedState(gl, scene);
   if (samples > 1) gl.Enable(GL_MULTISAMPLE);  // multisample rasterization into `ms`
+  std::optional<double> offset_r;
+  if (probe_offset) {
+    clearFramebuffer(gl, scene);
+    offset_r = measureOffsetR(gl, program, scene, probe_first);
+  }
   clearFramebuffer(gl, scene);
   drawPassesGl(gl, program, scene, data, textures, faults);
   resetPassState(gl);
@@ -1398,6 +1472,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["gl_version"] = s.version;
   m["glsl_version"] = s.glsl_version;
   m["subpixel_bits"] = s.subpixel_bits;  // what the comparator's snap band uses
+  if (offset_r) m["polygon_offset_r"] = *offset_r;
   m["gl_subpixel_bits"] = s.gl_subpixel_bits;
   m["subpixel_bits_source"] = s.subpixel_source;
   m["platform"] = s.context->platform();

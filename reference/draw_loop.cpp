@@ -212,6 +212,11 @@ Frame Renderer::run() {
                  {"timing_ms", {{"render", ms}}}};
   if (options_.abuffer && !shift_.active)
     frame_.meta["abuffer"] = abufferMeta(abuffer_, clip_, scene_.height);
+  // The reference's r is the format's minimum resolvable difference (frame.json of a GL
+  // frame has the driver's, measured, in the same unit).
+  if (std::any_of(passes.begin(), passes.end(),
+                  [](const DrawPass& p) { return p.ops.polygon_offset.has_value(); }))
+    frame_.meta["polygon_offset_r"] = 1.0;
   return std::move(frame_);
 }
 
@@ -475,6 +480,7 @@ void Renderer::setUpGeneralFan(TriangleContext& t, const FragmentInterpolator& i
   const glm::dvec2 range = pass.ops.depth_range;
   const double scale = range.y - range.x;  // window z = n + (f - n) z01
   t.offset = 0.0;
+  t.offset_steps = 0.0f;
   double offset_reach = 0.0;  // steps
   if (pass.ops.polygon_offset) {
     // m = max(|dz/dx|, |dz/dy|): the estimate GL allows at the low end, and what Mesa's
@@ -486,6 +492,9 @@ void Renderer::setUpGeneralFan(TriangleContext& t, const FragmentInterpolator& i
     const double r = minimumResolvableDepth(depth_format_, max_z);
     const PolygonOffset& o = *pass.ops.polygon_offset;
     t.offset = m * o.factor + r * o.units;
+    // r is the implementation's: what another r moves the depth by is the comparator's
+    // (offset_steps x the measured spread of r, docs/tolerances.md "Polygon offset").
+    t.offset_steps = static_cast<float>(std::fabs(o.units) * r * depth_steps_);
     offset_reach = std::fabs(o.factor) * (std::fabs(g.x) + std::fabs(g.y) - m) * depth_steps_;
     // d32f: r follows the exponent of the depth, which implementations may take per
     // fragment instead of per polygon.

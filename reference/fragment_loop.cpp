@@ -488,7 +488,8 @@ void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage
         if (!f.stencil_pass) {
           stencil_[index] = applyStencilOp(face->fail, s, face->ref, face->write_mask);
           f.stencil_after = stencil_[index];
-          if (uncertainty_) gaps_.compared(index, z, t.depth_slope, reach, false, false, false);
+          if (uncertainty_)
+            gaps_.compared(index, z, t.depth_slope, reach, t.offset_steps, false, false, false);
           if (trace_ != nullptr) fragmentColor<kShading>(t, f.barycentric, &f.shading);
           traced();
           continue;
@@ -497,7 +498,7 @@ void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage
       const bool depth_pass = compares(pass.depth_func, key, stored);
       f.depth_pass = depth_pass;
       if (uncertainty_)
-        gaps_.compared(index, z, t.depth_slope, reach, tested, pass.blend,
+        gaps_.compared(index, z, t.depth_slope, reach, t.offset_steps, tested, pass.blend,
                        plane_keys_[index] == t.plane_key);
       if (face != nullptr) {
         const StencilOp op = depth_pass ? face->pass : face->depth_fail;

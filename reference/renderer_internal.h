@@ -120,6 +120,7 @@ struct TriangleContext {
   // The general fragment operations (Renderer::general_ops_), of the fan triangle:
   bool front_facing = true;     // the stencil face it uses
   double offset = 0.0;          // polygon offset, window-z units
+  float offset_steps = 0.0f;    // |units| x r in depth-format steps (offset_steps channel)
   std::uint64_t plane_key = 0;  // its depth plane (compared() `invariant`), never 0
 };
 

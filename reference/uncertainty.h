@@ -110,6 +110,7 @@ class UncertaintyTracker {
     texel_reach_ = frame.texel_reach.data();
     shade_reach_ = frame.shade_reach.data();
     normal_reach_ = frame.normal_reach.data();
+    offset_steps_ = frame.offset_steps.data();
     shade_active_ = false;
     normal_active_ = false;
     texel_active_ = false;
@@ -154,9 +155,11 @@ class UncertaintyTracker {
   //    invariance rules make that comparison come out the same in every implementation
   //    (equal-depth multipass), so it counts nowhere.
   //  - storedDepth(): the fragment wrote its depth.
-  void compared(std::size_t index, double z, float slope, float reach, bool tested, bool blended,
-                bool invariant) {
+  // `offset`: the fragment's |units| x r in steps (the offset_steps channel).
+  void compared(std::size_t index, double z, float slope, float reach, float offset, bool tested,
+                bool blended, bool invariant) {
     depth_reach_[index] = std::max(depth_reach_[index], reach);
+    offset_steps_[index] = std::max(offset_steps_[index], offset);
     if (!tested || invariant) return;
     const bool against_clear = std::isinf(stored_z_[index]);
     const float g = toSteps(std::fabs(z - (against_clear ? clear_z_ : stored_z_[index])));
@@ -355,6 +358,7 @@ class UncertaintyTracker {
   float* texel_reach_ = nullptr;
   float* shade_reach_ = nullptr;
   float* normal_reach_ = nullptr;
+  float* offset_steps_ = nullptr;
   // Whether a fragment has had a shade_reach (normal_reach) other than 0 this frame. Until
   // one has, every value of the plane is its initial 0 and every write would store 0 again:
   // they are skipped, so that frames without thin triangles (short normals), most, do not
