@@ -31,6 +31,7 @@
 #include "fixtures/catalog.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
+#include "fixtures/scene_logic.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -57,6 +58,13 @@ MutationScene sceneFacts(const Scene& scene) {
     if (o.mesh.triangles.empty()) continue;
     m.textured = m.textured || mat.texture != nullptr;
     m.blended = m.blended || (scene.state.blend == Blend::Alpha && mat.opacity < 1.0);
+  }
+  for (const DrawPass& p : drawPasses(scene)) {
+    if (p.primitives.empty()) continue;
+    m.depth_tested = m.depth_tested || p.depth_func != DepthFunc::Always;
+    m.stencil = m.stencil || p.ops.stencil.has_value();
+    m.blend_function = m.blend_function || (p.blend && p.blend_function);
+    m.scissor = m.scissor || p.ops.scissor.has_value();
   }
   return m;
 }

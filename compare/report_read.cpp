@@ -260,6 +260,20 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
     ds.stencil.ambiguous = r.count(st, "ambiguous", stat);
     ds.stencil.hard = r.count(st, "hard", stat);
     ds.stencil.worst = r.pixel(st, "worst", stat).value_or(PixelRef{});
+    if (st.contains("worst_expected") && st["worst_expected"].is_number_integer())
+      ds.stencil.worst_expected = st["worst_expected"].get<int>();
+    if (st.contains("worst_actual") && st["worst_actual"].is_number_integer())
+      ds.stencil.worst_actual = st["worst_actual"].get<int>();
+  }
+  if (d.contains("polygon_offset_r") && d["polygon_offset_r"].is_object()) {
+    const json& o = d["polygon_offset_r"];
+    auto value = [&](const char* key) {
+      return o.contains(key) && o[key].is_number() ? o[key].get<double>()
+                                                   : std::numeric_limits<double>::quiet_NaN();
+    };
+    ds.offset_r_expected = value("expected");
+    ds.offset_r_actual = value("actual");
+    ds.offset_r_spread = value("spread");
   }
   ds.histogram = histogramFrom(r, d.contains("histogram") ? d["histogram"] : json(),
                                dat + ".histogram", ds.histogram);

@@ -16,13 +16,18 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::array<MutationFault, 6> kFaults = {{
+constexpr std::array<MutationFault, 10> kFaults = {{
     {"light_scale", "shading", "every light 1% brighter"},
     {"depth_bias", "depth", "stored depth 4 x the fail threshold further (8 d16 / 64 d24 steps)"},
     {"drop_primitive", "visibility", "one visible triangle not drawn"},
     {"move_vertex", "visibility", "one vertex of one visible triangle one pixel right"},
     {"texel_offset", "shading", "textures sampled one texel to the right"},
     {"blend_factor", "shading", "alpha blending with GL_ONE instead of GL_SRC_ALPHA"},
+    {"depth_func", "visibility", "wrong depth function: LESS and GREATER (and the others) swapped"},
+    {"stencil_op", "depth", "stencil op off by one: each op the next in GL's list"},
+    {"blend_function", "shading",
+     "wrong blend factor: each blend function's source factor the next"},
+    {"scissor_shift", "visibility", "scissor box one pixel off (to the right)"},
 }};
 
 constexpr std::array<MutationVerdict, 6> kVerdicts = {
@@ -76,6 +81,10 @@ std::string faultSetting(const MutationFault& fault, const MutationScene& scene,
   if (name == "depth_bias") return scene.depth_format == "d16" ? "depth_bias=8" : "depth_bias=64";
   if (name == "texel_offset") return scene.textured ? "texel_offset=1" : "";
   if (name == "blend_factor") return scene.blended ? "blend_factor=one" : "";
+  if (name == "depth_func") return scene.depth_tested ? "depth_func=inverted" : "";
+  if (name == "stencil_op") return scene.stencil ? "stencil_op=shifted" : "";
+  if (name == "blend_function") return scene.blend_function ? "blend_function=shifted" : "";
+  if (name == "scissor_shift") return scene.scissor ? "scissor_shift=1" : "";
   if (scene.visible_ids.empty()) return "";
   // The same primitive on every run: a stream seeded by (seed, index, fault).
   RandomStream stream(RandomStream::mix(seed) ^ RandomStream::mix(index + 0x632be59bd9b4e019ull) ^

@@ -40,7 +40,9 @@ struct MutationFault {
 };
 
 // light_scale (shading), depth_bias (depth), drop_primitive and move_vertex (visibility),
-// texel_offset and blend_factor (shading).
+// texel_offset and blend_factor (shading); the fragment operations' depth_func (visibility),
+// stencil_op (depth: the stencil buffer is compared in that class), blend_function
+// (shading) and scissor_shift (visibility).
 std::span<const MutationFault> mutationFaults();
 // Throws InputError naming the valid names.
 const MutationFault& mutationFault(const std::string& name);
@@ -51,6 +53,10 @@ struct MutationScene {
   std::string depth_format = "d24";        // d16, d24 or d32f
   bool textured = false;                   // some drawn material has a texture
   bool blended = false;                    // blend alpha with a material of opacity < 1
+  bool depth_tested = false;               // some pass tests depth (a function other than ALWAYS)
+  bool stencil = false;                    // some pass has a stencil test
+  bool blend_function = false;             // some pass blends with the object form of blend
+  bool scissor = false;                    // some pass has a scissor box
 };
 
 // The RASTERCHECK_GL_FAULT value of `fault` for scene `index` of `seed`, e.g.

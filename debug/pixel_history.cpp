@@ -355,7 +355,7 @@ Json pixelHistory(const Scene& scene, const PixelQuery& query, const Frame& fram
         {"draw",
          {{"pass", pass_index},
           {"kind", passKind(scene, pass, options.force_painter)},
-          {"depth_func", pass.depth_func == DepthFunc::Less ? "less" : "always"},
+          {"depth_func", toString(pass.depth_func)},
           {"depth_write", pass.depth_write},
           {"blend", pass.blend}}},
         {"barycentric", vec(f.barycentric)},
@@ -368,12 +368,25 @@ Json pixelHistory(const Scene& scene, const PixelQuery& query, const Frame& fram
                : Json(static_cast<std::uint64_t>(std::nearbyint(f.stored_z * steps_per_unit)))},
           {"format", toString(depth_format)}}},
         {"depth_test",
-         {{"func", pass.depth_func == DepthFunc::Less ? "less" : "always"},
+         {{"func", toString(pass.depth_func)},
           {"result", f.depth_pass ? "pass" : "fail"},
           {"against", num(f.depth_against)},
           {"against_source", depth_source},
           {"write", depth_write}}}};
     j["shading"] = shadingJson(scene, f);
+    // The fragment operations before the depth test, in GL's order (null: not set).
+    const FragmentOps& ops = pass.ops;
+    Json stencil = nullptr;
+    if (f.stencil_before >= 0) {
+      stencil = {{"before", f.stencil_before},
+                 {"result", f.stencil_pass ? "pass" : "fail"},
+                 {"after", f.stencil_after}};
+    }
+    j["ops"] = {{"scissor", ops.scissor ? Json(f.scissor_pass ? "pass" : "fail") : Json(nullptr)},
+                {"stencil", stencil},
+                {"depth_range", {num(ops.depth_range.x), num(ops.depth_range.y)}},
+                {"polygon_offset", ops.polygon_offset ? num(f.offset) : Json(nullptr)},
+                {"color_mask", ops.color_mask}};
     // The buffer as the reference reads it back to blend (rgba8: exactly q / 255) and, in
     // color_after, as frame.exr holds it (a float per channel).
     const glm::dvec4 after = f.color_written;
@@ -385,7 +398,9 @@ Json pixelHistory(const Scene& scene, const PixelQuery& query, const Frame& fram
           {"src", vec(src)},
           {"alpha", num(color_format == ColorFormat::RGBA8 ? ref::clampUnit(src.a) : src.a)},
           {"dst", vec(buffer)},
-          {"result", vec(ref::blendSourceOver(src, buffer, color_format))}};
+          {"result", vec(pass.blend_function ? ref::blendWithFunction(pass.ops.blend_function, src,
+                                                                      buffer, color_format)
+                                             : ref::blendSourceOver(src, buffer, color_format))}};
     } else {
       j["blend"] = nullptr;
     }

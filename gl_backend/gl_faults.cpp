@@ -16,6 +16,7 @@ namespace {
 constexpr const char* kValidFaults =
     "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
     "shader_compile_error, move_vertex=ID, texel_offset=N, blend_factor=one|swapped, "
+    "depth_func=inverted, stencil_op=shifted, blend_function=shifted, scissor_shift=N, "
     "hang=FIXTURE|*, crash=FIXTURE|*";
 
 [[noreturn]] void badFault(std::string_view entry, std::string_view why) {
@@ -40,7 +41,9 @@ T number(std::string_view entry, std::string_view value) {
 bool Faults::any() const {
   return drop_primitive != 0 || depth_bias_steps != 0 || light_scale != 1.0 ||
          no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
-         texel_offset != 0.0 || blend_factor != Blend::Correct || !hang.empty() || !crash.empty();
+         texel_offset != 0.0 || blend_factor != Blend::Correct || depth_func_inverted ||
+         stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || !hang.empty() ||
+         !crash.empty();
 }
 
 bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }
@@ -58,6 +61,10 @@ std::string Faults::describe() const {
   if (texel_offset != 0.0) parts.push_back(fmt::format("texel_offset={}", texel_offset));
   if (blend_factor != Blend::Correct)
     parts.push_back(fmt::format("blend_factor={}", blend_factor == Blend::One ? "one" : "swapped"));
+  if (depth_func_inverted) parts.emplace_back("depth_func=inverted");
+  if (stencil_op_shifted) parts.emplace_back("stencil_op=shifted");
+  if (blend_function_shifted) parts.emplace_back("blend_function=shifted");
+  if (scissor_shift != 0) parts.push_back(fmt::format("scissor_shift={}", scissor_shift));
   if (!hang.empty()) parts.push_back("hang=" + hang);
   if (!crash.empty()) parts.push_back("crash=" + crash);
   return fmt::format("{}", fmt::join(parts, ","));
@@ -77,7 +84,9 @@ Faults parseFaults(std::string_view text) {
     const bool flag = name == "no_inverse_transpose" || name == "shader_compile_error";
     const bool valued = name == "drop_primitive" || name == "depth_bias" || name == "light_scale" ||
                         name == "shift_x" || name == "move_vertex" || name == "texel_offset" ||
-                        name == "blend_factor" || name == "hang" || name == "crash";
+                        name == "blend_factor" || name == "hang" || name == "crash" ||
+                        name == "depth_func" || name == "stencil_op" || name == "blend_function" ||
+                        name == "scissor_shift";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
     if (name == "drop_primitive") {
@@ -102,6 +111,17 @@ Faults parseFaults(std::string_view text) {
       } else {
         badFault(entry, "must be one or swapped");
       }
+    } else if (name == "depth_func") {
+      if (value != "inverted") badFault(entry, "must be inverted");
+      f.depth_func_inverted = true;
+    } else if (name == "stencil_op") {
+      if (value != "shifted") badFault(entry, "must be shifted");
+      f.stencil_op_shifted = true;
+    } else if (name == "blend_function") {
+      if (value != "shifted") badFault(entry, "must be shifted");
+      f.blend_function_shifted = true;
+    } else if (name == "scissor_shift") {
+      f.scissor_shift = number<int>(entry, value);
     } else if (name == "hang" || name == "crash") {
       if (value.empty()) badFault(entry, "needs a fixture name or *");
       (name == "hang" ? f.hang : f.crash) = std::string(value);

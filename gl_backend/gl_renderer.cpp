@@ -842,9 +842,22 @@ GLenum glBlendFactorOf(BlendFactor f) {
   return kFactors.at(static_cast<std::size_t>(f));
 }
 
-void setStencilFace(const gl::Functions& gl, GLenum face, const StencilFace& f) {
+// The test-only faults of the fragment operations (gl_testing.h).
+CompareFunc invertedFunc(CompareFunc f) {
+  constexpr std::array<CompareFunc, 8> kInverted{
+      CompareFunc::Always, CompareFunc::Greater, CompareFunc::NotEqual, CompareFunc::GEqual,
+      CompareFunc::Less,   CompareFunc::Equal,   CompareFunc::LEqual,   CompareFunc::Never};
+  return kInverted.at(static_cast<std::size_t>(f));
+}
+StencilOp shiftedOp(StencilOp op) {
+  return kStencilOps.at((static_cast<std::size_t>(op) + 1) % kStencilOps.size());
+}
+
+void setStencilFace(const gl::Functions& gl, GLenum face, const StencilFace& f,
+                    const gl::testing::Faults& faults) {
+  auto op = [&](StencilOp o) { return glStencilOp(faults.stencil_op_shifted ? shiftedOp(o) : o); };
   gl.StencilFuncSeparate(face, glCompare(f.func), f.ref, f.read_mask);
-  gl.StencilOpSeparate(face, glStencilOp(f.fail), glStencilOp(f.depth_fail), glStencilOp(f.pass));
+  gl.StencilOpSeparate(face, op(f.fail), op(f.depth_fail), op(f.pass));
   gl.StencilMaskSeparate(face, f.write_mask);
 }
 
@@ -859,7 +872,8 @@ void setPassState(const gl::Functions& gl, const DrawPass& pass,
     gl.CullFace(pass.cull == Cull::Back ? GL_BACK : GL_FRONT);
   }
   gl.FrontFace(pass.front_face == FrontFace::CW ? GL_CW : GL_CCW);
-  gl.DepthFunc(glCompare(pass.depth_func));
+  gl.DepthFunc(
+      glCompare(faults.depth_func_inverted ? invertedFunc(pass.depth_func) : pass.depth_func));
   gl.DepthMask(pass.depth_write ? GL_TRUE : GL_FALSE);
   const FragmentOps& ops = pass.ops;
   gl.DepthRange(ops.depth_range.x, ops.depth_range.y);
@@ -872,14 +886,15 @@ void setPassState(const gl::Functions& gl, const DrawPass& pass,
   }
   if (ops.stencil) {
     gl.Enable(GL_STENCIL_TEST);
-    setStencilFace(gl, GL_FRONT, ops.stencil->front);
-    setStencilFace(gl, GL_BACK, ops.stencil->back);
+    setStencilFace(gl, GL_FRONT, ops.stencil->front, faults);
+    setStencilFace(gl, GL_BACK, ops.stencil->back, faults);
   } else {
     gl.Disable(GL_STENCIL_TEST);
   }
   if (ops.scissor) {
     gl.Enable(GL_SCISSOR_TEST);
-    gl.Scissor(ops.scissor->x, ops.scissor->y, ops.scissor->width, ops.scissor->height);
+    gl.Scissor(ops.scissor->x + faults.scissor_shift, ops.scissor->y, ops.scissor->width,
+               ops.scissor->height);
   } else {
     gl.Disable(GL_SCISSOR_TEST);
   }
@@ -894,8 +909,12 @@ void setPassState(const gl::Functions& gl, const DrawPass& pass,
   if (pass.blend_function) {
     const BlendFunction& b = ops.blend_function;
     gl.BlendEquationSeparate(glBlendEquationOf(b.equation), glBlendEquationOf(b.equation_alpha));
-    gl.BlendFuncSeparate(glBlendFactorOf(b.src), glBlendFactorOf(b.dst),
-                         glBlendFactorOf(b.src_alpha), glBlendFactorOf(b.dst_alpha));
+    const BlendFactor src =
+        faults.blend_function_shifted
+            ? kBlendFactors.at((static_cast<std::size_t>(b.src) + 1) % kBlendFactors.size())
+            : b.src;
+    gl.BlendFuncSeparate(glBlendFactorOf(src), glBlendFactorOf(b.dst), glBlendFactorOf(b.src_alpha),
+                         glBlendFactorOf(b.dst_alpha));
     gl.BlendColor(static_cast<GLfloat>(b.constant.r), static_cast<GLfloat>(b.constant.g),
                   static_cast<GLfloat>(b.constant.b), static_cast<GLfloat>(b.constant.a));
   } else {

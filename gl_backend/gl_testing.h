@@ -34,6 +34,18 @@ struct Faults {
   // or src*(1-a) + dst*a, instead of src*a + dst*(1-a).
   enum class Blend { Correct, One, Swapped };
   Blend blend_factor = Blend::Correct;
+  // The fragment operations' classic table errors (the fault is the value's name):
+  // depth_func=inverted: LESS and GREATER, LEQUAL and GEQUAL, EQUAL and NOTEQUAL, NEVER and
+  //   ALWAYS swapped in every pass that sets a depth function;
+  // stencil_op=shifted: every stencil op replaced by the next in GL's list (KEEP -> ZERO ->
+  //   REPLACE -> INCR -> INCR_WRAP -> DECR -> DECR_WRAP -> INVERT -> KEEP);
+  // blend_function=shifted: the colour source factor of every blend function (the object
+  //   form of blend) replaced by the next in the list of kBlendFactors (the last wraps);
+  // scissor_shift=N: every scissor box N pixels to the right.
+  bool depth_func_inverted = false;
+  bool stencil_op_shifted = false;
+  bool blend_function_shifted = false;
+  int scissor_shift = 0;
   // hang=NAME / crash=NAME: the render of the fixture named NAME ("*": every fixture) never
   // returns (blocks after the draw, as a driver stuck in a fence would) or dies with
   // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.

@@ -120,7 +120,7 @@ TEST(FrameIo, ExrHasTheContractChannelsAndTypes) {
   std::vector<std::string> want = {"R", "G", "B", "A", "Z", "id"};
   for (const rc::UncertaintyChannelInfo& info : rc::kUncertaintyChannelInfo)
     want.emplace_back(info.name);
-  ASSERT_EQ(want.size(), 22u);
+  ASSERT_EQ(want.size(), 23u);
   ASSERT_EQ(spec.nchannels, static_cast<int>(want.size()));
   for (const std::string& name : want) {
     const int c = spec.channelindex(name);

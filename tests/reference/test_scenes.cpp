@@ -225,6 +225,7 @@ std::string frameBytes(const Frame& frame) {
   append(out, frame.color);
   append(out, frame.depth);
   append(out, frame.id);
+  append(out, frame.stencil);
   for (const std::vector<float>* c : frame.uncertainty()) append(out, *c);
   return out;
 }
