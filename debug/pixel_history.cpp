@@ -154,12 +154,39 @@ std::string story(const Json& doc) {
             ? ""
             : fmt::format(" ({} steps of {})", fmtNum(d["steps"]), d["format"].get<std::string>()));
     const Json& t = f["depth_test"];
+    // The fragment operations before the depth test, when the scene has them.
+    if (f.contains("ops")) {
+      const Json& ops = f["ops"];
+      if (!ops["scissor"].is_null())
+        s += fmt::format("  scissor test: {}\n", ops["scissor"].get<std::string>());
+      if (ops["scissor"] == "fail") {
+        s += "  outside the scissor box: discarded, nothing written\n";
+        continue;
+      }
+      if (!ops["polygon_offset"].is_null())
+        s += fmt::format("  polygon offset {} added to the window depth\n",
+                         fmtNum(ops["polygon_offset"]));
+      if (!ops["stencil"].is_null()) {
+        const Json& st = ops["stencil"];
+        s += fmt::format("  stencil test against {}: {}, stencil now {}\n", fmtNum(st["before"]),
+                         st["result"].get<std::string>(), fmtNum(st["after"]));
+        if (st["result"] == "fail") {
+          s += "  failed the stencil test: discarded, nothing else written\n";
+          continue;
+        }
+      }
+    }
     const std::string against = t["against_source"] == "clear"
                                     ? fmt::format("the clear depth {}", fmtNum(t["against"]))
                                     : fmt::format("{} (stored by {})", fmtNum(t["against"]),
                                                   t["against_source"].get<std::string>());
-    if (t["func"] == "always") {
+    const std::string func = t["func"].get<std::string>();
+    if (func == "always") {
       s += "  no depth test (ALWAYS)";
+    } else if (func != "less") {
+      s += fmt::format("  {} the depth test ({}) against {}: {} vs {}",
+                       t["result"] == "pass" ? "passed" : "failed", func, against,
+                       fmtNum(d["stored"]), fmtNum(t["against"]));
     } else if (t["result"] == "pass") {
       s += fmt::format("  passed the depth test against {}: {} < {}", against, fmtNum(d["stored"]),
                        fmtNum(t["against"]));

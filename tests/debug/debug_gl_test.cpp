@@ -71,6 +71,11 @@ TEST(DebugGl, ExplainJsonKeysBothWaysIncludingABackendThatCannotRun) {
                         " --pixel 32,24 --json --backends ref:abuffer," + kSoftpipe);
   ASSERT_EQ(ok.code, 0) << ok.err;
   collectKeys(json::parse(ok.out), "", seen);
+  // A stencil test (documented keys fragments[].ops.stencil.*).
+  const Result stencil = run("explain " + catalog("fragment-ops/stencil_portal.json") +
+                             " --pixel 80,60 --json --backends " + kLlvmpipe);
+  ASSERT_EQ(stencil.code, 0) << stencil.err;
+  collectKeys(json::parse(stencil.out), "", seen);
   for (const std::string& k : seen) EXPECT_TRUE(documented.count(k)) << "undocumented key " << k;
   for (const std::string& k : documented) EXPECT_TRUE(seen.count(k)) << "never seen " << k;
 }

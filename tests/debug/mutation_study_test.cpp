@@ -23,7 +23,11 @@ TEST(MutationStudy, TheFaultsAndTheirClasses) {
                                                                    {"drop_primitive", "visibility"},
                                                                    {"move_vertex", "visibility"},
                                                                    {"texel_offset", "shading"},
-                                                                   {"blend_factor", "shading"}}));
+                                                                   {"blend_factor", "shading"},
+                                                                   {"depth_func", "visibility"},
+                                                                   {"stencil_op", "depth"},
+                                                                   {"blend_function", "shading"},
+                                                                   {"scissor_shift", "visibility"}}));
   EXPECT_EQ(std::string(mutationFault("depth_bias").cls), "depth");
   EXPECT_THROW(mutationFault("shift_x"), InputError);
 }
