@@ -3,6 +3,7 @@
 #include "app/variants.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <fstream>
 
@@ -21,13 +22,46 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A quad with polygon offset in a `format` buffer: its GL render measures the driver's r
+// (frame.json polygon_offset_r, docs/gl_backend.md "Polygon offset's r, measured").
+Scene offsetProbe(DepthFormat format) {
+  Scene s;
+  s.name = fmt::format("probe/polygon_offset_{}", toString(format));
+  s.width = 8;
+  s.height = 8;
+  s.camera.projection = Projection::Orthographic;
+  s.camera.eye = {0.0, 0.0, 1.0};
+  s.camera.bounds = {0.0, 8.0, 0.0, 8.0};
+  s.camera.near = 0.5;
+  s.camera.far = 1.5;
+  s.ambient_light = glm::dvec3(1.0);
+  s.materials.push_back(Material{});
+  s.materials.back().name = "default";
+  Object o;
+  o.name = "quad";
+  o.mesh.positions = {{-1, -1, 0}, {9, -1, 0}, {9, 9, 0}, {-1, 9, 0}};
+  o.mesh.normals.assign(4, glm::vec3(0, 0, 1));
+  o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  s.objects.push_back(o);
+  s.state.depth_format = format;
+  s.state.ops.polygon_offset = PolygonOffset{0.0, 1.0};
+  return s;
+}
+
+constexpr std::array kOffsetProbes = {std::pair{"polygon_offset_d16", DepthFormat::D16},
+                                      std::pair{"polygon_offset_d24", DepthFormat::D24},
+                                      std::pair{"polygon_offset_d32f", DepthFormat::D32F}};
+
 // The probes go through a fixture file, like every GL render; the reference renders
 // the file's scene too, so both see exactly the same (float) vertices.
 const std::map<std::string, Scene>& probeScenes() {
-  static const std::map<std::string, Scene> probes = {
-      {"subpixel", variants::subpixelProbe()},
-      {"tie_break", variants::tieBreakProbe().scene},
-      {"depth_rounding", variants::depthProbe().scene}};
+  static const std::map<std::string, Scene> probes = [] {
+    std::map<std::string, Scene> p = {{"subpixel", variants::subpixelProbe()},
+                                      {"tie_break", variants::tieBreakProbe().scene},
+                                      {"depth_rounding", variants::depthProbe().scene}};
+    for (const auto& [name, format] : kOffsetProbes) p[name] = offsetProbe(format);
+    return p;
+  }();
   return probes;
 }
 
@@ -85,6 +119,19 @@ nlohmann::json analyseVariants(const VariantProbes& probes,
       for (const auto& [name, outcome] : got) writeFrameDir(outcome->frame, dir / name);
       v = variants::backendVariants(got.at("subpixel")->frame, got.at("tie_break")->frame,
                                     got.at("depth_rounding")->frame, reference);
+      // Polygon offset's r per depth format, as each render measured it.
+      nlohmann::json r = nlohmann::json::object();
+      for (const auto& [name, format] : kOffsetProbes) {
+        const nlohmann::json& meta = got.at(name)->frame.meta;
+        const auto it = meta.find("polygon_offset_r");
+        r[toString(format)] = it != meta.end() ? *it : nlohmann::json(nullptr);
+        if (it != meta.end() && it->is_number() && it->get<double>() < 1.0)
+          v["findings"].push_back(fmt::format(
+              "polygon offset: r for {} is {} of the format's minimum resolvable difference "
+              "(below 1: an offset of one unit may not separate two depths)",
+              toString(format), it->get<double>()));
+      }
+      v["polygon_offset_r"] = r;
       v["probe_seconds"] = shared_seconds;
     } catch (const InputError& e) {
       v = {{"error", e.what()}};

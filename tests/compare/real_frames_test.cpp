@@ -317,3 +317,66 @@ TEST(Ambiguity, AClearOcclusionErrorIsHard) {
 
 }  // namespace
 }  // namespace rc
+
+namespace rc {
+namespace {
+
+// Blend functions in rgba8 (docs/tolerances.md section 8): every equation's blended pixels
+// carry blend_count; a colour error of the allowance (a unit of final rounding plus
+// blend_rounding_units per blend) passes and one unit more fails, and a cleared pixel is
+// held to a unit. Catalog scenes that blend with additive, constant, saturate, subtract
+// and reverse_subtract functions, and min/max (rgba32f: no per-blend units, the relative
+// term).
+TEST(BlendFunctions, AFaultJustBeyondTheAllowanceFails) {
+  for (const char* rel :
+       {"fragment-ops/blend_constant_saturate.json", "fragment-ops/additive_particles.json"}) {
+    SCOPED_TRACE(rel);
+    const Frame ref = render(catalog(rel));
+    const Tolerances tol = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);
+    // Interior pixels (no edge within the band, no depth tie) with blends on them.
+    std::vector<std::size_t> blended;
+    for (std::size_t i = 0; i < ref.pixelCount(); ++i)
+      if (ref.blend_count[i] >= 1.0f && ref.edge_dist[i] >= 1.0f && ref.blend_gap[i] > 1000.0f &&
+          ref.color[4 * i + 1] < 0.5f)
+        blended.push_back(i);
+    ASSERT_GE(blended.size(), 20u);
+    auto shifted = [&](double extra_units) {
+      Frame gl = ref;
+      gl.meta["backend"] = "gl:test";
+      for (std::size_t i : blended) {
+        const double allowance = 1.0 + tol.blend_rounding_units * ref.blend_count[i];
+        gl.color[4 * i + 1] = static_cast<float>(
+            std::nearbyint(ref.color[4 * i + 1] * 255.0 + allowance + extra_units) / 255.0);
+      }
+      return compareFrames(ref, gl, ref, tol);
+    };
+    EXPECT_EQ(shifted(0.0).shading.over_fail, 0u);
+    EXPECT_EQ(shifted(1.0).shading.over_fail, blended.size());
+  }
+}
+
+TEST(ClearedBuffers, AnUnclearedPixelFailsInItsClass) {
+  const Frame ref = render(catalog("fragment-ops/scissored_out.json"));
+  for (std::uint32_t id : ref.id) ASSERT_EQ(id, 0u);
+  const Tolerances tol = defaultTolerances(DepthFormat::D24, ColorFormat::RGBA8);
+  EXPECT_EQ(compareFrames(ref, ref, ref, tol).status, Status::Pass);
+  Frame depth = ref;
+  depth.depth[5] = 1.0f;  // the clear depth is 0.75: a driver that did not clear depth
+  const PairResult d = compareFrames(ref, depth, ref, tol);
+  EXPECT_EQ(d.depth.status, Status::Fail);
+  EXPECT_EQ(d.depth.cleared_mismatched, 1u);
+  EXPECT_EQ(d.shading.status, Status::Pass);
+  Frame colour = ref;
+  colour.color[4 * 7 + 2] += 2.0f / 255.0f;  // two units: beyond the clear's rounding
+  EXPECT_EQ(compareFrames(ref, colour, ref, tol).shading.cleared_mismatched, 1u);
+  colour.color[4 * 7 + 2] -= 1.0f / 255.0f;  // one unit: rounding of the clear colour
+  EXPECT_EQ(compareFrames(ref, colour, ref, tol).shading.status, Status::Pass);
+  Frame stencil = ref;
+  stencil.stencil[9] = 8;  // clear.stencil is 7
+  const PairResult s = compareFrames(ref, stencil, ref, tol);
+  EXPECT_EQ(s.depth.stencil.hard, 1u);
+  EXPECT_EQ(s.depth.status, Status::Fail);
+}
+
+}  // namespace
+}  // namespace rc
