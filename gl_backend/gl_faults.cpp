@@ -17,6 +17,7 @@ constexpr const char* kValidFaults =
     "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
     "shader_compile_error, move_vertex=ID, texel_offset=N, blend_factor=one|swapped, "
     "depth_func=inverted, stencil_op=shifted, blend_function=shifted, scissor_shift=N, "
+    "lod_shift=N, "
     "hang=FIXTURE|*, crash=FIXTURE|*";
 
 [[noreturn]] void badFault(std::string_view entry, std::string_view why) {
@@ -42,7 +43,8 @@ bool Faults::any() const {
   return drop_primitive != 0 || depth_bias_steps != 0 || light_scale != 1.0 ||
          no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
          texel_offset != 0.0 || blend_factor != Blend::Correct || depth_func_inverted ||
-         stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || !hang.empty() ||
+         stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 ||
+         !hang.empty() ||
          !crash.empty();
 }
 
@@ -65,6 +67,7 @@ std::string Faults::describe() const {
   if (stencil_op_shifted) parts.emplace_back("stencil_op=shifted");
   if (blend_function_shifted) parts.emplace_back("blend_function=shifted");
   if (scissor_shift != 0) parts.push_back(fmt::format("scissor_shift={}", scissor_shift));
+  if (lod_shift != 0.0) parts.push_back(fmt::format("lod_shift={}", lod_shift));
   if (!hang.empty()) parts.push_back("hang=" + hang);
   if (!crash.empty()) parts.push_back("crash=" + crash);
   return fmt::format("{}", fmt::join(parts, ","));
@@ -86,7 +89,7 @@ Faults parseFaults(std::string_view text) {
                         name == "shift_x" || name == "move_vertex" || name == "texel_offset" ||
                         name == "blend_factor" || name == "hang" || name == "crash" ||
                         name == "depth_func" || name == "stencil_op" || name == "blend_function" ||
-                        name == "scissor_shift";
+                        name == "scissor_shift" || name == "lod_shift";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
     if (name == "drop_primitive") {
@@ -122,6 +125,8 @@ Faults parseFaults(std::string_view text) {
       f.blend_function_shifted = true;
     } else if (name == "scissor_shift") {
       f.scissor_shift = number<int>(entry, value);
+    } else if (name == "lod_shift") {
+      f.lod_shift = number<double>(entry, value);
     } else if (name == "hang" || name == "crash") {
       if (value.empty()) badFault(entry, "needs a fixture name or *");
       (name == "hang" ? f.hang : f.crash) = std::string(value);

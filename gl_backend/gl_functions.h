@@ -98,6 +98,7 @@ namespace rc::gl {
   X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                                             \
   X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                                   \
   X(PFNGLTEXPARAMETERIPROC, TexParameteri)                                             \
+  X(PFNGLTEXPARAMETERFPROC, TexParameterf)                                             \
   X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                           \
   X(PFNGLDRAWARRAYSPROC, DrawArrays)                                                   \
   X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)                                         \

@@ -28,6 +28,7 @@
 
 #include "fixtures/errors.h"
 #include "fixtures/multisample.h"
+#include "fixtures/mipmaps.h"
 #include "fixtures/scene_logic.h"
 #include "gl_backend/context.h"
 #include "gl_backend/gl_backend.h"
@@ -697,18 +698,33 @@ void uploadVertices(RenderObjects& o, const gl::VertexData& data) {
 }
 
 // One GL texture per distinct rc::Texture; returns the name for each material (0: none).
-std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max_texture_size) {
+std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max_texture_size,
+                                   const gl::testing::Faults& faults) {
   const gl::Functions& gl = o.gl;
   std::map<const Texture*, GLuint> by_texture;
   std::vector<GLuint> per_material(scene.materials.size(), 0);
-  const GLint filter = scene.state.texture_filter == TextureFilter::Linear ? GL_LINEAR : GL_NEAREST;
-  const GLint wrap = scene.state.texture_wrap == TextureWrap::Clamp ? GL_CLAMP_TO_EDGE : GL_REPEAT;
+  const RenderState& st = scene.state;
+  constexpr std::array<GLint, 6> kMinFilters{GL_NEAREST,
+                                             GL_LINEAR,
+                                             GL_NEAREST_MIPMAP_NEAREST,
+                                             GL_LINEAR_MIPMAP_NEAREST,
+                                             GL_NEAREST_MIPMAP_LINEAR,
+                                             GL_LINEAR_MIPMAP_LINEAR};
+  const GLint min_filter = kMinFilters.at(static_cast<std::size_t>(minFilter(st)));
+  const GLint mag_filter = magFilter(st) == TextureFilter::Linear ? GL_LINEAR : GL_NEAREST;
+  const GLint wrap = st.texture_wrap == TextureWrap::Clamp            ? GL_CLAMP_TO_EDGE
+                     : st.texture_wrap == TextureWrap::MirroredRepeat ? GL_MIRRORED_REPEAT
+                                                                      : GL_REPEAT;
+  // Every level of the chain both renderers sample (fixtures/mipmaps.h) when the level of
+  // detail matters; level 0 alone otherwise, as before.
+  const bool levels = lodSampling(st);
   gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
   gl.ActiveTexture(GL_TEXTURE0);
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
     const Texture* t = scene.materials[m].texture.get();
     if (t == nullptr) continue;
-    if (auto it = by_texture.find(t); it != by_texture.end()) {
+    const bool explicit_levels = !scene.materials[m].texture_levels.empty();
+    if (auto it = by_texture.find(t); it != by_texture.end() && !explicit_levels) {
       per_material[m] = it->second;
       continue;
     }
@@ -721,14 +737,29 @@ std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max
     o.textures.push_back(name);
     gl.BindTexture(GL_TEXTURE_2D, name);
     // Row 0 of rc::Texture is v = 0, which is also GL's first row: no flip.
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, t->width, t->height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                  t->rgba.data());
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    const std::vector<std::shared_ptr<const Texture>> chain =
+        levels ? mipChain(scene.materials[m]) : std::vector<std::shared_ptr<const Texture>>{};
+    if (levels) {
+      for (std::size_t k = 0; k < chain.size(); ++k)
+        gl.TexImage2D(GL_TEXTURE_2D, static_cast<GLint>(k), GL_RGBA8, chain[k]->width,
+                      chain[k]->height, 0, GL_RGBA, GL_UNSIGNED_BYTE, chain[k]->rgba.data());
+    } else {
+      gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, t->width, t->height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                    t->rgba.data());
+    }
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, levels ? min_filter : mag_filter);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, mag_filter);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL,
+                     levels ? static_cast<GLint>(chain.size()) - 1 : 0);
+    if (levels) {
+      gl.TexParameterf(GL_TEXTURE_2D, GL_TEXTURE_LOD_BIAS,
+                       static_cast<GLfloat>(st.lod_bias + faults.lod_shift));
+      gl.TexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MIN_LOD, static_cast<GLfloat>(st.min_lod));
+      gl.TexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_LOD, static_cast<GLfloat>(st.max_lod));
+    }
     by_texture.emplace(t, name);
     per_material[m] = name;
   }
@@ -1448,7 +1479,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   RenderObjects objects(gl);
   uploadVertices(objects, data);
   const std::vector<GLuint> textures =
-      uploadTextures(objects, scene, glInteger(gl, GL_MAX_TEXTURE_SIZE));
+      uploadTextures(objects, scene, glInteger(gl, GL_MAX_TEXTURE_SIZE), faults);
   setSceneUniforms(gl, program, scene, faults);
   if (gl::testing::hooks().gl_error_after_upload) gl.Enable(0xFFFFu);  // not a capability
   checkGl(s, "upload");

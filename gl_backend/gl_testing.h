@@ -46,6 +46,9 @@ struct Faults {
   bool stencil_op_shifted = false;
   bool blend_function_shifted = false;
   int scissor_shift = 0;
+  // lod_shift=N: every mipmapped texture's level of detail N higher (GL_TEXTURE_LOD_BIAS
+  // + N): a level of detail off by N levels.
+  double lod_shift = 0.0;
   // hang=NAME / crash=NAME: the render of the fixture named NAME ("*": every fixture) never
   // returns (blocks after the draw, as a driver stuck in a fence would) or dies with
   // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.

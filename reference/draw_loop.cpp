@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "fixtures/big_buffer.h"
+#include "fixtures/mipmaps.h"
 #include "fixtures/scene_geometry.h"
 #include "reference/fragment_ops.h"
 #include "reference/prefetch.h"
@@ -62,7 +63,17 @@ Renderer::Renderer(const Scene& scene, const ReferenceOptions& options, const Pi
       edges_(t_scratch.edges),
       windows_(t_scratch.windows),
       piece_(t_scratch.piece),
-      shift_(shift) {
+      shift_(shift),
+      lod_(lodSampling(scene.state)),
+      lod_state_(lodState(scene.state)) {
+  if (lod_) {
+    for (const Material& m : scene.materials) {
+      chain_storage_.push_back(mipChain(m));
+      std::vector<const Texture*> chain;
+      for (const auto& level : chain_storage_.back()) chain.push_back(level.get());
+      chains_.push_back(std::move(chain));
+    }
+  }
   shading_.reserve(scene.materials.size());
   for (const Material& m : scene.materials) shading_.push_back(prepareShading(lighting_, m));
   // prepareTriangle()'s colour of an unlit, untextured, unblended flat triangle: one per
@@ -226,6 +237,7 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
   t.material = &scene_.materials[obj.material];
   t.shading = &shading_[obj.material];
   t.texture = t.material->texture.get();
+  t.chain = lod_ && t.texture != nullptr ? &chains_[obj.material] : nullptr;
   for (int k = 0; k < 3; ++k) {
     t.v[k] = &vertices_[t.prim->object][tri[k]];
     if (scene_.state.shading == Shading::Gouraud) t.gouraud[k] = &gouraud_[t.prim->object][tri[k]];

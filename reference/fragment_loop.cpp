@@ -156,8 +156,12 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   glm::dvec2 uv(0.0);
   if (t.texture) {
     uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
-    tex = glm::dvec3(
-        sampleTexture(*t.texture, uv, scene_.state.texture_filter, scene_.state.texture_wrap));
+    if (t.chain != nullptr && interp != nullptr && row != nullptr) {
+      tex = glm::dvec3(lodTexel(t, uv, b, *interp, *row, dx));
+    } else {
+      tex = glm::dvec3(
+          sampleTexture(*t.texture, uv, scene_.state.texture_filter, scene_.state.texture_wrap));
+    }
   }
   LitColor lit;
   if constexpr (kShading == Shading::Flat) {
@@ -216,6 +220,26 @@ void Renderer::traceTerms(const TriangleContext& t, const glm::dvec3& b,
     terms.lights[i].specular = b.x * vt[0].lights[i].specular + b.y * vt[1].lights[i].specular +
                                b.z * vt[2].lights[i].specular;
   }
+}
+
+void Renderer::uvDerivatives(const TriangleContext& t, const FragmentInterpolator& interp,
+                             const FragmentInterpolator::Row& row, double dx, const glm::dvec3& b,
+                             glm::dvec2& d_dx, glm::dvec2& d_dy) const {
+  glm::dvec3 db[2];
+  interp.barycentricGradient(row, dx, b, db);
+  const glm::dvec2 size(t.texture->width, t.texture->height);
+  d_dx = (db[0].x * t.v[0]->uv + db[0].y * t.v[1]->uv + db[0].z * t.v[2]->uv) * size;
+  d_dy = (db[1].x * t.v[0]->uv + db[1].y * t.v[1]->uv + db[1].z * t.v[2]->uv) * size;
+}
+
+glm::dvec4 Renderer::lodTexel(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+                              const FragmentInterpolator& interp,
+                              const FragmentInterpolator::Row& row, double dx) const {
+  glm::dvec2 d_dx;
+  glm::dvec2 d_dy;
+  uvDerivatives(t, interp, row, dx, b, d_dx, d_dy);
+  const double lambda = lodOf(scaleFactor(d_dx, d_dy), lod_state_);
+  return sampleAtLod(*t.chain, uv, lambda, lod_state_).color;
 }
 
 glm::dvec4 Renderer::storedColor(std::size_t index) const {
@@ -490,7 +514,8 @@ void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage
           f.stencil_after = stencil_[index];
           if (uncertainty_)
             gaps_.compared(index, z, t.depth_slope, reach, t.offset_steps, false, false, false);
-          if (trace_ != nullptr) fragmentColor<kShading>(t, f.barycentric, &f.shading);
+          if (trace_ != nullptr)
+            fragmentColor<kShading>(t, f.barycentric, &f.shading, nullptr, &interp, &row, dx);
           traced();
           continue;
         }
@@ -506,7 +531,8 @@ void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage
         f.stencil_after = stencil_[index];
       }
       if (!depth_pass) {
-        if (trace_ != nullptr) fragmentColor<kShading>(t, f.barycentric, &f.shading);
+        if (trace_ != nullptr)
+          fragmentColor<kShading>(t, f.barycentric, &f.shading, nullptr, &interp, &row, dx);
         traced();
         continue;
       }
@@ -608,7 +634,9 @@ void Renderer::traceSpans(const TriangleContext& t, const TriangleCoverage& cove
       f.stored_z = storedDepth(key, depth_format_);
       f.depth_pass = pass;
       f.depth_against = storedDepth(against, depth_format_);
-      const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading);
+      const FragmentInterpolator::Row trace_row = interp.row(cy);
+      const glm::dvec4 color = fragmentColor<kShading>(t, f.barycentric, &f.shading, nullptr,
+                                                       &interp, &trace_row, interp.dx(cx));
       if (pass) {
         if (t.pass->depth_write) depth_[index] = key;
         if (t.pass->blend && defer_blends_) {

@@ -52,6 +52,16 @@ class FragmentInterpolator {
     return r;
   }
   double dx(double x) const { return x - x0_; }
+  // The row `oy` px above or below r (the uncertainty channels' neighbourhood: not
+  // bit-identical to row(y + oy), which sums in another order).
+  Row shiftedRow(const Row& r, double oy) const {
+    Row s = r;
+    s.z += z_.ddy * oy;
+    s.inv_w += inv_w_.ddy * oy;
+    for (int k = 0; k < 3; ++k) s.num[k] += num_[k].ddy * oy;
+    s.w = 1.0 / s.inv_w;
+    return s;
+  }
   double depthAt(const Row& r, double dx) const { return r.z + z_.ddx * dx; }
   glm::dvec3 barycentricAt(const Row& r, double dx) const {
     // The row's quotient where the denominator equals the row's (always, for an affine

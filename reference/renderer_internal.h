@@ -29,6 +29,7 @@
 #include "reference/rasterizer.h"
 #include "reference/reference_renderer.h"
 #include "reference/shading.h"
+#include "reference/texture_lod.h"
 #include "reference/uncertainty.h"
 #include "reference/vertex_stage.h"
 #include "reference/vertex_windows.h"
@@ -94,6 +95,8 @@ struct TriangleContext {
   const Material* material = nullptr;
   const PreparedShading* shading = nullptr;
   const Texture* texture = nullptr;
+  // Level-of-detail sampling (Renderer::lod_): the material's mip chain, level 0 first.
+  const std::vector<const Texture*>* chain = nullptr;
   const TransformedVertex* v[3] = {nullptr, nullptr, nullptr};
   const LitColor* gouraud[3] = {nullptr, nullptr, nullptr};  // per original vertex
   glm::dvec3 centroid{0.0};     // flat: world-space centroid of the original triangle
@@ -252,6 +255,19 @@ class Renderer {
                       const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
                       const FragmentInterpolator::Row& row, double dx) const;
   void traceTerms(const TriangleContext& t, const glm::dvec3& b, ShadingTerms& terms) const;
+  // Level-of-detail sampling: the texture coordinate's derivatives (level-0 texels per px)
+  // at the fragment, and the sample.
+  void uvDerivatives(const TriangleContext& t, const FragmentInterpolator& interp,
+                     const FragmentInterpolator::Row& row, double dx, const glm::dvec3& b,
+                     glm::dvec2& d_dx, glm::dvec2& d_dy) const;
+  glm::dvec4 lodTexel(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+                      const FragmentInterpolator& interp, const FragmentInterpolator::Row& row,
+                      double dx) const;
+  // The texel note of a level-of-detail fragment (renderer_uncertainty.cpp).
+  TexelNote lodNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+                    const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
+                    const FragmentInterpolator::Row& row, double dx, double reach_s,
+                    double reach_t) const;
   void writeColor(std::size_t index, const glm::dvec4& src, bool blend);
   // The general fragment operations (fragment_loop.cpp): scissor, stencil, depth (with
   // range and offset), blending, colour mask, in GL's order, every fragment through
@@ -298,6 +314,11 @@ class Renderer {
   std::vector<std::vector<VertexWindow>>& windows_;  // per object, per vertex, scratch
   std::vector<TransformedVertex>& piece_;            // transformVertices(), scratch
   const SampleShift shift_;                          // multisampling: the sample drawn
+  // Level-of-detail sampling (fixtures/scene.h lodSampling()): each material's mip chain.
+  const bool lod_;
+  const LodState lod_state_;
+  std::vector<std::vector<std::shared_ptr<const Texture>>> chain_storage_;
+  std::vector<std::vector<const Texture*>> chains_;
   // prefetchRows(): the first vertex of the last triangle it saw.
   double prefetch_x_ = -1e9;
   double prefetch_y_ = -1e9;

@@ -261,6 +261,15 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
   tt.gradient = h * std::hypot(glm::dot(db[0], v), glm::dot(db[1], v));
   tt.reach = kTexelCoordinateReach *
              (h * std::max(std::fabs(uv.y), t.uq_max.y / std::fabs(q)) + tt.gradient * image);
+  if (t.chain != nullptr) {
+    // Level of detail: the colour range over every lambda and sample position a legal
+    // implementation may use (lodNote()), always within reach (texel_dist 0).
+    TexelNote lod = lodNote(t, uv, b, ambient_diffuse, interp, row, dx,
+                            s.reach + kSnapDisagreementPx * s.gradient,
+                            tt.reach + kSnapDisagreementPx * tt.gradient);
+    lod.gain = note.gain;
+    return lod;
+  }
   if (scene_.state.texture_filter == TextureFilter::Linear) {
     // Where float32 interpolation may move the sample (reach, texels), the filter may
     // read any footprint within it: the colour range over all of them.
@@ -280,6 +289,74 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
     for (int c = 0; c < 3; ++c)
       alt = std::max(alt, std::fabs(ambient_diffuse[c] * (choice.alt[k][c] - choice.chosen[c])));
   note.alt = static_cast<float>(255.0 * alt * weight);
+  return note;
+}
+
+}  // namespace rc::ref
+
+namespace rc::ref {
+
+// The freedom GL gives level-of-detail sampling, as a colour range (docs/tolerances.md
+// "Level of detail"): the scale factor may be any f with max(mu, mv) <= f <= mu + mv (mu,
+// mv the largest |derivative| of u and of v), from derivatives a driver may take anywhere
+// in its 2x2 quad (a finite difference across a pixel is the derivative somewhere within
+// it: the fragment's and its eight neighbours' exact derivatives bound them), lambda in
+// fixed point (1/32 either way), and the sample may move by its float32 reach and by a
+// filter weight quantised to 8 bits (1/256 texel of the coarsest level read). The note's
+// texel_alt is the lit colour range over that lambda interval and those positions
+// (lodRange()) plus a unit for the 8-bit filtered texel; texel_dist 0 (always within).
+TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+                            const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
+                            const FragmentInterpolator::Row& row, double dx, double reach_s,
+                            double reach_t) const {
+  (void)b;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo[4] = {kInf, kInf, kInf, kInf};  // |ux|, |vx|, |uy|, |vy|
+  double hi[4] = {0.0, 0.0, 0.0, 0.0};
+  for (int oy = -1; oy <= 1; ++oy) {
+    const FragmentInterpolator::Row r = oy == 0 ? row : interp.shiftedRow(row, oy);
+    for (int ox = -1; ox <= 1; ++ox) {
+      const glm::dvec3 bb = interp.barycentricAt(r, dx + ox);
+      glm::dvec2 d_dx;
+      glm::dvec2 d_dy;
+      uvDerivatives(t, interp, r, dx + ox, bb, d_dx, d_dy);
+      const double v[4] = {std::fabs(d_dx.x), std::fabs(d_dx.y), std::fabs(d_dy.x),
+                           std::fabs(d_dy.y)};
+      for (int k = 0; k < 4; ++k) {
+        if (std::isnan(v[k])) continue;
+        lo[k] = std::min(lo[k], v[k]);
+        hi[k] = std::max(hi[k], v[k]);
+      }
+    }
+  }
+  const double rho_lo = std::max(std::max(lo[0], lo[2]), std::max(lo[1], lo[3]));
+  const double rho_hi = std::max(hi[0], hi[2]) + std::max(hi[1], hi[3]);
+  constexpr double kLodPrecision = 1.0 / 32.0;
+  const double bias = std::clamp(lod_state_.bias, -kMaxLodBias, kMaxLodBias);
+  auto clampLod = [&](double l) {
+    if (std::isnan(l)) l = lod_state_.min_lod;
+    return std::clamp(l, lod_state_.min_lod, lod_state_.max_lod);
+  };
+  const double lambda_lo = clampLod(std::log2(rho_lo) + bias - kLodPrecision);
+  const double lambda_hi = clampLod(std::log2(rho_hi) + bias + kLodPrecision);
+  const std::vector<const Texture*>& chain = *t.chain;
+  const int q = static_cast<int>(chain.size()) - 1;
+  const int coarsest = std::clamp(static_cast<int>(std::ceil(lambda_hi)), 0, q);
+  const glm::dvec2 shift(
+      reach_s / chain[0]->width + 1.0 / (256.0 * chain[static_cast<std::size_t>(coarsest)]->width),
+      reach_t / chain[0]->height +
+          1.0 / (256.0 * chain[static_cast<std::size_t>(coarsest)]->height));
+  const glm::dvec4 range = lodRange(chain, uv, lambda_lo, lambda_hi, shift, lod_state_);
+  const double weight = blendWeight(t);
+  double alt = 0.0;
+  double light = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    alt = std::max(alt, std::fabs(ambient_diffuse[c] * range[c]));
+    light = std::max(light, ambient_diffuse[c]);
+  }
+  TexelNote note;
+  note.dist = 0.0f;
+  note.alt = static_cast<float>(weight * (255.0 * alt + light));
   return note;
 }
 

@@ -25,6 +25,13 @@ const std::array<double, 256>& unorm8Table() {
 int wrapIndex(double floored, int size, TextureWrap wrap) {
   if (!std::isfinite(floored)) return 0;
   if (wrap == TextureWrap::Clamp) return static_cast<int>(std::clamp(floored, 0.0, size - 1.0));
+  if (wrap == TextureWrap::MirroredRepeat) {
+    // Period 2 size: indices size .. 2 size - 1 mirror back onto size - 1 .. 0.
+    const double period = 2.0 * size;
+    const double m = floored - period * std::floor(floored / period);
+    const int k = std::clamp(static_cast<int>(m), 0, 2 * size - 1);
+    return k < size ? k : 2 * size - 1 - k;
+  }
   const double m = floored - size * std::floor(floored / size);  // floor-mod, in [0, size]
   return std::clamp(static_cast<int>(m), 0, size - 1);           // m == size only by rounding
 }

@@ -4,7 +4,8 @@
 //   nearest: i = floor(u * W);
 //   linear:  u * W - 0.5 = i0 + a (i0 = floor), taps i0 and i0 + 1 weighted 1 - a and a,
 //            the same in v, four taps;
-//   wrap:    repeat = floor-mod W, clamp = clamp-to-edge (index clamped to [0, W - 1]).
+//   wrap:    repeat = floor-mod W, clamp = clamp-to-edge (index clamped to [0, W - 1]),
+//            mirrored repeat = floor-mod 2W, indices W .. 2W - 1 read 2W - 1 - index.
 // In double. A non-finite coordinate samples texel 0 (GL leaves it undefined).
 #pragma once
 
