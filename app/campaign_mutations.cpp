@@ -58,6 +58,7 @@ MutationScene sceneFacts(const Scene& scene) {
     if (o.mesh.triangles.empty()) continue;
     m.textured = m.textured || mat.texture != nullptr;
     m.blended = m.blended || (scene.state.blend == Blend::Alpha && mat.opacity < 1.0);
+    m.lod = m.lod || (mat.texture != nullptr && lodSampling(scene.state));
   }
   for (const DrawPass& p : drawPasses(scene)) {
     if (p.primitives.empty()) continue;

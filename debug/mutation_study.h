@@ -42,7 +42,8 @@ struct MutationFault {
 // light_scale (shading), depth_bias (depth), drop_primitive and move_vertex (visibility),
 // texel_offset and blend_factor (shading); the fragment operations' depth_func (visibility),
 // stencil_op (depth: the stencil buffer is compared in that class), blend_function
-// (shading) and scissor_shift (visibility).
+// (shading) and scissor_shift (visibility); lod_shift (shading) for textures sampled with a
+// level of detail.
 std::span<const MutationFault> mutationFaults();
 // Throws InputError naming the valid names.
 const MutationFault& mutationFault(const std::string& name);
@@ -57,6 +58,7 @@ struct MutationScene {
   bool stencil = false;                    // some pass has a stencil test
   bool blend_function = false;             // some pass blends with the object form of blend
   bool scissor = false;                    // some pass has a scissor box
+  bool lod = false;  // textured, sampled with a level of detail (fixtures/scene.h lodSampling())
 };
 
 // The RASTERCHECK_GL_FAULT value of `fault` for scene `index` of `seed`, e.g.

@@ -44,8 +44,7 @@ bool Faults::any() const {
          no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
          texel_offset != 0.0 || blend_factor != Blend::Correct || depth_func_inverted ||
          stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 ||
-         !hang.empty() ||
-         !crash.empty();
+         !hang.empty() || !crash.empty();
 }
 
 bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }

@@ -27,8 +27,8 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "fixtures/errors.h"
-#include "fixtures/multisample.h"
 #include "fixtures/mipmaps.h"
+#include "fixtures/multisample.h"
 #include "fixtures/scene_logic.h"
 #include "gl_backend/context.h"
 #include "gl_backend/gl_backend.h"

@@ -160,7 +160,7 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
       tex = glm::dvec3(lodTexel(t, uv, b, *interp, *row, dx));
     } else {
       tex = glm::dvec3(
-          sampleTexture(*t.texture, uv, scene_.state.texture_filter, scene_.state.texture_wrap));
+          sampleTexture(*t.texture, uv, magFilter(scene_.state), scene_.state.texture_wrap));
     }
   }
   LitColor lit;

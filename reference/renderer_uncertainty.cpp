@@ -103,7 +103,7 @@ void Renderer::setUpFanChannels(TriangleContext& t, const FragmentInterpolator& 
     }
     t.den_grad = interp.denominatorGradient();
   }
-  if (t.texel_choice && scene_.state.texture_filter == TextureFilter::Linear)
+  if (t.texel_choice && magFilter(scene_.state) == TextureFilter::Linear)
     t.texture_range = textureRangeOf(t.texture);
   if (t.texel_choice) {
     t.uq_max = glm::dvec2(0.0);
@@ -270,7 +270,7 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
     lod.gain = note.gain;
     return lod;
   }
-  if (scene_.state.texture_filter == TextureFilter::Linear) {
+  if (magFilter(scene_.state) == TextureFilter::Linear) {
     // Where float32 interpolation may move the sample (reach, texels), the filter may
     // read any footprint within it: the colour range over all of them.
     const glm::dvec4 range = linearReachRange(*t.texture, uv, scene_.state.texture_wrap, s.reach,
@@ -311,11 +311,12 @@ TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv, cons
                             double reach_t) const {
   (void)b;
   constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr int kLodReachPx = 1;            // a quad's finite differences: within a pixel
   double lo[4] = {kInf, kInf, kInf, kInf};  // |ux|, |vx|, |uy|, |vy|
   double hi[4] = {0.0, 0.0, 0.0, 0.0};
-  for (int oy = -1; oy <= 1; ++oy) {
+  for (int oy = -kLodReachPx; oy <= kLodReachPx; ++oy) {
     const FragmentInterpolator::Row r = oy == 0 ? row : interp.shiftedRow(row, oy);
-    for (int ox = -1; ox <= 1; ++ox) {
+    for (int ox = -kLodReachPx; ox <= kLodReachPx; ++ox) {
       const glm::dvec3 bb = interp.barycentricAt(r, dx + ox);
       glm::dvec2 d_dx;
       glm::dvec2 d_dy;
@@ -337,8 +338,11 @@ TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv, cons
     if (std::isnan(l)) l = lod_state_.min_lod;
     return std::clamp(l, lod_state_.min_lod, lod_state_.max_lod);
   };
-  const double lambda_lo = clampLod(std::log2(rho_lo) + bias - kLodPrecision);
-  const double lambda_hi = clampLod(std::log2(rho_hi) + bias + kLodPrecision);
+  // The precision applies after the clamps too: a lambda clamped to max_lod = 3.5 sits on
+  // a nearest-mip boundary that llvmpipe rounds up (level 4) where the spec's formula
+  // gives level 3 (campaign s20261295 scene 00165, mipmap profile).
+  const double lambda_lo = clampLod(std::log2(rho_lo) + bias) - kLodPrecision;
+  const double lambda_hi = clampLod(std::log2(rho_hi) + bias) + kLodPrecision;
   const std::vector<const Texture*>& chain = *t.chain;
   const int q = static_cast<int>(chain.size()) - 1;
   const int coarsest = std::clamp(static_cast<int>(std::ceil(lambda_hi)), 0, q);

@@ -42,8 +42,8 @@ double lodOf(double rho, const LodState& s) {
   return std::clamp(lambda, s.min_lod, s.max_lod);
 }
 
-LodSample sampleAtLod(const std::vector<const Texture*>& chain, const glm::dvec2& uv,
-                      double lambda, const LodState& s) {
+LodSample sampleAtLod(const std::vector<const Texture*>& chain, const glm::dvec2& uv, double lambda,
+                      const LodState& s) {
   LodSample out;
   if (lambda <= switchPoint(s) || !mipmapped(s.min)) {
     out.magnified = lambda <= switchPoint(s);
@@ -73,8 +73,10 @@ LodSample sampleAtLod(const std::vector<const Texture*>& chain, const glm::dvec2
   out.level0 = static_cast<int>(d1);
   out.level1 = out.level0 + 1;
   out.weight = lambda - d1;
-  const glm::dvec4 t1 = sampleTexture(*chain[static_cast<std::size_t>(out.level0)], uv, filter, s.wrap);
-  const glm::dvec4 t2 = sampleTexture(*chain[static_cast<std::size_t>(out.level1)], uv, filter, s.wrap);
+  const glm::dvec4 t1 =
+      sampleTexture(*chain[static_cast<std::size_t>(out.level0)], uv, filter, s.wrap);
+  const glm::dvec4 t2 =
+      sampleTexture(*chain[static_cast<std::size_t>(out.level1)], uv, filter, s.wrap);
   out.color = (1.0 - out.weight) * t1 + out.weight * t2;
   return out;
 }
@@ -97,8 +99,8 @@ glm::dvec4 lodRange(const std::vector<const Texture*>& chain, const glm::dvec2& 
   }
   glm::dvec4 mn(std::numeric_limits<double>::infinity());
   glm::dvec4 mx(-std::numeric_limits<double>::infinity());
-  const glm::dvec2 offsets[5] = {{0.0, 0.0}, {shift.x, 0.0}, {-shift.x, 0.0}, {0.0, shift.y},
-                                 {0.0, -shift.y}};
+  const glm::dvec2 offsets[5] = {
+      {0.0, 0.0}, {shift.x, 0.0}, {-shift.x, 0.0}, {0.0, shift.y}, {0.0, -shift.y}};
   for (double lambda : lambdas) {
     if (!std::isfinite(lambda)) continue;
     for (const glm::dvec2& o : offsets) {

@@ -49,8 +49,8 @@ struct LodSample {
   int level1 = 0;
   double weight = 0.0;  // of level1
 };
-LodSample sampleAtLod(const std::vector<const Texture*>& chain, const glm::dvec2& uv,
-                      double lambda, const LodState& s);
+LodSample sampleAtLod(const std::vector<const Texture*>& chain, const glm::dvec2& uv, double lambda,
+                      const LodState& s);
 
 // Per channel, the largest minus the smallest texel value any lambda in [lo, hi] and any
 // sample position within `shift` (uv units, per axis) of uv gives: lambda at the ends of the

@@ -27,7 +27,8 @@ TEST(MutationStudy, TheFaultsAndTheirClasses) {
                                                                    {"depth_func", "visibility"},
                                                                    {"stencil_op", "depth"},
                                                                    {"blend_function", "shading"},
-                                                                   {"scissor_shift", "visibility"}}));
+                                                                   {"scissor_shift", "visibility"},
+                                                                   {"lod_shift", "shading"}}));
   EXPECT_EQ(std::string(mutationFault("depth_bias").cls), "depth");
   EXPECT_THROW(mutationFault("shift_x"), InputError);
 }
