@@ -59,6 +59,19 @@ Json shadingJson(const Scene& scene, const FragmentTrace& f) {
                    {"specular", vec(p.specular)}});
   }
   j["points"] = pts;
+  // Level-of-detail sampling: what chose the level(s), and the interval a conforming driver
+  // may use (docs/tolerances.md section 9); null otherwise.
+  const ShadingTerms::Lod& lod = terms.lod;
+  j["texture_lod"] =
+      lod.used ? Json{{"derivatives",
+                       {num(lod.d_dx.x), num(lod.d_dx.y), num(lod.d_dy.x), num(lod.d_dy.y)}},
+                      {"rho", num(lod.rho)},
+                      {"lambda", num(lod.lambda)},
+                      {"magnified", lod.magnified},
+                      {"levels", {lod.level0, lod.level1}},
+                      {"weight", num(lod.weight)},
+                      {"lambda_allowed", {num(lod.lambda_lo), num(lod.lambda_hi)}}}
+               : Json(nullptr);
   j["ambient"] = vec(terms.ambient);
   Json lights = Json::array();
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
@@ -221,6 +234,15 @@ std::string story(const Json& doc) {
     if (!sh["texture"].is_null())
       s += fmt::format("    texture {} at uv {} multiplies ambient and diffuse\n",
                        fmtVec(sh["texture"]), fmtVec(sh["uv"]));
+    if (sh.contains("texture_lod") && !sh["texture_lod"].is_null()) {
+      const Json& l = sh["texture_lod"];
+      s += fmt::format(
+          "    level of detail: derivatives {} texels/px, rho {}, lambda {} ({}), levels {} "
+          "weight {}; a conforming lambda lies in {}\n",
+          fmtVec(l["derivatives"]), fmtNum(l["rho"]), fmtNum(l["lambda"]),
+          l["magnified"].get<bool>() ? "magnified" : "minified", fmtVec(l["levels"]),
+          fmtNum(l["weight"]), fmtVec(l["lambda_allowed"]));
+    }
     s += fmt::format("    colour = (ambient + sum diffuse){} + sum specular = {}, alpha {}\n",
                      sh["texture"].is_null() ? "" : " x texture",
                      fmtVec(Json::array({sh["color"][0], sh["color"][1], sh["color"][2]})),

@@ -157,7 +157,7 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
   if (t.texture) {
     uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
     if (t.chain != nullptr && interp != nullptr && row != nullptr) {
-      tex = glm::dvec3(lodTexel(t, uv, b, *interp, *row, dx));
+      tex = glm::dvec3(lodTexel(t, uv, b, *interp, *row, dx, terms));
     } else {
       tex = glm::dvec3(
           sampleTexture(*t.texture, uv, magFilter(scene_.state), scene_.state.texture_wrap));
@@ -234,12 +234,28 @@ void Renderer::uvDerivatives(const TriangleContext& t, const FragmentInterpolato
 
 glm::dvec4 Renderer::lodTexel(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                               const FragmentInterpolator& interp,
-                              const FragmentInterpolator::Row& row, double dx) const {
+                              const FragmentInterpolator::Row& row, double dx,
+                              ShadingTerms* terms) const {
   glm::dvec2 d_dx;
   glm::dvec2 d_dy;
   uvDerivatives(t, interp, row, dx, b, d_dx, d_dy);
-  const double lambda = lodOf(scaleFactor(d_dx, d_dy), lod_state_);
-  return sampleAtLod(*t.chain, uv, lambda, lod_state_).color;
+  const double rho = scaleFactor(d_dx, d_dy);
+  const double lambda = lodOf(rho, lod_state_);
+  const LodSample sample = sampleAtLod(*t.chain, uv, lambda, lod_state_);
+  if (terms != nullptr) {  // explain
+    ShadingTerms::Lod& l = terms->lod;
+    l.used = true;
+    l.d_dx = d_dx;
+    l.d_dy = d_dy;
+    l.rho = rho;
+    l.lambda = lambda;
+    l.magnified = sample.magnified;
+    l.level0 = sample.level0;
+    l.level1 = sample.level1;
+    l.weight = sample.weight;
+    std::tie(l.lambda_lo, l.lambda_hi) = lodInterval(t, interp, row, dx);
+  }
+  return sample.color;
 }
 
 glm::dvec4 Renderer::storedColor(std::size_t index) const {

@@ -262,7 +262,11 @@ class Renderer {
                      glm::dvec2& d_dx, glm::dvec2& d_dy) const;
   glm::dvec4 lodTexel(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                       const FragmentInterpolator& interp, const FragmentInterpolator::Row& row,
-                      double dx) const;
+                      double dx, ShadingTerms* terms = nullptr) const;
+  // The lambda interval a conforming driver may use at the fragment (renderer_uncertainty.cpp).
+  std::pair<double, double> lodInterval(const TriangleContext& t,
+                                        const FragmentInterpolator& interp,
+                                        const FragmentInterpolator::Row& row, double dx) const;
   // The texel note of a level-of-detail fragment (renderer_uncertainty.cpp).
   TexelNote lodNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
                     const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,

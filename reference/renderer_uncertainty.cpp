@@ -305,11 +305,10 @@ namespace rc::ref {
 // filter weight quantised to 8 bits (1/256 texel of the coarsest level read). The note's
 // texel_alt is the lit colour range over that lambda interval and those positions
 // (lodRange()) plus a unit for the 8-bit filtered texel; texel_dist 0 (always within).
-TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
-                            const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
-                            const FragmentInterpolator::Row& row, double dx, double reach_s,
-                            double reach_t) const {
-  (void)b;
+std::pair<double, double> Renderer::lodInterval(const TriangleContext& t,
+                                                const FragmentInterpolator& interp,
+                                                const FragmentInterpolator::Row& row,
+                                                double dx) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr int kLodReachPx = 1;            // a quad's finite differences: within a pixel
   double lo[4] = {kInf, kInf, kInf, kInf};  // |ux|, |vx|, |uy|, |vy|
@@ -341,8 +340,16 @@ TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv, cons
   // The precision applies after the clamps too: a lambda clamped to max_lod = 3.5 sits on
   // a nearest-mip boundary that llvmpipe rounds up (level 4) where the spec's formula
   // gives level 3 (campaign s20261295 scene 00165, mipmap profile).
-  const double lambda_lo = clampLod(std::log2(rho_lo) + bias) - kLodPrecision;
-  const double lambda_hi = clampLod(std::log2(rho_hi) + bias) + kLodPrecision;
+  return {clampLod(std::log2(rho_lo) + bias) - kLodPrecision,
+          clampLod(std::log2(rho_hi) + bias) + kLodPrecision};
+}
+
+TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+                            const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
+                            const FragmentInterpolator::Row& row, double dx, double reach_s,
+                            double reach_t) const {
+  (void)b;
+  const auto [lambda_lo, lambda_hi] = lodInterval(t, interp, row, dx);
   const std::vector<const Texture*>& chain = *t.chain;
   const int q = static_cast<int>(chain.size()) - 1;
   const int coarsest = std::clamp(static_cast<int>(std::ceil(lambda_hi)), 0, q);

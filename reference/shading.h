@@ -65,6 +65,21 @@ struct ShadingTerms {
   std::vector<LightTerms> lights;  // one per scene light, in scene order
   glm::dvec3 texture{1.0};         // texel rgb multiplying ambient and diffuse; 1 if untextured
   glm::dvec2 uv{0.0};              // the interpolated texture coordinate (textured only)
+  // Level-of-detail sampling (textured, fixtures/scene.h lodSampling()): what chose the
+  // level(s) (docs/reference.md "Textures: level of detail").
+  struct Lod {
+    bool used = false;
+    glm::dvec2 d_dx{0.0};  // (du/dx, dv/dx), level-0 texels per px
+    glm::dvec2 d_dy{0.0};
+    double rho = 0.0;
+    double lambda = 0.0;
+    bool magnified = false;
+    int level0 = 0;
+    int level1 = 0;
+    double weight = 0.0;     // of level1
+    double lambda_lo = 0.0;  // the interval a conforming driver may use (tolerances.md 9)
+    double lambda_hi = 0.0;
+  } lod;
   glm::dvec4 color{0.0};
   std::vector<ShadedPoint> points;  // where the lighting was evaluated, with its factors
 };

@@ -76,6 +76,11 @@ TEST(DebugGl, ExplainJsonKeysBothWaysIncludingABackendThatCannotRun) {
                              " --pixel 80,60 --json --backends " + kLlvmpipe);
   ASSERT_EQ(stencil.code, 0) << stencil.err;
   collectKeys(json::parse(stencil.out), "", seen);
+  // Level-of-detail sampling (documented keys fragments[].shading.texture_lod.*).
+  const Result lod = run("explain " + catalog("mipmap/level_colours.json") +
+                         " --pixel 80,60 --json --backends ref");
+  ASSERT_EQ(lod.code, 0) << lod.err;
+  collectKeys(json::parse(lod.out), "", seen);
   for (const std::string& k : seen) EXPECT_TRUE(documented.count(k)) << "undocumented key " << k;
   for (const std::string& k : documented) EXPECT_TRUE(seen.count(k)) << "never seen " << k;
 }

@@ -256,7 +256,8 @@ TEST(Explain, JsonKeysAreTheDocumentedOnes) {
       catalog("shading/sphere_flat_low.json") + " --pixel 0,0 --backends ref",
       catalog("transparency/oit_cyclic.json") + " --pixel 57,93 --backends ref:abuffer",
       catalog("fragment-ops/stencil_portal.json") + " --pixel 80,60 --backends ref",
-      catalog("fragment-ops/decal_offset.json") + " --pixel 90,70 --backends ref"};
+      catalog("fragment-ops/decal_offset.json") + " --pixel 90,70 --backends ref",
+      catalog("mipmap/level_colours.json") + " --pixel 80,60 --backends ref"};
   for (const std::string& call : calls) {
     const Result r = run("explain " + call + " --json");
     ASSERT_EQ(r.code, 0) << call << ": " << r.err;
