@@ -300,8 +300,8 @@ namespace rc::ref {
 // "Level of detail"): the scale factor may be any f with max(mu, mv) <= f <= mu + mv (mu,
 // mv the largest |derivative| of u and of v), from derivatives a driver may take anywhere
 // in its 2x2 quad (a finite difference across a pixel is the derivative somewhere within
-// it: the fragment's and its eight neighbours' exact derivatives bound them), lambda in
-// fixed point (1/32 either way), and the sample may move by its float32 reach and by a
+// it: the fragment's and its eight neighbours' exact derivatives bound them), lambda to 0.09
+// either way (an approximated log2), and the sample may move by its float32 reach and by a
 // filter weight quantised to 8 bits (1/256 texel of the coarsest level read). The note's
 // texel_alt is the lit colour range over that lambda interval and those positions
 // (lodRange()) plus a unit for the 8-bit filtered texel; texel_dist 0 (always within).
@@ -331,7 +331,11 @@ std::pair<double, double> Renderer::lodInterval(const TriangleContext& t,
   }
   const double rho_lo = std::max(std::max(lo[0], lo[2]), std::max(lo[1], lo[3]));
   const double rho_hi = std::max(hi[0], hi[2]) + std::max(hi[1], hi[3]);
-  constexpr double kLodPrecision = 1.0 / 32.0;
+  // llvmpipe takes log2 by a piecewise-linear approximation (gallivm's lp_build_fast_log2:
+  // log2(1 + m) ~ m, up to 0.0861 off; half that where it squares rho first): campaign
+  // s20261296 scenes 00237 and 00705 (mipmap profile) on llvmpipe and zink lie up to 0.066
+  // below the exact lambda.
+  constexpr double kLodPrecision = 0.09;
   const double bias = std::clamp(lod_state_.bias, -kMaxLodBias, kMaxLodBias);
   auto clampLod = [&](double l) {
     if (std::isnan(l)) l = lod_state_.min_lod;
