@@ -380,3 +380,36 @@ TEST(ClearedBuffers, AnUnclearedPixelFailsInItsClass) {
 
 }  // namespace
 }  // namespace rc
+
+namespace rc {
+namespace {
+
+// The level-of-detail allowance (docs/tolerances.md section 9) is neither missing nor
+// loose, on the level-coloured floor (every level its own colour): a lambda moved by less
+// than its precision passes; one level off fails. (Blend weights rounded to 0 or 1 pass
+// there: GL's bounds on the scale factor, max(mu, mv) to mu + mv, span up to a whole level
+// where mu and mv are alike, and on this floor they are everywhere the chain is not past
+// its last level.)
+TEST(LevelOfDetail, WithinThePrecisionPassesALevelOffFails) {
+  const Scene scene = loadScene(catalog("mipmap/level_colours.json"));
+  Frame ref = renderReference(scene);
+  ref.meta["backend"] = "ref";
+  auto variant = [&](double bias, std::optional<MinFilter> min) {
+    Scene s = scene;
+    s.state.lod_bias += bias;
+    if (min) s.state.texture_min_filter = *min;
+    ReferenceOptions o;
+    o.uncertainty = false;
+    Frame f = renderReference(s, o);
+    f.meta["backend"] = "gl:test";
+    return compareFrames(ref, f, ref, defaultTolerances(DepthFormat::D24, ColorFormat::RGBA32F));
+  };
+  EXPECT_EQ(variant(0.06, std::nullopt).shading.over_fail, 0u);
+  EXPECT_EQ(variant(-0.06, std::nullopt).shading.over_fail, 0u);
+  const PairResult off = variant(1.0, std::nullopt);
+  EXPECT_GT(off.shading.over_fail, static_cast<std::uint64_t>(ref.pixelCount() / 4));
+  EXPECT_EQ(variant(0.0, MinFilter::LinearMipmapNearest).shading.over_fail, 0u);
+}
+
+}  // namespace
+}  // namespace rc
