@@ -186,7 +186,7 @@ void Comparator::runRange(int y, int x0, int x1) {
       continue;
     }
     if (a == 0) {  // background on both sides: the clear values
-      clearedPixel(i, za[x], zb[x], pa, pb);
+      clearedPixel(i, true, za[x], zb[x], pa, pb);
       continue;
     }
     ++vis_match_;
@@ -384,16 +384,19 @@ void Comparator::runRowFast(int y) {
   if (x < w) runRange<kMaps>(y, x, w);
 }
 
-void Comparator::clearedPixel(std::size_t i, float za, float zb, const float* pa, const float* pb) {
+void Comparator::clearedPixel(std::size_t i, bool depth, float za, float zb, const float* pa,
+                              const float* pb) {
   DepthStats& d = r_.depth;
-  ++d.cleared_checked;
-  const double dz = std::fabs(scale_(za) - scale_(zb));
-  const double depth_rounding = scale_.quantized ? 1.0 : 0.0;
-  if (!(dz <= depth_rounding)) {  // NaN too
-    ++d.cleared_mismatched;
-    ++d.over_tolerance;
-    ++d.over_fail;
-    depth_worst_.offer(std::isnan(dz) ? kInf : dz - depth_rounding, i, dz, depth_rounding);
+  if (depth) {
+    ++d.cleared_checked;
+    const double dz = std::fabs(scale_(za) - scale_(zb));
+    const double depth_rounding = scale_.quantized ? 1.0 : 0.0;
+    if (!(dz <= depth_rounding)) {  // NaN too
+      ++d.cleared_mismatched;
+      ++d.over_tolerance;
+      ++d.over_fail;
+      depth_worst_.offer(std::isnan(dz) ? kInf : dz - depth_rounding, i, dz, depth_rounding);
+    }
   }
   ShadingStats& s = r_.shading;
   ++s.cleared_checked;
@@ -541,7 +544,7 @@ void Comparator::runMultisampleRow(int y) {
     } else if (!any_primitive) {
       // Background on both sides. Only the colour: a multisampled GL frame's depth comes
       // through a shader's float arithmetic (docs/gl_backend.md), not exact near 1.
-      clearedPixel(i, e_.depth[i], e_.depth[i], pa, pb);
+      clearedPixel(i, false, e_.depth[i], a_.depth[i], pa, pb);
       continue;
     } else if (maps_) {
       maps_->pixel_class[i] = PixelClass::Match;

@@ -164,8 +164,9 @@ class Comparator {
   PixelClass record(std::size_t i, std::uint32_t a, std::uint32_t b, bool ambiguous, bool by_gap,
                     double edge);
 
-  // A pixel where neither side drew anything (classify.cpp).
-  void clearedPixel(std::size_t i, float za, float zb, const float* pa, const float* pb);
+  // A pixel where neither side drew anything (classify.cpp); its depth only with `depth`.
+  void clearedPixel(std::size_t i, bool depth, float za, float zb, const float* pa,
+                    const float* pb);
   // The stencil planes, after the pass over the pixels (classify.cpp).
   void compareStencil();
 

@@ -19,6 +19,10 @@ namespace {
 // JSON has no NaN or Inf.
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+json clearedJson(std::uint64_t checked, std::uint64_t mismatched) {
+  return {{"checked", checked}, {"mismatched", mismatched}};
+}
+
 json pixel(const PixelRef& p) { return p.valid() ? json::array({p.x, p.y}) : json(nullptr); }
 json windowPixel(const PixelRef& p, int height) {
   return p.valid() ? json::array({p.x, height - 1 - p.y}) : json(nullptr);
@@ -234,7 +238,7 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
       {"worst_allowance", d.worst.valid() ? num(d.worst_allowance) : json(nullptr)},
       {"step", num(1.0 / depthStepsPerUnit(t.depth_format))},
       {"histogram", histogram(d.histogram, d.max_steps, "steps")},
-      {"cleared", {{"checked", d.cleared_checked}, {"mismatched", d.cleared_mismatched}}},
+      {"cleared", clearedJson(d.cleared_checked, d.cleared_mismatched)},
       {"polygon_offset_r",
        {{"expected", num(d.offset_r_expected)},
         {"actual", num(d.offset_r_actual)},
@@ -250,28 +254,27 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
         {"worst_expected",
          d.stencil.worst.valid() ? json(d.stencil.worst_expected) : json(nullptr)},
         {"worst_actual", d.stencil.worst.valid() ? json(d.stencil.worst_actual) : json(nullptr)}}}};
-  j["shading"] = {
-      {"status", toString(s.status)},
-      {"compared", s.compared},
-      {"max_abs", num(s.max_abs)},
-      {"mean_abs", num(s.mean_abs)},
-      {"rmse", num(s.rmse)},
-      {"psnr_db", num(s.psnr_db)},
-      {"p99_abs", num(s.p99_abs)},
-      {"over_tolerance", s.over_tolerance},
-      {"over_fail", s.over_fail},
-      {"nonfinite", s.nonfinite},
-      {"texel_choice", s.texel_choice},
-      {"cleared", {{"checked", s.cleared_checked}, {"mismatched", s.cleared_mismatched}}},
-      {"blend_uncertain", s.blend_uncertain},
-      {"max_abs_rgba",
-       {num(s.max_abs_rgba[0]), num(s.max_abs_rgba[1]), num(s.max_abs_rgba[2]),
-        num(s.max_abs_rgba[3])}},
-      {"worst", pixel(s.worst)},
-      {"worst_window", windowPixel(s.worst, r.height)},
-      {"worst_abs", s.worst.valid() ? num(s.worst_abs) : json(nullptr)},
-      {"worst_allowance", s.worst.valid() ? num(s.worst_allowance) : json(nullptr)},
-      {"histogram", histogram(s.histogram, s.max_abs, "8-bit units")}};
+  j["shading"] = {{"status", toString(s.status)},
+                  {"compared", s.compared},
+                  {"max_abs", num(s.max_abs)},
+                  {"mean_abs", num(s.mean_abs)},
+                  {"rmse", num(s.rmse)},
+                  {"psnr_db", num(s.psnr_db)},
+                  {"p99_abs", num(s.p99_abs)},
+                  {"over_tolerance", s.over_tolerance},
+                  {"over_fail", s.over_fail},
+                  {"nonfinite", s.nonfinite},
+                  {"texel_choice", s.texel_choice},
+                  {"cleared", clearedJson(s.cleared_checked, s.cleared_mismatched)},
+                  {"blend_uncertain", s.blend_uncertain},
+                  {"max_abs_rgba",
+                   {num(s.max_abs_rgba[0]), num(s.max_abs_rgba[1]), num(s.max_abs_rgba[2]),
+                    num(s.max_abs_rgba[3])}},
+                  {"worst", pixel(s.worst)},
+                  {"worst_window", windowPixel(s.worst, r.height)},
+                  {"worst_abs", s.worst.valid() ? num(s.worst_abs) : json(nullptr)},
+                  {"worst_allowance", s.worst.valid() ? num(s.worst_allowance) : json(nullptr)},
+                  {"histogram", histogram(s.histogram, s.max_abs, "8-bit units")}};
   if (v.samples > 1) {  // multisampled: pixels count as mismatched when any sample differs
     j["visibility"]["samples"] = v.samples;
     j["visibility"]["mismatched_samples"] = v.mismatched_samples;

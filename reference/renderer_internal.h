@@ -268,7 +268,7 @@ class Renderer {
                                         const FragmentInterpolator& interp,
                                         const FragmentInterpolator::Row& row, double dx) const;
   // The texel note of a level-of-detail fragment (renderer_uncertainty.cpp).
-  TexelNote lodNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+  TexelNote lodNote(const TriangleContext& t, const glm::dvec2& uv,
                     const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
                     const FragmentInterpolator::Row& row, double dx, double reach_s,
                     double reach_t) const;

@@ -264,9 +264,9 @@ TexelNote Renderer::texelNote(const TriangleContext& t, const glm::dvec2& uv, co
   if (t.chain != nullptr) {
     // Level of detail: the colour range over every lambda and sample position a legal
     // implementation may use (lodNote()), always within reach (texel_dist 0).
-    TexelNote lod = lodNote(t, uv, b, ambient_diffuse, interp, row, dx,
-                            s.reach + kSnapDisagreementPx * s.gradient,
-                            tt.reach + kSnapDisagreementPx * tt.gradient);
+    TexelNote lod =
+        lodNote(t, uv, ambient_diffuse, interp, row, dx, s.reach + kSnapDisagreementPx * s.gradient,
+                tt.reach + kSnapDisagreementPx * tt.gradient);
     lod.gain = note.gain;
     return lod;
   }
@@ -348,11 +348,10 @@ std::pair<double, double> Renderer::lodInterval(const TriangleContext& t,
           clampLod(std::log2(rho_hi) + bias) + kLodPrecision};
 }
 
-TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv, const glm::dvec3& b,
+TexelNote Renderer::lodNote(const TriangleContext& t, const glm::dvec2& uv,
                             const glm::dvec3& ambient_diffuse, const FragmentInterpolator& interp,
                             const FragmentInterpolator::Row& row, double dx, double reach_s,
                             double reach_t) const {
-  (void)b;
   const auto [lambda_lo, lambda_hi] = lodInterval(t, interp, row, dx);
   const std::vector<const Texture*>& chain = *t.chain;
   const int q = static_cast<int>(chain.size()) - 1;

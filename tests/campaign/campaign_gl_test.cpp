@@ -356,10 +356,12 @@ TEST(CampaignGl, ShortMutationStudyCatchesEveryFaultInItsClass) {
   }
   // The verdicts, checked against the definition from the three comparisons' classes.
   const std::map<std::string, std::string> cls = {
-      {"light_scale", "shading"},    {"depth_bias", "depth"},     {"drop_primitive", "visibility"},
-      {"move_vertex", "visibility"}, {"texel_offset", "shading"}, {"blend_factor", "shading"},
-      {"depth_func", "visibility"},  {"stencil_op", "depth"},     {"blend_function", "shading"},
-      {"scissor_shift", "visibility"}, {"lod_shift", "shading"}};
+      {"light_scale", "shading"},       {"depth_bias", "depth"},
+      {"drop_primitive", "visibility"}, {"move_vertex", "visibility"},
+      {"texel_offset", "shading"},      {"blend_factor", "shading"},
+      {"depth_func", "visibility"},     {"stencil_op", "depth"},
+      {"blend_function", "shading"},    {"scissor_shift", "visibility"},
+      {"lod_shift", "shading"}};
   for (const json& result : study["results"]) {
     const std::string c = cls.at(result["fault"]);
     const auto has = [&](const char* key) {
