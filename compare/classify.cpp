@@ -209,7 +209,7 @@ void Comparator::runRange(int y, int x0, int x1) {
     }
 
     // Shading.
-    if (!color_finite) {
+    if (!colorsComparable(pa, pb)) {
       shadingNonFinite(i);
       if (kMaps) maps->shading_abs[i] = std::numeric_limits<float>::quiet_NaN();
       continue;
@@ -572,7 +572,7 @@ void Comparator::runMultisampleRow(int y) {
       ++shade_skipped_;
       continue;
     }
-    if (!color_finite) {
+    if (!colorsComparable(pa, pb)) {
       shadingNonFinite(i);
       if (maps_) maps_->shading_abs[i] = std::numeric_limits<float>::quiet_NaN();
       continue;

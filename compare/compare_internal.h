@@ -31,6 +31,17 @@ inline bool isNonFinite(float f) {
   return (std::bit_cast<std::uint32_t>(f) & 0x7f800000u) == 0x7f800000u;
 }
 
+// Whether both sides' colours can be compared channel by channel: finite, or the same
+// infinity on both sides (rgba32f keeps what blending computes: an overflow the reference
+// predicts, as repeated dst_color blends give, is agreement, not an error). NaN never is.
+inline bool colorsComparable(const float* a, const float* b) {
+  for (int c = 0; c < 4; ++c) {
+    const bool both_finite = !isNonFinite(a[c]) && !isNonFinite(b[c]);
+    if (!both_finite && !(std::isinf(a[c]) && a[c] == b[c])) return false;
+  }
+  return true;
+}
+
 // Four pixels at a time with GCC/Clang vector extensions: portable, and 128-bit so that
 // x86-64's SSE2 baseline runs every operation as one instruction.
 using V4f = float __attribute__((vector_size(16)));
@@ -144,6 +155,7 @@ class Comparator {
  private:
   // 8-bit error of one channel; rgba8 compares the stored 8-bit values.
   float colorError(float a, float b) const {
+    if (a == b) return 0.0f;  // also the same infinity on both sides (colorsComparable())
     if (!quantized_color_) return std::fabs(a - b) * 255.0f;
     constexpr float kMagic = 12582912.0f;  // 1.5 * 2^23: round to nearest in float
     return std::fabs(((a * 255.0f + kMagic) - kMagic) - ((b * 255.0f + kMagic) - kMagic));

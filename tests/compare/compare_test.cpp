@@ -394,6 +394,24 @@ TEST_F(CompareTest, DepthTieExcusesWrongPrimitiveOnlyWithinTheDepthTolerance) {
   EXPECT_EQ(compare().visibility.missing_hard, 1u);
 }
 
+// rgba32f overflow the reference predicts (both sides the same infinity) agrees; an
+// infinity of the other sign, or NaN on both sides, does not.
+TEST_F(CompareTest, TheSameInfinityOnBothSidesAgrees) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::size_t i = gl_.index(75, 30) * 4 + 1;
+  ref_.color[i] = gl_.color[i] = inf;
+  PairResult r = compare();
+  EXPECT_EQ(r.shading.nonfinite, 0u);
+  EXPECT_EQ(r.shading.status, Status::Pass);
+  EXPECT_EQ(r.nonfinite_actual.inf[1], 1u);  // still tallied
+  gl_.color[i] = -inf;
+  r = compare();
+  EXPECT_EQ(r.shading.nonfinite, 1u);
+  EXPECT_EQ(r.shading.status, Status::Fail);
+  ref_.color[i] = gl_.color[i] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(compare().shading.status, Status::Fail);
+}
+
 TEST_F(CompareTest, NonFiniteValuesAreCountedNeverCompared) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
