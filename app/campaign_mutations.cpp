@@ -59,6 +59,10 @@ MutationScene sceneFacts(const Scene& scene) {
     m.textured = m.textured || mat.texture != nullptr;
     m.blended = m.blended || (scene.state.blend == Blend::Alpha && mat.opacity < 1.0);
     m.lod = m.lod || (mat.texture != nullptr && lodSampling(scene.state));
+    const MinFilter min = minFilter(scene.state);
+    m.lod_blend = m.lod_blend ||
+                  (mat.texture != nullptr &&
+                   (min == MinFilter::NearestMipmapLinear || min == MinFilter::LinearMipmapLinear));
   }
   for (const DrawPass& p : drawPasses(scene)) {
     if (p.primitives.empty()) continue;

@@ -219,14 +219,15 @@ std::vector<CampaignFailure> failuresOfReport(
       }
     }
     // What the expectations say of the row now, from the same facts `run` matched them
-    // against: fixture, actual backend, its GL version, the render state and the failing
-    // classes.
+    // against: fixture, its tags, actual backend, its GL version, the render state and the
+    // failing classes.
     std::vector<KnownFailure> known_now;
     if (expectations && status == "fail") {
       PairResult pair;
       pair.fixture = base.fixture;
       pair.actual = base.actual;
       pair.status = Status::Fail;
+      pair.tags = base.tags;  // entries scoped by tags match the fixture's, as in `run`
       if (row.contains("state") && row["state"].is_object()) pair.state = row["state"];
       const json* stack =
           row.contains("stacks") && row["stacks"].is_object() && row["stacks"].contains("actual")

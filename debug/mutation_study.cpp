@@ -16,7 +16,7 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::array<MutationFault, 11> kFaults = {{
+constexpr std::array<MutationFault, 12> kFaults = {{
     {"light_scale", "shading", "every light 1% brighter"},
     {"depth_bias", "depth", "stored depth 4 x the fail threshold further (8 d16 / 64 d24 steps)"},
     {"drop_primitive", "visibility", "one visible triangle not drawn"},
@@ -29,6 +29,7 @@ constexpr std::array<MutationFault, 11> kFaults = {{
      "wrong blend factor: each blend function's source factor the next"},
     {"scissor_shift", "visibility", "scissor box one pixel off (to the right)"},
     {"lod_shift", "shading", "level of detail one level off (GL_TEXTURE_LOD_BIAS + 1)"},
+    {"lod_weight", "shading", "two mip levels blended with the weight inverted (1 - f for f)"},
 }};
 
 constexpr std::array<MutationVerdict, 6> kVerdicts = {
@@ -87,6 +88,7 @@ std::string faultSetting(const MutationFault& fault, const MutationScene& scene,
   if (name == "blend_function") return scene.blend_function ? "blend_function=shifted" : "";
   if (name == "scissor_shift") return scene.scissor ? "scissor_shift=1" : "";
   if (name == "lod_shift") return scene.lod ? "lod_shift=1" : "";
+  if (name == "lod_weight") return scene.lod_blend ? "lod_weight=inverted" : "";
   if (scene.visible_ids.empty()) return "";
   // The same primitive on every run: a stream seeded by (seed, index, fault).
   RandomStream stream(RandomStream::mix(seed) ^ RandomStream::mix(index + 0x632be59bd9b4e019ull) ^

@@ -43,7 +43,7 @@ struct MutationFault {
 // texel_offset and blend_factor (shading); the fragment operations' depth_func (visibility),
 // stencil_op (depth: the stencil buffer is compared in that class), blend_function
 // (shading) and scissor_shift (visibility); lod_shift (shading) for textures sampled with a
-// level of detail.
+// level of detail, lod_weight (shading) for textures blended between two mip levels.
 std::span<const MutationFault> mutationFaults();
 // Throws InputError naming the valid names.
 const MutationFault& mutationFault(const std::string& name);
@@ -59,6 +59,7 @@ struct MutationScene {
   bool blend_function = false;             // some pass blends with the object form of blend
   bool scissor = false;                    // some pass has a scissor box
   bool lod = false;  // textured, sampled with a level of detail (fixtures/scene.h lodSampling())
+  bool lod_blend = false;  // textured with a *_mipmap_linear min filter (two levels blended)
 };
 
 // The RASTERCHECK_GL_FAULT value of `fault` for scene `index` of `seed`, e.g.

@@ -17,7 +17,7 @@ constexpr const char* kValidFaults =
     "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
     "shader_compile_error, move_vertex=ID, texel_offset=N, blend_factor=one|swapped, "
     "depth_func=inverted, stencil_op=shifted, blend_function=shifted, scissor_shift=N, "
-    "lod_shift=N, "
+    "lod_shift=N, lod_weight=inverted, "
     "hang=FIXTURE|*, crash=FIXTURE|*";
 
 [[noreturn]] void badFault(std::string_view entry, std::string_view why) {
@@ -44,7 +44,7 @@ bool Faults::any() const {
          no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
          texel_offset != 0.0 || blend_factor != Blend::Correct || depth_func_inverted ||
          stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 ||
-         !hang.empty() || !crash.empty();
+         lod_weight_inverted || !hang.empty() || !crash.empty();
 }
 
 bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }
@@ -67,6 +67,7 @@ std::string Faults::describe() const {
   if (blend_function_shifted) parts.emplace_back("blend_function=shifted");
   if (scissor_shift != 0) parts.push_back(fmt::format("scissor_shift={}", scissor_shift));
   if (lod_shift != 0.0) parts.push_back(fmt::format("lod_shift={}", lod_shift));
+  if (lod_weight_inverted) parts.emplace_back("lod_weight=inverted");
   if (!hang.empty()) parts.push_back("hang=" + hang);
   if (!crash.empty()) parts.push_back("crash=" + crash);
   return fmt::format("{}", fmt::join(parts, ","));
@@ -88,7 +89,7 @@ Faults parseFaults(std::string_view text) {
                         name == "shift_x" || name == "move_vertex" || name == "texel_offset" ||
                         name == "blend_factor" || name == "hang" || name == "crash" ||
                         name == "depth_func" || name == "stencil_op" || name == "blend_function" ||
-                        name == "scissor_shift" || name == "lod_shift";
+                        name == "scissor_shift" || name == "lod_shift" || name == "lod_weight";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
     if (name == "drop_primitive") {
@@ -126,6 +127,9 @@ Faults parseFaults(std::string_view text) {
       f.scissor_shift = number<int>(entry, value);
     } else if (name == "lod_shift") {
       f.lod_shift = number<double>(entry, value);
+    } else if (name == "lod_weight") {
+      if (value != "inverted") badFault(entry, "must be inverted");
+      f.lod_weight_inverted = true;
     } else if (name == "hang" || name == "crash") {
       if (value.empty()) badFault(entry, "needs a fixture name or *");
       (name == "hang" ? f.hang : f.crash) = std::string(value);

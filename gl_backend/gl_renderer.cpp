@@ -131,8 +131,8 @@ struct Program {
   GLint light_intensity = -1, specular_model = -1, attenuation = -1;
   GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
   GLint opacity = -1, has_texture = -1, texture = -1;
-  GLint fault_depth_bias = -1, fault_shift_ndc = -1,
-        fault_texel_offset = -1;  // -1 unless compiled with the fault
+  GLint fault_depth_bias = -1, fault_shift_ndc = -1, fault_texel_offset = -1,
+        fault_lod_bias = -1;  // -1 unless compiled with the fault
 };
 
 // The FBO of the last render, kept for the next one of the same size and formats:
@@ -453,6 +453,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   shader_faults.shift_x = faults.shift_x_px != 0.0;
   shader_faults.compile_error = faults.shader_compile_error;
   shader_faults.texel_offset = faults.texel_offset != 0.0;
+  shader_faults.lod_weight = faults.lod_weight_inverted;
   gl::ProgramSource source = gl::programSource(max_lights, shader_faults);
   const gl::testing::Hooks& hooks = gl::testing::hooks();
   if (!hooks.vertex_shader.empty()) source.vertex = hooks.vertex_shader;
@@ -517,6 +518,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   p.fault_depth_bias = loc("u_fault_depth_bias");
   p.fault_shift_ndc = loc("u_fault_shift_ndc");
   p.fault_texel_offset = loc("u_fault_texel_offset");
+  p.fault_lod_bias = loc("u_fault_lod_bias");
   return s.programs.emplace(key, p).first->second;
 }
 
@@ -787,6 +789,9 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
   }
   if (p.fault_texel_offset >= 0) {
     gl.Uniform1f(p.fault_texel_offset, static_cast<GLfloat>(faults.texel_offset));
+  }
+  if (p.fault_lod_bias >= 0) {
+    gl.Uniform1f(p.fault_lod_bias, static_cast<GLfloat>(scene.state.lod_bias + faults.lod_shift));
   }
   if (p.fault_depth_bias >= 0) {
     const int bits = depthBits(scene.state.depth_format);  // d32f: one step is 2^-24

@@ -49,6 +49,10 @@ struct Faults {
   // lod_shift=N: every mipmapped texture's level of detail N higher (GL_TEXTURE_LOD_BIAS
   // + N): a level of detail off by N levels.
   double lod_shift = 0.0;
+  // lod_weight=inverted: where a lookup blends two mip levels with weight f on the coarser,
+  // it uses 1 - f (textureQueryLOD, then two textureLod): the levels right, their weights
+  // wrong.
+  bool lod_weight_inverted = false;
   // hang=NAME / crash=NAME: the render of the fixture named NAME ("*": every fixture) never
   // returns (blocks after the draw, as a driver stuck in a fence would) or dies with
   // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.

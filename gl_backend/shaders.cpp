@@ -173,6 +173,9 @@ uniform float u_fault_depth_bias;  // test-only: STEPS / (2^bits - 1)
 #ifdef RC_FAULT_TEXEL_OFFSET
 uniform float u_fault_texel_offset;  // test-only: texels to the right
 #endif
+#ifdef RC_FAULT_LOD_WEIGHT
+uniform float u_fault_lod_bias;  // test-only: the texture's GL_TEXTURE_LOD_BIAS
+#endif
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_primitive_id;
@@ -184,6 +187,20 @@ void main() {
   vec3 tex = u_has_texture != 0 ? texture(u_texture, uv).rgb : vec3(1.0);
 #else
   vec3 tex = u_has_texture != 0 ? texture(u_texture, v_uv).rgb : vec3(1.0);
+#endif
+#ifdef RC_FAULT_LOD_WEIGHT
+  // Between two levels, the blend weight inverted: (1 - f) of the finer level and f of the
+  // coarser instead of the reverse. textureQueryLOD's x is the clamped level of detail the
+  // lookup above used; it is fractional only where two levels are blended. textureLod adds
+  // the texture's bias to its level, so the bias is taken off first.
+  if (u_has_texture != 0) {
+    float lod = textureQueryLOD(u_texture, v_uv).x;  // the ARB extension's spelling
+    float finer = floor(lod);
+    float f = lod - finer;
+    if (f > 0.0)
+      tex = mix(textureLod(u_texture, v_uv, finer - u_fault_lod_bias).rgb,
+                textureLod(u_texture, v_uv, finer + 1.0 - u_fault_lod_bias).rgb, 1.0 - f);
+  }
 #endif
   vec3 ambient_diffuse;
   vec3 specular;
@@ -217,6 +234,10 @@ ProgramSource programSource(int max_lights, const ShaderFaults& faults) {
   if (faults.shift_x) header += "#define RC_FAULT_SHIFT_X\n";
   if (faults.texel_offset) header += "#define RC_FAULT_TEXEL_OFFSET\n";
   std::string fragment_header = header;
+  // The extension line must come before any other statement than #version and #define.
+  if (faults.lod_weight)
+    fragment_header +=
+        "#extension GL_ARB_texture_query_lod : require\n#define RC_FAULT_LOD_WEIGHT\n";
   if (faults.compile_error) fragment_header += "#define RC_FAULT_COMPILE_ERROR\n";
   return {header + kLighting + kVertexMain, fragment_header + kLighting + kFragmentMain};
 }

@@ -47,6 +47,7 @@ struct ShaderFaults {
   bool shift_x = false;        // gl_Position.x += u_fault_shift_ndc * gl_Position.w
   bool compile_error = false;  // the fragment shader calls a function that does not exist
   bool texel_offset = false;   // texture() samples at v_uv + u_fault_texel_offset texels in s
+  bool lod_weight = false;     // two mip levels blended with the weight inverted (1 - f)
 };
 
 // The program for scenes with up to max_lights lights (array sizes are compile-time

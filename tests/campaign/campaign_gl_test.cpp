@@ -361,7 +361,7 @@ TEST(CampaignGl, ShortMutationStudyCatchesEveryFaultInItsClass) {
       {"texel_offset", "shading"},      {"blend_factor", "shading"},
       {"depth_func", "visibility"},     {"stencil_op", "depth"},
       {"blend_function", "shading"},    {"scissor_shift", "visibility"},
-      {"lod_shift", "shading"}};
+      {"lod_shift", "shading"},         {"lod_weight", "shading"}};
   for (const json& result : study["results"]) {
     const std::string c = cls.at(result["fault"]);
     const auto has = [&](const char* key) {

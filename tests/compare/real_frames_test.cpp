@@ -5,7 +5,9 @@
 // unmodified pair has it. Also ambiguity end to end on crafted geometry rendered two ways
 // (subpixel precision, painter's order). Expected counts come from the injection and the
 // band formula, never from running the comparator first.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <limits>
@@ -15,7 +17,10 @@
 
 #include "compare/compare.h"
 #include "fixtures/loader.h"
+#include "fixtures/mipmaps.h"
+#include "fixtures/scene_logic.h"
 #include "reference/reference_renderer.h"
+#include "reference/texture_lod.h"
 
 namespace rc {
 namespace {
@@ -409,6 +414,111 @@ TEST(LevelOfDetail, WithinThePrecisionPassesALevelOffFails) {
   const PairResult off = variant(1.0, std::nullopt);
   EXPECT_GT(off.shading.over_fail, static_cast<std::uint64_t>(ref.pixelCount() / 4));
   EXPECT_EQ(variant(0.0, MinFilter::LinearMipmapNearest).shading.over_fail, 0u);
+}
+
+// A driver-like sampler on the level-coloured floor (each level one colour, so a pixel's
+// colour tells its lambda and weight alone): derivatives of u, v taken per 2x2 quad from
+// the top-left pixel's neighbours (the quad is the driver's choice), rho approximated by
+// the largest derivative, log2 by exponent plus mantissa - 1 (off by up to 0.086), weights
+// rounded to 8 bits; the texels come from the reference's own sampleAtLod. That stays
+// inside the allowance; the same sampler one level off, or with the blend weight between
+// two levels inverted (1 - f for f), does not.
+struct DriverSampler {
+  double lambda_shift = 0.0;
+  bool invert_weight = false;
+};
+
+double fastLog2(double x) {
+  int e = 0;
+  const double m = std::frexp(x, &e);  // x = m 2^e, m in [0.5, 1)
+  return (e - 1) + (2.0 * m - 1.0);
+}
+
+Frame driverLikeFrame(const Scene& scene, const Frame& ref, const DriverSampler& d) {
+  const glm::dmat4 inv = glm::inverse(viewProjectionMatrix(scene));
+  const Material& mat = scene.materials.at(0);
+  const std::vector<std::shared_ptr<const Texture>> owned = mipChain(mat);
+  std::vector<const Texture*> chain;
+  for (const auto& t : owned) chain.push_back(t.get());
+  const ref::LodState st = ref::lodState(scene.state);
+  // The floor's uv at a pixel centre: the ray's hit on y = 0, then the quad's affine map
+  // (x -20..20 -> u 0..8, z 5..-60 -> v 0..12); nullopt where the ray misses the plane.
+  auto uvAt = [&](double px, double py) -> std::optional<glm::dvec2> {
+    const double nx = 2.0 * (px + 0.5) / scene.width - 1.0;
+    const double ny = 1.0 - 2.0 * (py + 0.5) / scene.height;
+    const glm::dvec4 a = inv * glm::dvec4(nx, ny, -1.0, 1.0),
+                     b = inv * glm::dvec4(nx, ny, 1.0, 1.0);
+    const glm::dvec3 p0 = glm::dvec3(a) / a.w, p1 = glm::dvec3(b) / b.w;
+    if (p1.y >= p0.y) return std::nullopt;
+    const glm::dvec3 hit = p0 + (p1 - p0) * (p0.y / (p0.y - p1.y));
+    return glm::dvec2((hit.x + 20.0) / 40.0 * 8.0, (5.0 - hit.z) / 65.0 * 12.0);
+  };
+  const double size = chain.front()->width;  // square level 0
+  Frame out = ref;
+  out.meta["backend"] = "gl:driver-like";
+  for (int y = 0; y < scene.height; ++y) {
+    for (int x = 0; x < scene.width; ++x) {
+      const std::size_t i = ref.index(x, y);
+      if (ref.id[i] == 0) continue;
+      const int qx = x & ~1, qy = y & ~1;
+      const auto c = uvAt(qx, qy), r = uvAt(qx + 1, qy), b = uvAt(qx, qy + 1), uv = uvAt(x, y);
+      if (!c || !r || !b || !uv) continue;
+      const glm::dvec2 dx = (*r - *c) * size, dy = (*b - *c) * size;
+      const double rho = std::max({std::abs(dx.x), std::abs(dx.y), std::abs(dy.x), std::abs(dy.y)});
+      double lambda = std::clamp(fastLog2(rho) + st.bias + d.lambda_shift, st.min_lod, st.max_lod);
+      const ref::LodSample plain = ref::sampleAtLod(chain, *uv, lambda, st);
+      if (!plain.magnified && plain.level1 != plain.level0) {
+        // Between two levels: the weight of the coarser rounded to 8 bits (or inverted),
+        // put back as a lambda the reference's sampler then blends with exactly.
+        double w = std::nearbyint(plain.weight * 256.0) / 256.0;
+        if (d.invert_weight) w = 1.0 - w;
+        lambda = plain.level0 + w;
+      }
+      const glm::dvec4 t = ref::sampleAtLod(chain, *uv, lambda, st).color;
+      for (int k = 0; k < 3; ++k) {
+        const float v = static_cast<float>(t[k]);
+        out.color[4 * i + k] = scene.state.color_format == ColorFormat::RGBA8
+                                   ? std::nearbyint(v * 255.0f) / 255.0f
+                                   : v;
+      }
+    }
+  }
+  return out;
+}
+
+TEST(LevelOfDetail, ADriverLikeSamplerPassesOneLevelOffOrInvertedWeightsFail) {
+  const Scene scene = loadScene(catalog("mipmap/level_colours.json"));
+  ASSERT_EQ(scene.state.texture_min_filter, MinFilter::LinearMipmapLinear);
+  const Frame ref = renderReference(scene);
+  const Tolerances tol = defaultTolerances(scene.state.depth_format, scene.state.color_format);
+  std::size_t floor_pixels = 0;
+  for (std::uint32_t id : ref.id) floor_pixels += id != 0 ? 1 : 0;
+  ASSERT_GT(floor_pixels, ref.pixelCount() / 3);
+
+  const PairResult like = compareFrames(ref, driverLikeFrame(scene, ref, {}), ref, tol);
+  EXPECT_EQ(like.shading.over_fail, 0u);
+  EXPECT_EQ(like.status, Status::Pass);
+  // The uncertainty channels are what lets it pass: without them the same frame fails.
+  ReferenceOptions bare;
+  bare.uncertainty = false;
+  Frame certain = renderReference(scene, bare);
+  certain.meta["backend"] = "ref";
+  EXPECT_GT(compareFrames(certain, driverLikeFrame(scene, ref, {}), certain, tol).shading.over_fail,
+            floor_pixels / 10);
+
+  const PairResult off = compareFrames(ref, driverLikeFrame(scene, ref, {1.0, false}), ref, tol);
+  // (Not all: near the camera both lambdas magnify or reach level 1 alike, far away both
+  // are past the last level.)
+  EXPECT_GT(off.shading.over_fail, floor_pixels / 3);
+  // Inverting f moves lambda by |1 - 2f|: outside GL's interval (up to one level wide where
+  // mu and mv are alike) at the pixels whose weight is far from one half.
+  const PairResult inverted =
+      compareFrames(ref, driverLikeFrame(scene, ref, {0.0, true}), ref, tol);
+  EXPECT_EQ(inverted.shading.status, Status::Fail);
+  EXPECT_GT(inverted.shading.over_fail, floor_pixels / 10);
+  std::printf("floor %zu px; over the allowance: one level off %llu, inverted weights %llu\n",
+              floor_pixels, static_cast<unsigned long long>(off.shading.over_fail),
+              static_cast<unsigned long long>(inverted.shading.over_fail));
 }
 
 }  // namespace

@@ -81,13 +81,16 @@ TEST(CampaignFailures, OneFailurePerFailingClassAndOneForAnError) {
 // The campaign re-applies the expectations file to its runs' reports: an entry added
 // after a run covers its failures (scoped like `run` scopes it: backend, GL version from
 // the row's stacks, render state), the row's own stale `known` no longer counts, and a
-// pair is known only when all its failing classes are.
+// pair is known only when all its failing classes are; entries scoped by tags see the
+// fixture's tags.
 TEST(CampaignFailures, ExpectationsAreAppliedAsTheyAreNowNotAsTheRunMarkedThem) {
   const Expectations x = parseExpectations(json::parse(R"({"expectations": [
       {"id": "sp-d16-depth", "fixture": "*", "backend": "gl:*:softpipe", "driver_version": "*Mesa 22.*",
        "state": {"depth_format": "d16"}, "class": "depth", "reason": "r"},
       {"id": "sp-d16-vis", "fixture": "*", "backend": "gl:*:softpipe", "state": {"depth_format": "d16"},
-       "class": "visibility", "reason": "r"}]})"),
+       "class": "visibility", "reason": "r"},
+      {"id": "sp-tagged", "fixture": "*", "backend": "gl:*:softpipe", "tags": ["tag:f"],
+       "class": "shading", "reason": "r"}]})"),
                                            "test");
   auto pair = [](const std::string& fixture, const std::string& version, const std::string& depth,
                  const std::string& vis, const std::string& shading) {
@@ -101,7 +104,8 @@ TEST(CampaignFailures, ExpectationsAreAppliedAsTheyAreNowNotAsTheRunMarkedThem) 
                          pair("b", "3.3 (Core Profile) Mesa 22.3.6", "d16", "fail", "pass"),
                          pair("c", "3.3 (Core Profile) Mesa 23.1.0", "d16", "pass", "pass"),
                          pair("d", "3.3 (Core Profile) Mesa 22.3.6", "d24", "pass", "pass"),
-                         pair("e", "3.3 (Core Profile) Mesa 22.3.6", "d16", "pass", "fail")});
+                         pair("e", "3.3 (Core Profile) Mesa 22.3.6", "d16", "pass", "fail"),
+                         pair("f", "3.3 (Core Profile) Mesa 22.3.6", "d16", "pass", "fail")});
   const auto now = failuresOfReport(r, "runs/0", info, "report.json", &x);
   std::map<std::string, std::string> known;
   for (const CampaignFailure& f : now) known[f.fixture + "/" + f.cls] = f.known;
@@ -112,6 +116,7 @@ TEST(CampaignFailures, ExpectationsAreAppliedAsTheyAreNowNotAsTheRunMarkedThem) 
   EXPECT_EQ(known["d/depth"], "") << "another depth format";
   EXPECT_EQ(known["e/depth"], "") << "its shading failure is not covered: not known at all";
   EXPECT_EQ(known["e/shading"], "");
+  EXPECT_EQ(known["f/shading"], "sp-tagged") << "scoped by the fixture's tags";
   // Without the file, what the run wrote.
   for (const CampaignFailure& f : read(r))
     if (f.cls == "depth") {

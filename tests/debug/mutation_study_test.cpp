@@ -28,7 +28,8 @@ TEST(MutationStudy, TheFaultsAndTheirClasses) {
                                                                    {"stencil_op", "depth"},
                                                                    {"blend_function", "shading"},
                                                                    {"scissor_shift", "visibility"},
-                                                                   {"lod_shift", "shading"}}));
+                                                                   {"lod_shift", "shading"},
+                                                                   {"lod_weight", "shading"}}));
   EXPECT_EQ(std::string(mutationFault("depth_bias").cls), "depth");
   EXPECT_THROW(mutationFault("shift_x"), InputError);
 }
@@ -45,6 +46,12 @@ TEST(MutationStudy, SettingsFollowWhatTheSceneOffers) {
   scene.textured = scene.blended = true;
   EXPECT_EQ(faultSetting(mutationFault("texel_offset"), scene, 1, 0), "texel_offset=1");
   EXPECT_EQ(faultSetting(mutationFault("blend_factor"), scene, 1, 0), "blend_factor=one");
+  EXPECT_EQ(faultSetting(mutationFault("lod_weight"), scene, 1, 0), "") << "no level blend";
+  scene.lod = true;
+  EXPECT_EQ(faultSetting(mutationFault("lod_shift"), scene, 1, 0), "lod_shift=1");
+  EXPECT_EQ(faultSetting(mutationFault("lod_weight"), scene, 1, 0), "") << "one level at a time";
+  scene.lod_blend = true;
+  EXPECT_EQ(faultSetting(mutationFault("lod_weight"), scene, 1, 0), "lod_weight=inverted");
 }
 
 TEST(MutationStudy, PrimitivesAreDrawnFromTheVisibleOnesReproducibly) {

@@ -1,10 +1,13 @@
 // The test-only GL faults (gl_testing.h, RASTERCHECK_GL_FAULT) against an unfaulted
 // render of the same scene: each must change exactly what it claims and nothing else,
 // so that the harness's self-tests can rely on them as known, located errors.
+#include <array>
 #include <cmath>
 #include <cstdlib>
+#include <memory>
 #include <string>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -372,6 +375,54 @@ TEST_F(GlFault, TexelOffsetSamplesTheNeighbouringTexel) {
   EXPECT_EQ(differs, clean.pixelCount()) << "every texel differs from its right neighbour";
 }
 
+// A full-image quad whose texture has one colour per mip level (level 0 128x128 for 64
+// pixels: lambda = 1 everywhere, face-on), ambient light only.
+Scene levelScene(MinFilter min, double lod_bias) {
+  Scene s = texelScene();
+  s.name = "gltest/levels";
+  auto solid = [](int size, std::array<std::uint8_t, 3> rgb) {
+    auto t = std::make_shared<Texture>();
+    t->path = fmt::format("generated-{}x{}", size, size);
+    t->width = t->height = size;
+    for (int i = 0; i < size * size; ++i)
+      t->rgba.insert(t->rgba.end(), {rgb[0], rgb[1], rgb[2], 255});
+    return t;
+  };
+  Material& m = s.materials.back();
+  m.texture = solid(128, {255, 0, 0});
+  m.texture_levels = {solid(64, {0, 255, 0}), solid(32, {0, 0, 255})};
+  for (int size = 16; size >= 1; size /= 2)
+    m.texture_levels.push_back(solid(size, {255, 255, 255}));
+  s.state.texture_min_filter = min;
+  s.state.lod_bias = lod_bias;
+  return s;
+}
+
+TEST_F(GlFault, LodWeightInvertsTheBlendBetweenLevelsOnly) {
+  Faults f;
+  f.lod_weight_inverted = true;
+  // lambda = 1.25: level 1 (green) weighted 0.75 and level 2 (blue) 0.25; the fault swaps
+  // the weights. Filtering within a level of one colour changes nothing.
+  const Scene blended = levelScene(MinFilter::LinearMipmapLinear, 0.25);
+  const Frame clean = render(blended);
+  const Frame faulted = renderFaulted(blended, f);
+  EXPECT_EQ(faulted.meta.at("fault_injected"), "lod_weight=inverted");
+  constexpr double kTol = 0.02;  // the driver's own lambda and weight precision
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const glm::dvec4 c = colorAt(clean, x, y), d = colorAt(faulted, x, y);
+      ASSERT_NEAR(c.g, 0.75, kTol) << x << "," << y;
+      ASSERT_NEAR(c.b, 0.25, kTol) << x << "," << y;
+      ASSERT_NEAR(d.g, 0.25, kTol) << x << "," << y;
+      ASSERT_NEAR(d.b, 0.75, kTol) << x << "," << y;
+      ASSERT_NEAR(d.r, 0.0, kTol) << x << "," << y;
+    }
+  }
+  // One level at a time (nearest between levels): nothing to weigh, nothing changes.
+  const Scene one_level = levelScene(MinFilter::LinearMipmapNearest, 0.25);
+  EXPECT_EQ(render(one_level).color, renderFaulted(one_level, f).color);
+}
+
 class GlFaultBlend : public GlFault, public ::testing::WithParamInterface<Faults::Blend> {};
 
 TEST_P(GlFaultBlend, WrongBlendFactorChangesOnlyBlendedPixels) {
@@ -455,6 +506,10 @@ TEST(GlFaultParse, CanonicalFormRoundTrips) {
   EXPECT_EQ(more.blend_factor, Faults::Blend::Swapped);
   EXPECT_EQ(more.describe(), "move_vertex=7,texel_offset=1,blend_factor=swapped");
   EXPECT_EQ(gl::testing::parseFaults("blend_factor=one").describe(), "blend_factor=one");
+  const Faults lod = gl::testing::parseFaults("lod_weight=inverted,lod_shift=1");
+  EXPECT_TRUE(lod.lod_weight_inverted);
+  EXPECT_EQ(lod.describe(), "lod_shift=1,lod_weight=inverted");
+  EXPECT_THROW(gl::testing::parseFaults("lod_weight=swapped"), InputError);
   const Faults again = gl::testing::parseFaults(text);
   EXPECT_EQ(again.describe(), text);
   EXPECT_FALSE(gl::testing::parseFaults("").any());
