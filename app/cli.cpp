@@ -132,6 +132,32 @@ int runCli(int argc, char** argv) {
                       "Run part K of N (K/N, 1-based) of the whole run, or `env`: from "
                       "RASTERCHECK_SHARD, CI_NODE_INDEX/CI_NODE_TOTAL or "
                       "JOB_COMPLETION_INDEX/JOB_COMPLETIONS; join the parts with `merge`");
+  run_cmd->add_option("--retries", run.retries,
+                      "Render every failing or erroring GL pair N more times, each in a fresh "
+                      "worker: renders that disagree make the pair a flake (default 1; 0: "
+                      "never)");
+  run_cmd->add_option("--baseline", run.baseline,
+                      "deqp-runner baseline (name,Status lines, e.g. a fails.txt or an earlier "
+                      "results.csv): failures it lists are expected; the exit code says whether "
+                      "the run matches it");
+  run_cmd->add_option("--flakes", run.flakes,
+                      "deqp-runner flakes file: regular expressions; a failing test one matches "
+                      "is a KnownFlake");
+  run_cmd->add_option("--skips", run.skips,
+                      "deqp-runner skips file: regular expressions; tests one matches are not "
+                      "rendered (Skip)");
+  run_cmd->add_option("--caselist", run.caselist,
+                      "Fixture names, one per line: run these, in this order (deqp-runner "
+                      "caselist)");
+  run_cmd
+      ->add_option("--fraction", run.fraction,
+                   "Run every Nth fixture of the list (deqp-runner --fraction)")
+      ->check(CLI::PositiveNumber);
+  run_cmd
+      ->add_option("--fraction-start", run.fraction_start,
+                   "Start --fraction at the Mth fixture, 1-based (deqp-runner "
+                   "--fraction-start)")
+      ->check(CLI::PositiveNumber);
   run_cmd->add_flag("!--no-variants", run.variants,
                     "Skip the variant probes (subpixel precision, tie-break, depth rounding) "
                     "of each GL backend");
@@ -233,6 +259,11 @@ int runCli(int argc, char** argv) {
       app.add_subcommand("merge", "Join the folders of `run --shard K/N` into one run's report");
   merge_cmd->add_option("runs", merge.runs, "Folders written by `run --shard`")->required();
   merge_cmd->add_option("--out,-o", merge.out, "Report folder")->required();
+  merge_cmd->add_option("--baseline", merge.baseline, "As for run, applied to the merged run");
+  merge_cmd->add_option("--flakes", merge.flakes, "As for run");
+  merge_cmd->add_option("--skips", merge.skips,
+                        "As for run (the parts have skipped already; names the file in the "
+                        "report)");
 
   DiffRunsArgs diff_runs;
   CLI::App* diff_runs_cmd = app.add_subcommand(

@@ -73,6 +73,17 @@ struct RunArgs {
   // Known driver differences to mark (compare/expectations.h): a file, "none", or empty
   // for the default (defaultExpectationsFile()).
   std::string expectations;
+  // Renders again, each in a fresh worker, of every GL pair that fails or errors; a pair
+  // whose renders disagree is a flake. -1: the default (1 for GL backends; the reference is
+  // deterministic and never retried).
+  int retries = -1;
+  // deqp-runner's files (compare/deqp_results.h, docs/ci.md); empty: none.
+  std::filesystem::path baseline, flakes, skips;
+  // deqp-runner's caselist: one fixture name per line, the run's fixtures and their order;
+  // and its sharding: every fraction-th fixture from the fraction_start-th (1-based).
+  std::filesystem::path caselist;
+  int fraction = 1;
+  int fraction_start = 1;
 };
 int runCommand(const RunArgs& args);
 
@@ -82,6 +93,7 @@ int workerCommand(const std::string& spec);
 struct MergeArgs {
   std::vector<std::filesystem::path> runs;  // folders written by `run --shard K/N`
   std::filesystem::path out;
+  std::filesystem::path baseline, flakes, skips;  // as for run
 };
 int mergeCommand(const MergeArgs& args);
 

@@ -1,7 +1,8 @@
 // `rastercheck merge RUN_DIR... --out DIR`: the folders of `run --shard K/N` joined into
 // the report one unsharded run would have written (report.json rows in the whole run's
 // order, junit.xml, report.html, pair images and kept frames), replacing DIR's outputs
-// all-or-nothing. The joining itself is compare/shards.h.
+// all-or-nothing; with --baseline/--flakes/--skips, deqp-runner's verdict on the whole run.
+// The joining itself is compare/shards.h.
 #include <iostream>
 #include <set>
 
@@ -9,6 +10,7 @@
 
 #include "app/commands.h"
 #include "app/report_support.h"
+#include "compare/deqp_results.h"
 #include "compare/pair_images.h"
 #include "compare/shards.h"
 #include "fixtures/errors.h"
@@ -39,6 +41,7 @@ int mergeCommand(const MergeArgs& args) {
         fs::absolute(run).lexically_normal() == fs::absolute(args.out).lexically_normal())
       throw InputError(fmt::format("{}: --out must not be one of the run folders", run.string()));
   }
+  const RunnerFiles runner = readRunnerFiles(args.baseline, args.flakes, args.skips);
   MergedRuns merged = mergeRunReports(args.runs);
   ReportFolder folder(args.out);
   // Pair images: into folders chosen as the whole run chooses them (unique whatever the
@@ -52,6 +55,18 @@ int mergeCommand(const MergeArgs& args) {
       file = target;
     }
   }
+  // Frames of retried renders: kept beside the others, at the same place under frames/.
+  for (PairResult& r : merged.report.results)
+    for (PairResult::Attempt& a : r.attempts) {
+      if (a.frame.empty()) continue;
+      for (const fs::path& run : args.runs) {
+        const fs::path rel = fs::absolute(a.frame).lexically_normal().lexically_relative(
+            fs::absolute(run).lexically_normal());
+        if (rel.empty() || *rel.begin() == "..") continue;
+        a.frame = (folder.staging() / rel).string();
+        break;
+      }
+    }
   // Kept frames: the same fixture's reference frame can be in several shards (identical).
   for (const fs::path& run : args.runs) {
     const fs::path frames = run / "frames";
@@ -62,6 +77,11 @@ int mergeCommand(const MergeArgs& args) {
       const fs::path target = folder.staging() / "frames" / e.path().lexically_relative(frames);
       if (!fs::exists(target, ec)) linkOrCopy(e.path(), target);
     }
+  }
+  // The deqp-runner files, applied to the whole run (a part's own verdict is its own).
+  if (runner.any()) {
+    for (PairResult& r : merged.report.results) r.runner_status.clear();
+    applyRunnerFiles(runner, merged.report);
   }
   folder.commit(merged.report);
   printSummary(merged.report, args.out, std::cout);

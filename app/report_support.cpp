@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "app/paths.h"
+#include "compare/deqp_results.h"
 #include "compare/pair_images.h"
 #include "fixtures/errors.h"
 #include "fixtures/loader.h"
@@ -85,8 +86,9 @@ PairResult comparePair(const Frame& expected, const Frame& actual, const Frame& 
 // ---- ReportFolder ----
 
 const std::vector<std::string>& ReportFolder::ownedNames() {
-  static const std::vector<std::string> names = {"frames",      "pairs",     "variants",
-                                                 "report.json", "junit.xml", "report.html"};
+  static const std::vector<std::string> names = {"frames",      "pairs",       "variants",
+                                                 "report.json", "junit.xml",   "report.html",
+                                                 "results.csv", "failures.csv"};
   return names;
 }
 
@@ -131,6 +133,7 @@ namespace {
 std::string cellText(const PairResult& r) {
   if (r.status == Status::Error) return "ERROR";
   if (r.status == Status::NotSupported) return "not supported";
+  if (r.status == Status::Flake) return "FLAKE";
   std::string status = toString(r.status);
   if (r.status != Status::Pass)
     std::transform(status.begin(), status.end(), status.begin(),
@@ -199,8 +202,8 @@ std::string summaryTable(const Report& report, std::size_t max_rows) {
         if (const auto it = cells.find({f, backends[k]}); it != cells.end())
           ++n[it->second->status];
       std::string text;
-      for (const Status st :
-           {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported})
+      for (const Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error,
+                              Status::NotSupported, Status::Flake})
         if (n[st] > 0)
           text += fmt::format("{}{} {}", text.empty() ? "" : ", ", n[st], toString(st));
       line += fmt::format("  {:<{}}", text, widths[k]);
@@ -228,13 +231,29 @@ void printSummary(const Report& report, const fs::path& out_dir, std::ostream& o
   }
   const ReportSummary s = report.summary();
   os << fmt::format(
-      "{} pairs: {} pass, {} warn, {} fail{}, {} error{}\n", s.total(), s.pass, s.warn, s.fail,
+      "{} pairs: {} pass, {} warn, {} fail{}, {} error{}{}\n", s.total(), s.pass, s.warn, s.fail,
       s.known_fail ? fmt::format(" ({} known)", s.known_fail) : std::string(), s.error,
-      s.not_supported ? fmt::format(", {} not supported", s.not_supported) : std::string());
+      s.not_supported ? fmt::format(", {} not supported", s.not_supported) : std::string(),
+      s.flake ? fmt::format(", {} flake", s.flake) : std::string());
+  if (!report.runner.empty()) {
+    // deqp-runner's verdict (compare/deqp_results.h): what the exit code follows.
+    const std::uint64_t unexpected = report.runner.value("unexpected", std::uint64_t{0});
+    os << (unexpected == 0
+               ? std::string("deqp-runner: matches baseline")
+               : fmt::format("deqp-runner: does not match baseline: {} unexpected", unexpected));
+    if (!report.skipped.empty()) os << fmt::format(" ({} skipped)", report.skipped.size());
+    os << '\n';
+    for (const PairResult& r : report.results)
+      if (!r.runner_status.empty() && !runnerSuccess(r.runner_status))
+        os << "  " << testName(r) << ',' << r.runner_status << '\n';
+  }
   os << "report: " << (fs::absolute(out_dir) / "report.html").lexically_normal().string() << '\n';
-  os << (s.error                 ? "ERROR"
-         : s.fail > s.known_fail ? "FAILURE"
+  const int code = exitCodeFor(report);
+  os << (code == kExitBackend    ? "ERROR"
+         : code == kExitFail     ? "FAILURE"
+         : s.fail > s.known_fail ? "PASS (as the baseline expects)"
          : s.fail || s.warn      ? "WARNING"
+         : s.flake               ? "PASS (with flakes)"
                                  : "PASS")
      << '\n';
 }

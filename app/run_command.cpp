@@ -32,7 +32,9 @@
 #include "app/variants.h"
 #include "app/version.h"
 #include "app/worker_pool.h"
+#include "compare/deqp_results.h"
 #include "compare/expectations.h"
+#include "compare/pair_images.h"
 #include "compare/report.h"
 #include "compare/shards.h"
 #include "fixtures/catalog.h"
@@ -172,6 +174,51 @@ void writeText(const fs::path& file, const std::string& text) {
   if (!out) throw InputError(fmt::format("{}: cannot write", file.string()));
 }
 
+// deqp-runner's caselist: one fixture name per line (blank lines and '#' lines skipped; a
+// line ending in ".txt" includes that caselist, relative to this one's folder), in order.
+void readCaselist(const fs::path& file, std::vector<std::pair<std::string, std::string>>& out,
+                  int depth = 0) {
+  if (depth > 16) throw InputError(fmt::format("{}: caselists include each other", file.string()));
+  std::ifstream in(file);
+  if (!in) throw InputError(fmt::format("{}: cannot read the caselist", file.string()));
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    if (line.size() > 4 && line.compare(line.size() - 4, 4, ".txt") == 0) {
+      readCaselist(file.parent_path() / line, out, depth + 1);
+      continue;
+    }
+    out.emplace_back(line, fmt::format("{}:{}", file.string(), n));
+  }
+}
+
+// The fixtures a caselist names, in its order; every name must be one of `found`.
+std::vector<FixtureEntry> selectCaselist(const fs::path& caselist,
+                                         std::vector<FixtureEntry> found) {
+  std::vector<std::pair<std::string, std::string>> names;
+  readCaselist(caselist, names);
+  std::map<std::string, std::size_t> by_name;
+  for (std::size_t i = 0; i < found.size(); ++i) by_name.emplace(found[i].name, i);
+  std::vector<FixtureEntry> out;
+  std::set<std::string> taken;
+  for (const auto& [name, at] : names) {
+    const auto it = by_name.find(name);
+    if (it == by_name.end())
+      throw InputError(fmt::format("{}: no fixture named \"{}\" in the run's inputs", at, name));
+    if (taken.insert(name).second) out.push_back(found[it->second]);
+  }
+  return out;
+}
+
+// A render's time as its frame.json says (time_ms), in seconds; 0 when it does not.
+double renderSeconds(const RenderOutcome& o) {
+  if (!o.ok || !o.frame.meta.is_object() || !o.frame.meta.contains("time_ms") ||
+      !o.frame.meta["time_ms"].is_number())
+    return 0.0;
+  return o.frame.meta["time_ms"].get<double>() / 1000.0;
+}
+
 }  // namespace
 
 int runCommand(const RunArgs& args) {
@@ -183,6 +230,10 @@ int runCommand(const RunArgs& args) {
     applyOverrides(check, cli);
   }
   const Expectations known = expectationsFromArgument(args.expectations);
+  const RunnerFiles runner = readRunnerFiles(args.baseline, args.flakes, args.skips);
+  if (args.retries < -1)
+    throw InputError(fmt::format("--retries {}: must be 0 or more", args.retries));
+  const int retries = args.retries < 0 ? 1 : args.retries;
   if (args.backends.empty()) throw InputError("run: --backends needs at least one SPEC");
   std::vector<BackendSpec> backends;
   for (const std::string& s : args.backends) backends.push_back(parseBackendSpec(s));
@@ -253,12 +304,38 @@ int runCommand(const RunArgs& args) {
     fixtures.push_back(std::move(c.entry));
   }
   if (fixtures.empty()) throw InputError("run: no fixtures found in the given paths");
+  if (!args.caselist.empty()) fixtures = selectCaselist(args.caselist, std::move(fixtures));
+  if (args.fraction < 1 || args.fraction_start < 1)
+    throw InputError(fmt::format("--fraction {} --fraction-start {}: both must be 1 or more",
+                                 args.fraction, args.fraction_start));
+  if (args.fraction > 1 || args.fraction_start > 1) {
+    // deqp-runner's meaning: entries M, M + N, M + 2N, ... of the list (1-based).
+    std::vector<FixtureEntry> part;
+    for (std::size_t i = static_cast<std::size_t>(args.fraction_start - 1); i < fixtures.size();
+         i += static_cast<std::size_t>(args.fraction))
+      part.push_back(std::move(fixtures[i]));
+    fixtures = std::move(part);
+  }
+  if (fixtures.empty())
+    throw InputError(fmt::format("run: --fraction {} --fraction-start {} leaves no fixture",
+                                 args.fraction, args.fraction_start));
 
   // The whole run's pairs, in report order (fixture, then backend); a shard keeps its part.
   std::vector<PairPlan> pairs;
+  std::vector<std::string> skipped;  // test names --skips leaves out (compare/deqp_results.h)
   for (std::size_t f = 0; f < fixtures.size(); ++f)
-    for (std::size_t b = 0; b < backends.size(); ++b)
-      if (backends[b].text != against.text) pairs.push_back({f, b, pairs.size()});
+    for (std::size_t b = 0; b < backends.size(); ++b) {
+      if (backends[b].text == against.text) continue;
+      PairResult named;
+      named.fixture = fixtures[f].name;
+      named.actual = backends[b].text;
+      named.expected = against.text;
+      if (runner.skips.matches(testName(named))) {
+        skipped.push_back(testName(named));
+        continue;
+      }
+      pairs.push_back({f, b, pairs.size()});
+    }
   const std::size_t total_pairs = pairs.size();
   // The reference renders too when --against has no uncertainty channels of its own.
   const bool needs_ref = against.kind == BackendSpec::Kind::Gl;
@@ -344,6 +421,13 @@ int runCommand(const RunArgs& args) {
         ticket_of[pool.submit({fixtures[f].file, spec})] = {f, spec};
     }
 
+    auto expectedFailure = [&](const PairResult& r) {
+      std::string now = runnerStatus(r);
+      if (r.status == Status::Fail && !knownFailuresOf(known, r).empty()) now = "ExpectedFail";
+      const auto it = runner.baseline.expected.find(testName(r));
+      return runnerSuccess(
+          withBaseline(now, it == runner.baseline.expected.end() ? std::string() : it->second));
+    };
     auto compareFixture = [&](std::size_t f) {
       const FixtureEntry& fx = fixtures[f];
       std::map<std::string, RenderOutcome>& outs = got[f];
@@ -425,6 +509,23 @@ int runCommand(const RunArgs& args) {
             r = errorResult(fx.name, against.text, spec, e.what());
           }
         }
+        r.render_seconds = renderSeconds(b);
+        // A pair to render again (`--retries`), as deqp-runner reruns what fails unexpectedly
+        // (not a failure an expectation or the baseline expects): its first attempt, with the
+        // frames a retry is judged against kept on disk.
+        if (retries > 0 && a.ok && backends[p->backend].kind == BackendSpec::Kind::Gl &&
+            (r.status == Status::Fail || r.status == Status::Error) && !expectedFailure(r)) {
+          keepFrame(against.text);
+          if (outs.count("ref") && outs.at("ref").ok) keepFrame("ref");
+          PairResult::Attempt first;
+          if (b.ok) {
+            first.digest = frameDigest(b.frame);
+            first.frame = keepFrame(spec).string();
+          } else {
+            first.error = stripNames(b.error, {fx.name + ": ", spec + ": "});
+          }
+          r.attempts.push_back(std::move(first));
+        }
         results[static_cast<std::size_t>(p - pairs.data())] = std::move(r);
       }
       outs.clear();  // the frames are done with
@@ -469,10 +570,80 @@ int runCommand(const RunArgs& args) {
     progress.clear();
     comparer.finish();  // rethrows a comparison's InputError: exit 2, no report
     if (!input_failure.empty()) throw InputError(input_failure);
+
+    // --retries: each failing or erroring GL pair rendered again, every render in a worker
+    // started for it alone; judged as each arrives (its frame kept, then dropped).
+    std::map<std::size_t, std::pair<std::size_t, int>> retry_of;  // ticket -> pair, attempt
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      if (!results[i] || results[i]->attempts.empty()) continue;
+      for (int k = 1; k <= retries; ++k) {
+        RenderRequest request{fixtures[pairs[i].fixture].file, backends[pairs[i].backend].text};
+        request.fresh = true;
+        retry_of[pool.submit(request)] = {i, k};
+      }
+    }
+    auto judgeRetry = [&](std::size_t i, int k, const RenderOutcome& o) {
+      PairResult& r = *results[i];
+      const FixtureEntry& fx = fixtures[pairs[i].fixture];
+      const std::string& spec = backends[pairs[i].backend].text;
+      const fs::path dir = frames_dir / fx.slug;
+      PairResult::Attempt attempt;
+      if (!o.ok) {
+        attempt.error = stripNames(o.error, {fx.name + ": ", spec + ": "});
+        r.attempts.push_back(std::move(attempt));
+        return;
+      }
+      attempt.digest = frameDigest(o.frame);
+      const fs::path kept = dir / fmt::format("{}~retry{}", fixtureSlug(spec), k);
+      writeFrameDir(o.frame, kept);
+      attempt.frame = kept.string();
+      const PairResult::Attempt& first = r.attempts.front();
+      if (!first.digest.empty() && first.digest != attempt.digest && r.flake_pixels == 0) {
+        int x = -1, y = -1;
+        r.flake_pixels = differingPixels(readFrameDir(first.frame), o.frame, &x, &y);
+        r.flake_first = {x, y};
+      }
+      if (first.digest.empty() && r.status == Status::Error) {
+        // The first render gave no frame: the row becomes this one's comparison.
+        const Frame expected = readFrameDir(dir / fixtureSlug(against.text));
+        Frame ref_frame;
+        if (!expected.hasUncertainty() && fs::exists(dir / "ref"))
+          ref_frame = readFrameDir(dir / "ref");
+        const Frame& uncertainty = ref_frame.width > 0 ? ref_frame : expected;
+        const Tolerances tol = pairTolerances(expected, o.frame, fx.tolerance, cli);
+        ClassMaps maps;
+        maps.want_flip = args.flip;
+        PairResult compared = compareNamed(expected, o.frame, uncertainty, tol, &maps);
+        if (compared.status != Status::Pass)
+          writePairImages(expected, o.frame, maps, folder.pairDirectory(compared), compared, {});
+        compared.attempts = std::move(r.attempts);
+        compared.render_seconds = r.render_seconds;
+        r = std::move(compared);
+      }
+      r.attempts.push_back(std::move(attempt));
+    };
+    while (pool.outstanding() > 0) {
+      for (auto& [ticket, outcome] : pool.poll(200)) {
+        const auto it = retry_of.find(ticket);
+        if (it != retry_of.end()) judgeRetry(it->second.first, it->second.second, outcome);
+      }
+    }
+    for (std::optional<PairResult>& r : results) {
+      if (!r || r->attempts.size() < 2) continue;
+      const PairResult::Attempt& first = r->attempts.front();
+      // Renders that disagree: one gave a frame and another did not, or their bits differ.
+      const bool disagree =
+          std::any_of(r->attempts.begin() + 1, r->attempts.end(), [&](const auto& a) {
+            return a.digest.empty() != first.digest.empty() || a.digest != first.digest;
+          });
+      if (disagree) r->status = Status::Flake;
+    }
     if (args.variants) report.variants = analyseVariants(probes, probe_outcomes, probe_seconds);
   }
   for (std::optional<PairResult>& r : results) report.results.push_back(std::move(*r));
+  report.skipped = std::move(skipped);
   applyExpectations(known, report);
+  applyRunnerFiles(runner, report);
   folder.commit(report);
   printSummary(report, args.out, std::cout);
   return exitCodeFor(report);

@@ -190,8 +190,9 @@ void WorkerPool::dispatch() {
     const Task task = queue_.front();
     queue_.pop_front();
     Worker* idle = nullptr;
-    for (auto& w : workers_)
-      if (!w->busy && w->spec == task.request.spec) idle = w.get();
+    if (!task.request.fresh)
+      for (auto& w : workers_)
+        if (!w->busy && !w->single_use && w->spec == task.request.spec) idle = w.get();
     if (idle != nullptr && send(*idle, task)) continue;
     if (idle != nullptr) {
       // It died while idle (nothing lost): reap it and start another.
@@ -199,6 +200,7 @@ void WorkerPool::dispatch() {
       retire(*idle, "", none, true);
     }
     Worker* fresh = startWorker(task.request.spec);
+    if (fresh != nullptr) fresh->single_use = task.request.fresh;
     if (fresh == nullptr || !send(*fresh, task))
       throw BackendError(
           fmt::format("cannot start a worker for {}: {}", task.request.spec, std::strerror(errno)));
@@ -273,6 +275,7 @@ void WorkerPool::readReply(Worker& w, std::vector<std::pair<std::size_t, RenderO
         --busy_;
         std::string().swap(w.reply);
         w.filled = 0;
+        if (w.single_use) retire(w, "", done, true);  // its one render is done
         return;
       }
     }

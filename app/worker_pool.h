@@ -27,6 +27,9 @@ struct RenderRequest {
   // Test-only: a RASTERCHECK_GL_FAULT setting for this render alone (gl_backend/gl_testing.h),
   // so that the mutation study's faulted renders share the clean renders' workers.
   std::string fault;
+  // Rendered by a worker started for this render alone and ended after it (`run --retries`:
+  // nothing the driver kept from earlier fixtures can reach it).
+  bool fresh = false;
 };
 
 struct RenderOutcome {
@@ -79,6 +82,7 @@ class WorkerPool {
     int reply_fd = -1;    // its fd 3, non-blocking here
     std::filesystem::path log;
     bool busy = false;
+    bool single_use = false;  // started for a `fresh` request: ended after its reply
     std::size_t ticket = 0;
     Clock::time_point started;
     std::uintmax_t log_start = 0;

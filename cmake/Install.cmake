@@ -30,7 +30,8 @@ foreach(module IN LISTS RC_MODULES)
 endforeach()
 
 # rc_package_module(TARGET MODULE): TARGET is the library of the module folder MODULE. Sets
-# its include directories (source tree when building, include/ when installed), names it
+# its include directories (source tree when building, include/ when installed) and its C++
+# standard as a usage requirement, names it
 # rastercheck::MODULE (an alias in the build tree, the exported name when installed) and
 # installs it with the headers of its folder.
 function(rc_package_module target module)
@@ -42,6 +43,9 @@ function(rc_package_module target module)
     $<BUILD_INTERFACE:${RC_BUILD_INCLUDEDIR}>
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/rastercheck>)
+  # The headers need C++20 (defaulted operator==, std::span): a consumer that links the
+  # target gets the requirement with it, whatever standard its own project sets.
+  target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${module} OUTPUT_NAME rastercheck_${module})
   add_library(rastercheck::${module} ALIAS ${target})
   install(TARGETS ${target} EXPORT rastercheckTargets

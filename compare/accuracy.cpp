@@ -2,6 +2,7 @@
 #include "compare/accuracy.h"
 
 #include <algorithm>
+#include <array>
 #include <fstream>
 #include <map>
 #include <set>
@@ -139,7 +140,7 @@ bool isReference(const std::string& spec) { return spec == "ref" || spec.rfind("
 
 struct Totals {
   std::uint64_t pairs = 0;
-  std::uint64_t by_status[5] = {0, 0, 0, 0, 0};  // indexed by Status
+  std::array<std::uint64_t, kStatusCount> by_status{};  // indexed by Status
   std::uint64_t hard = 0;
   std::uint64_t ambiguous = 0;
   double depth_max = 0.0;
@@ -175,6 +176,7 @@ using Group = std::pair<std::string, std::string>;  // expected, actual
 std::string verdictCell(const AccuracyPair& p) {
   if (p.status == Status::Error) return "error: " + cell(p.error);
   if (p.status == Status::NotSupported) return "not supported: " + cell(p.error);
+  if (p.status == Status::Flake) return "flake: renders differ between attempts";
   if (p.status == Status::Pass) return "pass";
   std::vector<std::string> parts;
   if (p.visibility_status != Status::Pass)
@@ -580,7 +582,8 @@ std::string accuracyMarkdown(const AccuracyData& data, const std::string& comman
                     "with other differences. Verdicts: {} pass, {} warn, {} fail, {} error{}.",
                     t.pairs, identical, edge_only, t.pairs - identical - edge_only, t.by_status[0],
                     t.by_status[1], t.by_status[2], t.by_status[3],
-                    t.by_status[4] ? fmt::format(", {} not supported", t.by_status[4]) : ""));
+                    (t.by_status[4] ? fmt::format(", {} not supported", t.by_status[4]) : "") +
+                        (t.by_status[5] ? fmt::format(", {} flake", t.by_status[5]) : "")));
     for (const auto& [a, b] : bits)
       if (a > 0 && b > 0)
         line(fmt::format("Subpixel bits: `{}` {}, `{}` {}.", g.first, a, g.second, b));

@@ -205,6 +205,22 @@ struct PairResult {
   double depth_heat_scale = 0.0;    // steps that map to the top of depth_heat's colour map
   double shading_heat_scale = 0.0;  // 8-bit units that map to the top of shading_heat's
   double seconds = 0.0;             // time the comparison took
+  double render_seconds = 0.0;      // the actual side's render (frame.json time_ms), if known
+  // `run --retries`: every render of the actual side (empty: rendered once). Status Flake
+  // when they disagree; the classes above are then the comparison of the first attempt
+  // that rendered, and flake_pixels and flake_first locate where the first two frames that
+  // differ differ (0 and none when the disagreement is one render failing).
+  struct Attempt {
+    std::string digest;  // frameDigest() of what it rendered; empty when it did not render
+    std::string error;   // why it did not render
+    std::string frame;   // where its frame was kept, relative to the report folder
+  };
+  std::vector<Attempt> attempts;
+  std::uint64_t flake_pixels = 0;
+  PixelRef flake_first;
+  // The deqp-runner status of the row (compare/deqp_results.h) once a baseline, flakes or
+  // skips list has been applied; empty otherwise.
+  std::string runner_status;
 };
 
 // A report row for a pair that could not be compared (e.g. the backend did not start).

@@ -102,12 +102,12 @@ std::string backendCounts(const Report& report, const Columns& columns) {
     ++n[columns.of[k]][static_cast<std::size_t>(report.results[k].status)];
   std::string out =
       "<h2>Backends</h2><table id=\"backends\"><tr><th>backend</th><th>pass</th><th>warn</th>"
-      "<th>fail</th><th>error</th><th>not supported</th></tr>";
+      "<th>fail</th><th>error</th><th>not supported</th><th>flake</th></tr>";
   for (std::size_t b = 0; b < columns.names.size(); ++b)
     out += fmt::format(
         "<tr><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>"
-        "<td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
-        esc(columns.names[b]), n[b][0], n[b][1], n[b][2], n[b][3], n[b][4]);
+        "<td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
+        esc(columns.names[b]), n[b][0], n[b][1], n[b][2], n[b][3], n[b][4], n[b][5]);
   return out + "</table>";
 }
 

@@ -25,7 +25,7 @@ h3{font-size:15px;margin:0 0 6px}
 .summary b{display:block;font-size:20px}
 .badge{display:inline-block;padding:0 6px;border-radius:4px;font-size:12px;font-weight:600;
   text-transform:uppercase;color:#fff}
-.pass{background:#2e7d32}.warn{background:#e6a100}.fail{background:#c62828}.error{background:#6a1b9a}.not_supported{background:#607d8b}
+.pass{background:#2e7d32}.warn{background:#e6a100}.fail{background:#c62828}.error{background:#6a1b9a}.not_supported{background:#607d8b}.flake{background:#ad1457}
 table{border-collapse:collapse;background:#fff}
 th,td{border:1px solid #ddd;padding:3px 7px;text-align:left;white-space:nowrap}
 td.n{text-align:right;font-variant-numeric:tabular-nums}

@@ -197,21 +197,88 @@ std::string pairFolderName(const PairResult& result) {
 
 }  // namespace
 
+namespace {
+
+// 64-bit FNV-1a over whole words: not cryptographic, only to notice a changed frame.
+class FrameHash {
+ public:
+  void word(std::uint64_t w) { h_ = (h_ ^ w) * 0x100000001b3ull; }
+  template <class T>
+  void plane(const std::vector<T>& v) {
+    word(v.size());
+    const std::size_t bytes = v.size() * sizeof(T);
+    const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+    std::size_t k = 0;
+    for (; k + 8 <= bytes; k += 8) {
+      std::uint64_t w;
+      std::memcpy(&w, p + k, 8);
+      word(w);
+    }
+    for (; k < bytes; ++k) word(p[k]);
+  }
+  std::string hex() const { return fmt::format("{:016x}", h_); }
+
+ private:
+  std::uint64_t h_ = 0xcbf29ce484222325ull;
+};
+
+}  // namespace
+
 std::string colorDigest(const Frame& frame) {
-  // 64-bit FNV-1a over whole words: not cryptographic, only to notice a changed frame.
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  auto mix = [&](std::uint64_t w) { h = (h ^ w) * 0x100000001b3ull; };
-  mix(static_cast<std::uint64_t>(frame.width) << 32 | static_cast<std::uint32_t>(frame.height));
+  FrameHash h;
+  h.word(static_cast<std::uint64_t>(frame.width) << 32 | static_cast<std::uint32_t>(frame.height));
   const std::size_t bytes = frame.color.size() * sizeof(float);
   const auto* p = reinterpret_cast<const unsigned char*>(frame.color.data());
   std::size_t k = 0;
   for (; k + 8 <= bytes; k += 8) {
     std::uint64_t w;
     std::memcpy(&w, p + k, 8);
-    mix(w);
+    h.word(w);
   }
-  for (; k < bytes; ++k) mix(p[k]);
-  return fmt::format("{:016x}", h);
+  for (; k < bytes; ++k) h.word(p[k]);
+  return h.hex();
+}
+
+std::string frameDigest(const Frame& frame) {
+  FrameHash h;
+  h.word(static_cast<std::uint64_t>(frame.width) << 32 | static_cast<std::uint32_t>(frame.height));
+  h.word(static_cast<std::uint64_t>(frame.samples));
+  h.plane(frame.color);
+  h.plane(frame.depth);
+  h.plane(frame.id);
+  h.plane(frame.stencil);
+  h.plane(frame.sample_id);
+  h.plane(frame.sample_depth);
+  h.plane(frame.coverage);
+  return h.hex();
+}
+
+std::uint64_t differingPixels(const Frame& a, const Frame& b, int* first_x, int* first_y) {
+  if (a.width != b.width || a.height != b.height || a.samples != b.samples)
+    throw InputError(fmt::format("frames of {}x{} and {}x{} cannot be compared pixel by pixel",
+                                 a.width, a.height, b.width, b.height));
+  auto same = [](const auto& x, const auto& y, std::size_t i, std::size_t n) {
+    if (x.size() != y.size()) return false;
+    if (x.empty()) return true;
+    return std::memcmp(&x[i * n], &y[i * n], n * sizeof(x[0])) == 0;
+  };
+  std::uint64_t count = 0;
+  *first_x = *first_y = -1;
+  const std::size_t pixels = a.pixelCount();
+  for (std::size_t i = 0; i < pixels; ++i) {
+    bool equal = same(a.color, b.color, i, 4) && same(a.depth, b.depth, i, 1) &&
+                 same(a.id, b.id, i, 1) && same(a.stencil, b.stencil, i, 1);
+    for (int s = 0; equal && s < a.samples && a.samples > 1; ++s) {
+      const std::size_t k = a.sampleIndex(s, i);
+      equal = same(a.sample_id, b.sample_id, k, 1) && same(a.sample_depth, b.sample_depth, k, 1);
+    }
+    if (equal) continue;
+    if (count++ == 0) {
+      *first_x = static_cast<int>(i % static_cast<std::size_t>(a.width));
+      *first_y = static_cast<int>(i / static_cast<std::size_t>(a.width));
+    }
+  }
+  return count;
 }
 
 Rgb8 classColor(PixelClass c) { return pixelClassInfo(c).color; }

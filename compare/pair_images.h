@@ -42,6 +42,13 @@ float heatPosition(float value, double scale);
 // frame.json ("color_digest"), so that a reader can tell whether the folder's color.png
 // still shows the colour in frame.exr.
 std::string colorDigest(const Frame& frame);
+// The same over everything a driver rendered: size, samples, colour, depth, ids, stencil
+// and the per-sample planes (not the reference's uncertainty channels). Two renders with
+// the same digest gave the same bits (`run --retries` tells a flake by it).
+std::string frameDigest(const Frame& frame);
+// Pixels where two frames of one size differ in any bit of colour, depth, id or stencil
+// (multisampled: of a sample's id or depth too), and the first of them in row order.
+std::uint64_t differingPixels(const Frame& a, const Frame& b, int* first_x, int* first_y);
 
 // Ready-made 8-bit pictures of the two frames (the frame folders' color.png, which
 // `render` writes from the same frame with the same conversion). When given, they are

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "compare/atomic_file.h"
+#include "compare/deqp_results.h"
 #include "compare/report_text.h"
 #include "fixtures/errors.h"
 
@@ -139,16 +140,50 @@ ReportSummary Report::summary() const {
       case Status::NotSupported:
         ++s.not_supported;
         break;
+      case Status::Flake:
+        ++s.flake;
+        break;
     }
   }
   return s;
 }
 
 int exitCodeFor(const Report& report) {
+  if (!report.runner.empty()) {
+    int code = kExitPass;
+    for (const PairResult& r : report.results) {
+      if (runnerSuccess(r.runner_status)) continue;
+      if (r.runner_status == "Crash" || r.runner_status == "Timeout") return kExitBackend;
+      code = kExitFail;
+    }
+    return code;
+  }
   const ReportSummary s = report.summary();
   if (s.error) return kExitBackend;
   if (s.fail > s.known_fail) return kExitFail;
   return kExitPass;
+}
+
+// The retries of a pair and its deqp-runner status (app/run_command.cpp, compare/deqp_results.h).
+void addRunnerFields(json& j, const PairResult& r, const fs::path& report_dir) {
+  if (!r.attempts.empty()) {
+    json attempts = json::array();
+    for (const PairResult::Attempt& a : r.attempts) {
+      json x = json::object();
+      if (a.error.empty()) {
+        x["digest"] = a.digest;
+      } else {
+        x["error"] = a.error;
+      }
+      if (!a.frame.empty()) x["frame"] = relativePath(a.frame, report_dir);
+      attempts.push_back(x);
+    }
+    j["attempts"] = attempts;
+  }
+  if (r.status == Status::Flake)
+    j["flake"] = {{"differing_pixels", r.flake_pixels}, {"first", pixel(r.flake_first)}};
+  if (r.render_seconds > 0.0) j["render_seconds"] = num(r.render_seconds);
+  if (!r.runner_status.empty()) j["runner_status"] = r.runner_status;
 }
 
 json toJson(const PairResult& r, const fs::path& report_dir) {
@@ -171,6 +206,7 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
     // "not_supported"), zero counts.
     const char* e = toString(r.status);
     j[r.status == Status::Error ? "error" : "not_supported"] = r.error;
+    addRunnerFields(j, r, report_dir);
     j["visibility"] = {{"status", e},  {"mismatched", 0}, {"ambiguous", 0},      {"hard", 0},
                        {"missing", 0}, {"extra", 0},      {"wrong_primitive", 0}};
     j["depth"] = {{"status", e},    {"compared", 0},       {"max_steps", 0},  {"mean_steps", 0},
@@ -293,6 +329,7 @@ json toJson(const PairResult& r, const fs::path& report_dir) {
   j["heat_scales"] = {{"depth_steps", num(r.depth_heat_scale)},
                       {"shading_abs", num(r.shading_heat_scale)}};
   j["seconds"] = num(r.seconds);
+  addRunnerFields(j, r, report_dir);
   return j;
 }
 
@@ -309,12 +346,15 @@ json toJson(const Report& report, const fs::path& report_dir) {
               {"fail", s.fail},
               {"error", s.error},
               {"not_supported", s.not_supported},
+              {"flake", s.flake},
               {"known_fail", s.known_fail},
               {"total", s.total()}}},
             {"exit_code", exitCodeFor(report)}};
   if (!report.command.empty()) j["command"] = report.command;
   if (!report.variants.empty()) j["variants"] = report.variants;
   if (!report.shard.empty()) j["shard"] = report.shard;
+  if (!report.runner.empty()) j["runner"] = report.runner;
+  if (!report.skipped.empty()) j["skipped"] = report.skipped;
   return j;
 }
 
@@ -325,6 +365,22 @@ std::string describe(const PairResult& r) {
   std::string head = fmt::format("{} {} {} vs {}", status, r.fixture, r.expected, r.actual);
   if (r.status == Status::Error) return head + ": " + r.error;
   if (r.status == Status::NotSupported) return head + ": " + r.error;
+  if (r.status == Status::Flake) {
+    std::vector<std::string> what;
+    for (const PairResult::Attempt& a : r.attempts)
+      what.push_back(a.error.empty() ? a.digest.substr(0, 12) : "no frame (" + a.error + ")");
+    head += fmt::format(": {} renders disagree: {}", r.attempts.size(), fmt::join(what, " / "));
+    if (r.flake_pixels > 0)
+      head +=
+          fmt::format("; {} px differ, first {}", r.flake_pixels, where(r.flake_first, r.height));
+    std::vector<std::string> failing;
+    for (const auto& [name, st] :
+         {std::pair{"visibility", r.visibility.status}, std::pair{"depth", r.depth.status},
+          std::pair{"shading", r.shading.status}})
+      if (st == Status::Fail) failing.emplace_back(name);
+    if (!failing.empty()) head += fmt::format("; the first failed {}", fmt::join(failing, ", "));
+    return head;
+  }
   if (!r.known.empty()) {
     std::vector<std::string> ids;
     for (const KnownFailure& k : r.known) ids.push_back(k.id);
@@ -348,6 +404,8 @@ void writeReport(const Report& report, const fs::path& out_dir) {
   files.stageText(out_dir / "report.json", toJson(report, out_dir).dump(2) + "\n");
   files.stageText(out_dir / "junit.xml", junitXml(report));
   files.stageText(out_dir / "report.html", reportHtml(report, out_dir));
+  files.stageText(out_dir / "results.csv", resultsCsv(report));
+  files.stageText(out_dir / "failures.csv", failuresCsv(report));
   files.commit();
 }
 

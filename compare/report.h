@@ -23,7 +23,8 @@ struct ReportSummary {
   std::uint64_t error = 0;
   std::uint64_t known_fail = 0;     // of `fail`, those an expectation covers
   std::uint64_t not_supported = 0;  // the backend cannot render the fixture: no verdict
-  std::uint64_t total() const { return pass + warn + fail + error + not_supported; }
+  std::uint64_t flake = 0;          // renders that disagreed when retried: no verdict
+  std::uint64_t total() const { return pass + warn + fail + error + not_supported + flake; }
 };
 
 struct Report {
@@ -36,13 +37,20 @@ struct Report {
   // A part of a sharded run (`run --shard K/N`): which part, and where its rows go in the
   // whole run, for `merge` (compare/merge.h). Empty for a whole run.
   nlohmann::json shard = nlohmann::json::object();
+  // deqp-runner's view (compare/deqp_results.h): the tests `--skips` left out (written to
+  // results.csv as Skip), and, when a baseline, flakes or skips file was applied, what was
+  // applied and whether the run matches it (report.json "runner"); empty otherwise.
+  std::vector<std::string> skipped;
+  nlohmann::json runner = nlohmann::json::object();
 
   ReportSummary summary() const;
 };
 
-// Exit status of a command that produced this report: 3 when any row is an error (a
-// backend could not run), else 1 when any comparison failed that no expectation covers,
-// else 0 (warnings and known failures pass).
+// Exit status of a command that produced this report. With deqp-runner files applied
+// (report.runner): 0 when every row's runner_status is a success (the run matches its
+// baseline), 3 when a row is an unexpected Crash or Timeout, else 1. Without: 3 when any
+// row is an error (a backend could not run), else 1 when any comparison failed that no
+// expectation covers, else 0 (warnings, known failures and flakes pass).
 int exitCodeFor(const Report& report);
 
 // report.json content. Image paths are written relative to report_dir (the folder the

@@ -68,7 +68,8 @@ std::optional<PixelRef> ReportReader::pixel(const json& j, const char* key,
 Status ReportReader::status(const json& j, const char* key, const std::string& path) const {
   if (!j.is_object() || !j.contains(key)) return Status::Pass;
   const std::string s = text(j, key, path);
-  for (Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported})
+  for (Status st : {Status::Pass, Status::Warn, Status::Fail, Status::Error, Status::NotSupported,
+                    Status::Flake})
     if (s == toString(st)) return st;
   fail(path + "." + key, fmt::format("unknown status \"{}\"", s));
 }
@@ -137,6 +138,37 @@ Thresholds thresholdsFrom(const ReportReader& r, const json& t, const char* key,
 
 }  // namespace
 
+namespace {
+
+// The retries and deqp-runner status of a row (report.cpp addRunnerFields).
+void runnerFieldsFrom(const ReportReader& r, const json& row, const std::string& at,
+                      const fs::path& report_dir, PairResult& p) {
+  if (row.contains("attempts")) {
+    const json& attempts = row["attempts"];
+    if (!attempts.is_array()) r.fail(at + ".attempts", "must be an array");
+    for (std::size_t k = 0; k < attempts.size(); ++k) {
+      const std::string kat = fmt::format("{}.attempts[{}]", at, k);
+      PairResult::Attempt a;
+      if (attempts[k].contains("error")) {
+        a.error = r.text(attempts[k], "error", kat);
+      } else {
+        a.digest = r.text(attempts[k], "digest", kat);
+      }
+      if (attempts[k].contains("frame"))
+        a.frame = (report_dir / fs::path(r.text(attempts[k], "frame", kat))).string();
+      p.attempts.push_back(std::move(a));
+    }
+  }
+  if (row.contains("flake") && row["flake"].is_object()) {
+    p.flake_pixels = r.count(row["flake"], "differing_pixels", at + ".flake");
+    p.flake_first = r.pixel(row["flake"], "first", at + ".flake").value_or(PixelRef{});
+  }
+  if (row.contains("render_seconds")) p.render_seconds = r.number(row, "render_seconds", at);
+  if (row.contains("runner_status")) p.runner_status = r.text(row, "runner_status", at);
+}
+
+}  // namespace
+
 PairResult pairResultFromJson(const ReportReader& r, const json& row, const std::string& at,
                               const fs::path& report_dir) {
   PairResult p;
@@ -159,6 +191,7 @@ PairResult pairResultFromJson(const ReportReader& r, const json& row, const std:
                          r.text(known[k], "reason", kat)});
     }
   }
+  runnerFieldsFrom(r, row, at, report_dir, p);
   if (p.status == Status::Error || p.status == Status::NotSupported) {
     const char* why = p.status == Status::Error ? "error" : "not_supported";
     p.error =
@@ -407,6 +440,10 @@ Report readReportFile(const fs::path& file) {
     report.command = doc["command"].get<std::string>();
   if (doc.contains("variants") && doc["variants"].is_object()) report.variants = doc["variants"];
   if (doc.contains("shard") && doc["shard"].is_object()) report.shard = doc["shard"];
+  if (doc.contains("runner") && doc["runner"].is_object()) report.runner = doc["runner"];
+  if (doc.contains("skipped") && doc["skipped"].is_array())
+    for (const json& s : doc["skipped"])
+      if (s.is_string()) report.skipped.push_back(s.get<std::string>());
   const json& results = r.member(doc, "results", "");
   if (!results.is_array()) r.fail("results", "must be an array");
   const fs::path dir = file.parent_path();

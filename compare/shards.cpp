@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <map>
 #include <numeric>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -180,6 +181,11 @@ MergedRuns mergeRunReports(const std::vector<fs::path>& run_dirs) {
                                  sharded ? "is not" : "is", parts.front().file.string(),
                                  sharded ? "is" : "is not"));
   }
+  // Tests --skips left out: every part lists those of its fixtures (each once here).
+  std::set<std::string> skipped;
+  for (const Part& p : parts)
+    for (const std::string& s : p.report.skipped)
+      if (skipped.insert(s).second) out.report.skipped.push_back(s);
   if (!sharded) {
     for (Part& p : parts) {
       for (PairResult& r : p.report.results) out.report.results.push_back(std::move(r));

@@ -23,6 +23,8 @@ const char* toString(Status status) {
       return "error";
     case Status::NotSupported:
       return "not_supported";
+    case Status::Flake:
+      return "flake";
   }
   return "?";
 }

@@ -16,8 +16,10 @@ namespace rc {
 // Verdict of one class, of a pair, of a report. Ordered: a worse status compares greater.
 // NotSupported: the backend cannot render what the fixture asks (e.g. more samples than
 // it has); a whole pair's status only, neither a pass nor a failure (docs/reports.md).
-enum class Status { Pass = 0, Warn = 1, Fail = 2, Error = 3, NotSupported = 4 };
-inline constexpr int kStatusCount = 5;  // Status values, for tables indexed by them
+// Flake: a pair whose renders under `run --retries` disagreed (different bits, or one
+// rendered and another did not): never a class's status.
+enum class Status { Pass = 0, Warn = 1, Fail = 2, Error = 3, NotSupported = 4, Flake = 5 };
+inline constexpr int kStatusCount = 6;  // Status values, for tables indexed by them
 const char* toString(Status status);
 Status worse(Status a, Status b);
 

@@ -18,7 +18,7 @@ constexpr const char* kValidFaults =
     "shader_compile_error, move_vertex=ID, texel_offset=N, blend_factor=one|swapped, "
     "depth_func=inverted, stencil_op=shifted, blend_function=shifted, scissor_shift=N, "
     "lod_shift=N, lod_weight=inverted, "
-    "hang=FIXTURE|*, crash=FIXTURE|*";
+    "hang=FIXTURE|*, crash=FIXTURE|*, flaky=FIXTURE|*, hang_once=FIXTURE|*";
 
 [[noreturn]] void badFault(std::string_view entry, std::string_view why) {
   throw InputError(
@@ -44,11 +44,16 @@ bool Faults::any() const {
          no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
          texel_offset != 0.0 || blend_factor != Blend::Correct || depth_func_inverted ||
          stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 ||
-         lod_weight_inverted || !hang.empty() || !crash.empty();
+         lod_weight_inverted || !hang.empty() || !crash.empty() || !flaky.empty() ||
+         !hang_once.empty();
 }
 
 bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }
 bool Faults::crashes(const std::string& fixture) const { return crash == "*" || crash == fixture; }
+bool Faults::flakes(const std::string& fixture) const { return flaky == "*" || flaky == fixture; }
+bool Faults::hangsOnce(const std::string& fixture) const {
+  return hang_once == "*" || hang_once == fixture;
+}
 
 std::string Faults::describe() const {
   std::vector<std::string> parts;
@@ -70,6 +75,8 @@ std::string Faults::describe() const {
   if (lod_weight_inverted) parts.emplace_back("lod_weight=inverted");
   if (!hang.empty()) parts.push_back("hang=" + hang);
   if (!crash.empty()) parts.push_back("crash=" + crash);
+  if (!flaky.empty()) parts.push_back("flaky=" + flaky);
+  if (!hang_once.empty()) parts.push_back("hang_once=" + hang_once);
   return fmt::format("{}", fmt::join(parts, ","));
 }
 
@@ -88,7 +95,8 @@ Faults parseFaults(std::string_view text) {
     const bool valued = name == "drop_primitive" || name == "depth_bias" || name == "light_scale" ||
                         name == "shift_x" || name == "move_vertex" || name == "texel_offset" ||
                         name == "blend_factor" || name == "hang" || name == "crash" ||
-                        name == "depth_func" || name == "stencil_op" || name == "blend_function" ||
+                        name == "flaky" || name == "hang_once" || name == "depth_func" ||
+                        name == "stencil_op" || name == "blend_function" ||
                         name == "scissor_shift" || name == "lod_shift" || name == "lod_weight";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
@@ -130,9 +138,12 @@ Faults parseFaults(std::string_view text) {
     } else if (name == "lod_weight") {
       if (value != "inverted") badFault(entry, "must be inverted");
       f.lod_weight_inverted = true;
-    } else if (name == "hang" || name == "crash") {
+    } else if (name == "hang" || name == "crash" || name == "flaky" || name == "hang_once") {
       if (value.empty()) badFault(entry, "needs a fixture name or *");
-      (name == "hang" ? f.hang : f.crash) = std::string(value);
+      (name == "hang"    ? f.hang
+       : name == "crash" ? f.crash
+       : name == "flaky" ? f.flaky
+                         : f.hang_once) = std::string(value);
     } else if (name == "no_inverse_transpose") {
       f.no_inverse_transpose = true;
     } else {

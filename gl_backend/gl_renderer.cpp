@@ -1,10 +1,12 @@
 // renderGl: the process-wide GL session, the FBO, the draw sequence of drawPasses() and
 // the readback into a Frame (top row first). See gl_backend.h and docs/gl_backend.md.
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -14,11 +16,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <new>
 #include <optional>
+#include <random>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -1383,7 +1387,22 @@ void injectStall(const gl::testing::Faults& faults, const std::string& fixture) 
     std::signal(SIGSEGV, SIG_DFL);  // a sanitizer's handler would turn it into an exit code
     std::raise(SIGSEGV);
   }
-  if (faults.hangs(fixture)) {
+  bool hang = faults.hangs(fixture);
+  if (!hang && faults.hangsOnce(fixture)) {
+    // The first render in this temporary folder creates the marker and hangs; the others
+    // find it. O_EXCL makes "first" hold across processes.
+    std::string slug = fixture;
+    for (char& c : slug)
+      if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
+    const std::filesystem::path marker =
+        std::filesystem::temp_directory_path() / ("rastercheck-hang-once-" + slug);
+    const int fd = ::open(marker.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      ::close(fd);
+      hang = true;
+    }
+  }
+  if (hang) {
     // Said in the render's own output: a `run` worker keeps what it printed during the
     // render it was killed in, and the once-per-process fault warning may belong to an
     // earlier render of the same worker.
@@ -1391,6 +1410,21 @@ void injectStall(const gl::testing::Faults& faults, const std::string& fixture) 
     std::fflush(nullptr);
     for (;;) ::pause();
   }
+}
+
+// The test-only flaky fault: one pixel, drawn where possible, raised by a random 64..191
+// 8-bit units in red, from the operating system's entropy (so no two renders agree).
+void injectFlake(const gl::testing::Faults& faults, const std::string& fixture, Frame& frame) {
+  if (!faults.flakes(fixture) || frame.color.empty()) return;
+  std::random_device entropy;
+  const std::size_t n = frame.pixelCount();
+  std::vector<std::size_t> drawn;
+  for (std::size_t i = 0; i < n; ++i)
+    if (frame.id[i] != 0) drawn.push_back(i);
+  const std::size_t pick = drawn.empty() ? entropy() % n : drawn[entropy() % drawn.size()];
+  const auto units = static_cast<float>(64 + entropy() % 128);
+  float& red = frame.color[4 * pick];
+  red = red > 0.5f ? red - units / 255.0f : red + units / 255.0f;
 }
 
 Frame renderLocked(const Scene& scene, const GlSpec& spec) {
@@ -1517,6 +1551,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   }
   checkGl(s, "readback");
   s.render_unfinished = false;
+  injectFlake(faults, scene.name, frame);
   const double readback_ms = msSince(start);
   const double readback_cpu_ms = threadCpuMs() - cpu_start;
 

@@ -58,11 +58,20 @@ struct Faults {
   // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.
   std::string hang;
   std::string crash;
+  // flaky=NAME: the frame of that fixture ("*": every fixture) differs on every render (one
+  // pixel's colour raised by a random 64..191 8-bit units: a race, an uninitialised read);
+  // hang_once=NAME: its render hangs the first time in this temporary folder (a marker file
+  // in TMPDIR, so the first render of any process), and renders normally afterwards.
+  // For `run --retries`' flake tests.
+  std::string flaky;
+  std::string hang_once;
 
   bool any() const;
   // Whether hang / crash apply to the fixture named `fixture`.
   bool hangs(const std::string& fixture) const;
   bool crashes(const std::string& fixture) const;
+  bool flakes(const std::string& fixture) const;
+  bool hangsOnce(const std::string& fixture) const;
   // The canonical comma-separated form (parseFaults(describe()) gives the same faults).
   std::string describe() const;
 };

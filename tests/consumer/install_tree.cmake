@@ -21,3 +21,12 @@ list(LENGTH libraries count)
 if(NOT configs OR NOT count EQUAL 5)
   message(FATAL_ERROR "expected rastercheckConfig.cmake and 5 libraries, found: ${configs} ${libraries}")
 endif()
+# Every exported module carries the C++ standard its headers need (a consumer that sets
+# none still compiles them: package.consumer_build).
+file(GLOB_RECURSE target_files ${PREFIX}/*rastercheckTargets.cmake)
+file(READ "${target_files}" targets)
+string(REGEX MATCHALL "INTERFACE_COMPILE_FEATURES \"cxx_std_20\"" features "${targets}")
+list(LENGTH features feature_count)
+if(NOT feature_count EQUAL 5)
+  message(FATAL_ERROR "expected cxx_std_20 on the 5 exported targets, found ${feature_count} in ${target_files}")
+endif()
