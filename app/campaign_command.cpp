@@ -627,8 +627,9 @@ class Campaign {
         std::cout << "  reproduce: " << c << '\n';
     }
     for (const auto& [backend, c] : s.backends)
-      std::cout << fmt::format("{}: {} pairs, {} pass, {} warn, {} fail, {} error\n", backend,
-                               c.total(), c.pass, c.warn, c.fail, c.error);
+      std::cout << fmt::format("{}: {} pairs, {} pass, {} warn, {} fail, {} error{}\n", backend,
+                               c.total(), c.pass, c.warn, c.fail, c.error,
+                               c.flake ? fmt::format(", {} flake", c.flake) : std::string());
     std::cout << fmt::format("{} of {} scenes, {} failures in {} groups{}\n", s.scenes_run,
                              s.scenes_total, failures_.size(), groups.size(),
                              s.complete ? "" : " (incomplete)");

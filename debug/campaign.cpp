@@ -378,6 +378,7 @@ void countReport(const json& report, std::map<std::string, BackendCounts>& count
     if (status == "warn") ++c.warn;
     if (status == "fail") ++c.fail;
     if (status == "error") ++c.error;
+    if (status == "flake") ++c.flake;
   }
 }
 
@@ -445,11 +446,11 @@ std::string summaryMarkdown(const CampaignSummary& s, const std::vector<Campaign
       s.complete ? "The campaign is complete."
                  : "**Incomplete**: run the same command again to continue where it stopped.");
   md +=
-      "## Pairs per backend\n\n| backend | pairs | pass | warn | fail | error "
-      "|\n|---|---|---|---|---|---|\n";
+      "## Pairs per backend\n\n| backend | pairs | pass | warn | fail | error | flake "
+      "|\n|---|---|---|---|---|---|---|\n";
   for (const auto& [backend, c] : s.backends)
-    md += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", backend, c.total(), c.pass, c.warn,
-                      c.fail, c.error);
+    md += fmt::format("| `{}` | {} | {} | {} | {} | {} | {} |\n", backend, c.total(), c.pass,
+                      c.warn, c.fail, c.error, c.flake);
   md += "\n## Groups\n\n";
   if (groups.empty()) {
     md += "No failures.\n";
@@ -505,11 +506,8 @@ std::string summaryMarkdown(const CampaignSummary& s, const std::vector<Campaign
 json summaryJson(const CampaignSummary& s, const std::vector<CampaignGroup>& groups) {
   json backends = json::object();
   for (const auto& [backend, c] : s.backends)
-    backends[backend] = {{"pairs", c.total()},
-                         {"pass", c.pass},
-                         {"warn", c.warn},
-                         {"fail", c.fail},
-                         {"error", c.error}};
+    backends[backend] = {{"pairs", c.total()}, {"pass", c.pass},   {"warn", c.warn},
+                         {"fail", c.fail},     {"error", c.error}, {"flake", c.flake}};
   json jg = json::array();
   for (const CampaignGroup& g : groups) {
     const auto& files = filesOf(s, g);

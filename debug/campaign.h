@@ -114,7 +114,8 @@ struct BackendCounts {
   std::uint64_t warn = 0;
   std::uint64_t fail = 0;
   std::uint64_t error = 0;
-  std::uint64_t total() const { return pass + warn + fail + error; }
+  std::uint64_t flake = 0;  // renders that disagreed when `run` retried them (docs/ci.md)
+  std::uint64_t total() const { return pass + warn + fail + error + flake; }
 };
 // Adds the rows of one report.json, keyed "ACTUAL" (or "ACTUAL vs EXPECTED" when the
 // expected SPEC is not ref).

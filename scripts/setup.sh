@@ -13,7 +13,7 @@ packages=(
   mesa-vulkan-drivers libvulkan-dev
   libassimp-dev assimp-testmodels
   nlohmann-json3-dev libcli11-dev libfmt-dev
-  libpugixml-dev python3-jsonschema zlib1g-dev
+  libpugixml-dev python3-jsonschema python3-yaml zlib1g-dev
   strace clang libclang-rt-14-dev
 )
 if [[ "${RASTERCHECK_SETUP_BROWSER:-1}" == 1 ]]; then

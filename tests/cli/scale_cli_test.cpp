@@ -55,8 +55,16 @@ const std::string kBackends = " --backends ref:painter,ref:subpixel=4 ";
 // the shard record and the command line.
 json withoutTimings(json j) {
   j.erase("shard");
-  for (json& row : j["results"]) row.erase("seconds");
+  for (json& row : j["results"]) {
+    row.erase("seconds");
+    row.erase("render_seconds");
+  }
   return j;
+}
+
+// results.csv without its durations (the third column).
+std::string withoutDurations(const std::string& csv) {
+  return std::regex_replace(csv, std::regex(",[^,\n]*\n"), "\n");
 }
 
 std::string withoutTimes(std::string xml) {
@@ -99,6 +107,9 @@ TEST(CliScale, ShardsMergedAreTheUnshardedRun) {
   EXPECT_EQ(withoutTimes(readFile(dir / "merged" / "junit.xml")),
             withoutTimes(readFile(dir / "whole" / "junit.xml")));
   EXPECT_EQ(readFile(dir / "merged" / "report.html"), readFile(dir / "whole" / "report.html"));
+  EXPECT_EQ(withoutDurations(readFile(dir / "merged" / "results.csv")),
+            withoutDurations(readFile(dir / "whole" / "results.csv")));
+  EXPECT_FALSE(readFile(dir / "merged" / "results.csv").empty());
   EXPECT_EQ(filesUnder(dir / "merged" / "pairs"), filesUnder(dir / "whole" / "pairs"));
   EXPECT_FALSE(filesUnder(dir / "merged" / "pairs").empty());
   EXPECT_EQ(filesUnder(dir / "merged" / "frames"), filesUnder(dir / "whole" / "frames"));
