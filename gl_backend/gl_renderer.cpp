@@ -1412,16 +1412,29 @@ void injectStall(const gl::testing::Faults& faults, const std::string& fixture) 
   }
 }
 
-// The test-only flaky fault: one pixel, drawn where possible, raised by a random 64..191
-// 8-bit units in red, from the operating system's entropy (so no two renders agree).
+// The test-only flaky fault: one pixel, chosen by the operating system's entropy (so no
+// two renders agree) among those whose 3x3 neighbourhood shows one primitive (drawn ones
+// first: away from every edge, where no allowance forgives it), loses its primitive (a
+// drawn pixel shows the background; a background pixel an id no scene has: neither is
+// forgiven by a depth tie) and has red 64..191 8-bit units off.
 void injectFlake(const gl::testing::Faults& faults, const std::string& fixture, Frame& frame) {
   if (!faults.flakes(fixture) || frame.color.empty()) return;
   std::random_device entropy;
-  const std::size_t n = frame.pixelCount();
-  std::vector<std::size_t> drawn;
-  for (std::size_t i = 0; i < n; ++i)
-    if (frame.id[i] != 0) drawn.push_back(i);
-  const std::size_t pick = drawn.empty() ? entropy() % n : drawn[entropy() % drawn.size()];
+  const int w = frame.width, h = frame.height;
+  std::vector<std::size_t> drawn, background;
+  for (int y = 1; y + 1 < h; ++y)
+    for (int x = 1; x + 1 < w; ++x) {
+      const std::size_t i = frame.index(x, y);
+      bool uniform = true;
+      for (int dy = -1; dy <= 1 && uniform; ++dy)
+        for (int dx = -1; dx <= 1 && uniform; ++dx)
+          uniform = frame.id[frame.index(x + dx, y + dy)] == frame.id[i];
+      if (uniform) (frame.id[i] != 0 ? drawn : background).push_back(i);
+    }
+  const std::vector<std::size_t>& from = drawn.empty() ? background : drawn;
+  const std::size_t pick =
+      from.empty() ? entropy() % frame.pixelCount() : from[entropy() % from.size()];
+  frame.id[pick] = frame.id[pick] != 0 ? 0u : 0x7fffffffu;
   const auto units = static_cast<float>(64 + entropy() % 128);
   float& red = frame.color[4 * pick];
   red = red > 0.5f ? red - units / 255.0f : red + units / 255.0f;

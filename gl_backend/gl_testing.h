@@ -58,8 +58,9 @@ struct Faults {
   // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.
   std::string hang;
   std::string crash;
-  // flaky=NAME: the frame of that fixture ("*": every fixture) differs on every render (one
-  // pixel's colour raised by a random 64..191 8-bit units: a race, an uninitialised read);
+  // flaky=NAME: the frame of that fixture ("*": every fixture) differs on every render (a
+  // random pixel away from edges loses its primitive id, and its red is off by 64..191
+  // 8-bit units: a race, an uninitialised read);
   // hang_once=NAME: its render hangs the first time in this temporary folder (a marker file
   // in TMPDIR, so the first render of any process), and renders normally afterwards.
   // For `run --retries`' flake tests.
