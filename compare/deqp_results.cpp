@@ -191,7 +191,7 @@ void applyRunnerFiles(const RunnerFiles& files, Report& report) {
     r.runner_status = status;
     if (!runnerSuccess(status)) {
       ++unexpected;
-      if (listed.size() < 50) listed.push_back(name + "," + status);
+      if (listed.size() < 50) listed.push_back(fmt::format("{},{}", name, status));
     }
   }
   nlohmann::json j = {{"matches_baseline", unexpected == 0}, {"unexpected", unexpected}};

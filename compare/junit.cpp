@@ -60,8 +60,8 @@ std::string junitXml(const Report& report) {
   suite.append_attribute("tests") = static_cast<unsigned long long>(s.total());
   suite.append_attribute("failures") = static_cast<unsigned long long>(s.fail - s.known_fail);
   suite.append_attribute("errors") = static_cast<unsigned long long>(s.error);
-  suite.append_attribute("skipped") =
-      static_cast<unsigned long long>(s.known_fail + s.not_supported + s.flake);
+  const std::uint64_t skipped = s.known_fail + s.not_supported + s.flake;
+  suite.append_attribute("skipped") = static_cast<unsigned long long>(skipped);
   suite.append_attribute("time") = fmt::format("{:.6f}", total_seconds).c_str();
   pugi::xml_node props = suite.append_child("properties");
   pugi::xml_node version = props.append_child("property");

@@ -28,7 +28,8 @@ namespace fs = std::filesystem;
 
 constexpr double kD24 = 16777215.0;
 
-Frame render(const fs::path& fixture, ReferenceOptions options = {}, const char* backend = "ref") {
+Frame render(const fs::path& fixture, const ReferenceOptions& options = {},
+             const char* backend = "ref") {
   const Scene scene = loadScene(fixture);
   Frame f = renderReference(scene, options);
   f.meta["backend"] = backend;
