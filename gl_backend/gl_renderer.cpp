@@ -275,21 +275,36 @@ bool keepsOneContext(const Session& s) {
   return s.zink && s.mesa_version.rfind("Mesa 22.", 0) == 0;
 }
 
+// softpipe's one dependence on what its context drew before (docs/gl_backend.md, "softpipe
+// and its context"): its colour tile cache holds a tile as floats (a cleared tile as the
+// clear colour's floats, unclamped: sp_tile_cache.c clear_tile_rgba; a blended one clamped
+// but not rounded to 8 bits) until the tile is written back to the rgba8 buffer, and blending
+// reads the destination from the cache. Whether a write-back comes between two draws (or the
+// clear and a draw) depends on what the context holds from earlier renders (texture cache
+// slots that still reference old textures make a later resource map flush every cache), so
+// blending onto an 8-bit buffer may read the floats or the stored 8-bit values. Those renders
+// get a new context; without blending, or into rgba32f, the tile's values are what is stored.
+bool blendsOntoRgba8(const Scene& scene) {
+  if (scene.state.color_format != ColorFormat::RGBA8) return false;
+  const std::vector<DrawPass> passes = drawPasses(scene);
+  return std::any_of(passes.begin(), passes.end(), [](const DrawPass& p) { return p.blend; });
+}
+
 // Whether the next render reuses this process's context, and with it the programs it
 // compiled, instead of starting from a new one (resetReusedContext() restores what a render
 // does not set itself): where the isolation test shows that a frame is the one a new context
 // gives, whatever the context drew before (GlBackend.FramesDoNotDependOnWhatWasDrawnBefore),
-// that is llvmpipe and zink; zink on Mesa 22 in any case (keepsOneContext). softpipe fails
-// that test: in a reused context its rgba8 blending over a clear colour outside [0, 1]
-// differs from a new context's (docs/gl_backend.md), so it gets a new context per render, as
-// does a driver the test has not run on (a GPU). RASTERCHECK_GL_CONTEXT=new gives every driver
-// but zink on Mesa 22 a new context per render, =reuse reuses it on every driver (to test
+// that is llvmpipe and zink; zink on Mesa 22 in any case (keepsOneContext); and softpipe but
+// for the renders blendsOntoRgba8() names. A driver the test has not run on (a GPU)
+// gets a new context per render. RASTERCHECK_GL_CONTEXT=new gives every driver but zink on
+// Mesa 22 a new context per render, =reuse reuses it on every driver and render (to test
 // one); it is read at every render.
-bool reusesContext(const Session& s) {
+bool reusesContext(const Session& s, const Scene& scene) {
   if (keepsOneContext(s)) return true;
   const char* forced = std::getenv("RASTERCHECK_GL_CONTEXT");
   if (forced != nullptr && std::string_view(forced) == "new") return false;
   if (forced != nullptr && std::string_view(forced) == "reuse") return true;
+  if (s.driver == "softpipe") return !blendsOntoRgba8(scene);
   return s.driver == "llvmpipe" || s.driver == "zink";
 }
 
@@ -391,7 +406,7 @@ void resetReusedContext(Session& s) {
 }
 
 // Returns the session for spec, made current on this thread.
-Session& acquireSession(const GlSpec& spec) {
+Session& acquireSession(const GlSpec& spec, const Scene& scene) {
   // A missing GPU is the answer for an egl-device spec, whatever else this process runs.
   if (spec.platform == GlSpec::Platform::EglDevice) gl::findEglDevice(spec.device);
   if (g_session == nullptr) {
@@ -414,7 +429,7 @@ Session& acquireSession(const GlSpec& spec) {
         spec.driver, have.driver, toString(spec)));
   }
   Session& s = *g_session;
-  const bool reuse = reusesContext(s);
+  const bool reuse = reusesContext(s, scene);
   s.context_use = !reuse ? "new" : s.render_unfinished ? "replaced" : "reused";
   if (!reuse) {
     renewContext(s);
@@ -1444,7 +1459,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   validateForRendering(scene);  // bad input is exit 2 before any driver starts
   const gl::testing::Faults faults = activeFaults();  // bad RASTERCHECK_GL_FAULT: exit 2
   auto start = Clock::now();
-  Session& s = acquireSession(spec);
+  Session& s = acquireSession(spec, scene);
   struct Release {
     Session& s;
     ~Release() { s.context->release(); }
