@@ -188,8 +188,8 @@ TEST(GlWorkers, ARequestsFaultAppliesToThatRenderAlone) {
 // every profile and the whole catalog in file order, then the same list shuffled, then A, B,
 // A for a blended and a textured scene, and every frame must be the bits a worker with a new
 // context per render (RASTERCHECK_GL_CONTEXT=new) gives. Where the driver keeps its context
-// (llvmpipe, zink) this is what allows it; softpipe gets a new context per render
-// (docs/gl_backend.md) and is held to the same. Tried: with the front face set only for
+// (llvmpipe, zink; softpipe but for renders that blend onto rgba8, docs/gl_backend.md) this
+// is what allows it. Tried: with the front face set only for
 // clockwise scenes it fails on llvmpipe.
 TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
   const fs::path dir = scratch("isolation");
