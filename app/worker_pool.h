@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <deque>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -52,6 +53,10 @@ class WorkerPool {
     // NAME=VALUE entries added to the workers' environment (e.g. the mutation study's
     // TMPDIR under its campaign folder).
     std::vector<std::string> environment;
+    // Workers of one backend at a time; 0: workersFor()'s choice (one for llvmpipe and zink,
+    // which draw on threads of their own; else a second and further ones only while the
+    // backend's queued renders are worth more than starting one).
+    int max_workers_per_spec = 0;
   };
   explicit WorkerPool(Options options);
   WorkerPool(const WorkerPool&) = delete;
@@ -95,6 +100,7 @@ class WorkerPool {
   };
 
   void dispatch();
+  std::size_t workersFor(const std::string& spec) const;
   Worker* startWorker(const std::string& spec);
   bool send(Worker& w, const Task& task);
   void readReply(Worker& w, std::vector<std::pair<std::size_t, RenderOutcome>>& done);
@@ -109,6 +115,9 @@ class WorkerPool {
   std::deque<Task> queue_;
   std::size_t next_ticket_ = 0;
   std::size_t busy_ = 0;
+  // Per backend: renders finished and their seconds (from request to reply), for
+  // workersFor()'s estimate of the work still queued.
+  std::map<std::string, std::pair<std::size_t, double>> render_time_;
   int started_ = 0;
 };
 
