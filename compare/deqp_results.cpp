@@ -70,6 +70,10 @@ std::vector<Row> rows(const Report& report) {
 std::string testName(const PairResult& r) {
   std::string name = r.fixture + "@" + r.actual;
   if (r.expected != "ref") name += "@" + r.expected;
+  // The files are comma-separated lines: a comma or line break in a fixture's name would
+  // split its line.
+  for (char& c : name)
+    if (c == ',' || c == '\n' || c == '\r') c = '_';
   return name;
 }
 

@@ -24,7 +24,8 @@ namespace rc {
 struct Report;
 
 // "<fixture>@<actual>", and "@<expected>" after it when the pair is not compared with the
-// reference: e.g. "shading/blinn_phong_sphere@gl:egl:llvmpipe".
+// reference: e.g. "shading/blinn_phong_sphere@gl:egl:llvmpipe". Commas and line breaks
+// (in a fixture's name) become '_'.
 std::string testName(const PairResult& r);
 
 // What the row is in deqp-runner's words before any baseline: Pass (pass), Warn (warn),

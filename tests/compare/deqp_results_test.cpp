@@ -50,6 +50,7 @@ TEST(DeqpResults, TestNamesAndStatuses) {
   EXPECT_EQ(testName(r), "shading/sphere@gl:egl:llvmpipe");
   r.expected = "gl:egl:softpipe";
   EXPECT_EQ(testName(r), "shading/sphere@gl:egl:llvmpipe@gl:egl:softpipe");
+  EXPECT_EQ(testName(row("a,b\nc", Status::Pass)), "a_b_c@gl:x") << "one CSV field";
 
   EXPECT_EQ(runnerStatus(row("a", Status::Pass)), "Pass");
   EXPECT_EQ(runnerStatus(row("a", Status::Warn)), "Warn");
