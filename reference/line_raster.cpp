@@ -152,4 +152,34 @@ std::vector<LinePixel> rasterizeLine(const FixedVertex& a, const FixedVertex& b,
   return out;
 }
 
+std::vector<LinePixel> rasterizeWideLine(const FixedVertex& a, const FixedVertex& b, double width,
+                                         int subpixel_bits, const PixelRect& clip) {
+  const auto w = static_cast<int>(std::max(1.0, std::nearbyint(width)));
+  if (w == 1) return rasterizeLine(a, b, subpixel_bits, clip);
+  const bool x_major = std::llabs(b.x - a.x) >= std::llabs(b.y - a.y);
+  // (w - 1) / 2 px in snapped units: exact, also for an even w (half a pixel) unless the
+  // grid has no half unit (0 bits), where the offset is done in doubled units instead.
+  const int bits = subpixel_bits == 0 ? 1 : subpixel_bits;
+  const std::int64_t k = subpixel_bits == 0 ? 2 : 1;
+  const std::int64_t shift = static_cast<std::int64_t>(w - 1) << (bits - 1);
+  FixedVertex oa{a.x * k, a.y * k}, ob{b.x * k, b.y * k};
+  (x_major ? oa.y : oa.x) -= shift;
+  (x_major ? ob.y : ob.x) -= shift;
+  // The replicated fragments reach w - 1 pixels past the offset segment's: rasterize it
+  // unclipped in the minor direction by that much, then clip each fragment.
+  PixelRect wide = clip;
+  (x_major ? wide.y0 : wide.x0) -= w - 1;
+  std::vector<LinePixel> out;
+  for (const LinePixel& p : rasterizeLine(oa, ob, bits, wide)) {
+    for (int i = 0; i < w; ++i) {
+      const LinePixel q = x_major ? LinePixel{p.x, p.y + i} : LinePixel{p.x + i, p.y};
+      if (q.x >= clip.x0 && q.x < clip.x1 && q.y >= clip.y0 && q.y < clip.y1) out.push_back(q);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const LinePixel& p, const LinePixel& q) {
+    return p.y != q.y ? p.y < q.y : p.x < q.x;
+  });
+  return out;
+}
+
 }  // namespace rc::ref

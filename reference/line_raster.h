@@ -40,4 +40,13 @@ bool lineProducesFragment(const FixedVertex& a, const FixedVertex& b, std::int64
 std::vector<LinePixel> rasterizeLine(const FixedVertex& a, const FixedVertex& b, int subpixel_bits,
                                      const PixelRect& clip);
 
+// A non-antialiased wide line by GL's column rule (14.5.2.1): w = the width rounded to the
+// nearest integer (0 counts as 1); the segment moved by -(w - 1) / 2 px in its minor
+// direction (y for an x-major segment, |dx| >= |dy|; else x) is rasterized by the one-pixel
+// rule, and each of its fragments becomes a column (x-major) or row of w fragments, the
+// fragment itself the lowest (leftmost). GL also lets an implementation draw a wide line as
+// the rectangle around the segment; which one a driver follows is a variant to probe.
+std::vector<LinePixel> rasterizeWideLine(const FixedVertex& a, const FixedVertex& b, double width,
+                                         int subpixel_bits, const PixelRect& clip);
+
 }  // namespace rc::ref

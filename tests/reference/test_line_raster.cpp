@@ -125,5 +125,38 @@ TEST(LineRaster, AnXMajorSegmentHasOneFragmentPerColumn) {
   }
 }
 
+std::set<std::pair<int, int>> widePixels(const FixedVertex& a, const FixedVertex& b, double w) {
+  std::set<std::pair<int, int>> out;
+  for (const LinePixel& p : rasterizeWideLine(a, b, w, kBits, kClip)) out.insert({p.x, p.y});
+  return out;
+}
+
+// GL's column rule: a width-3 horizontal segment through centres is three rows, centred;
+// a width-2 one is offset half a pixel down, so its rows are the one below and its own;
+// widths round to the nearest integer, 0.4 counting as 1; a y-major segment widens in x.
+TEST(LineRaster, WideLinesAreColumnsOfRoundedWidth) {
+  std::set<std::pair<int, int>> three, two;
+  for (int x = 0; x < 4; ++x)
+    for (int dy : {-1, 0, 1}) three.insert({x, dy});
+  EXPECT_EQ(widePixels(at(0, 0), at(4, 0), 3.0), three);
+  EXPECT_EQ(widePixels(at(0, 0), at(4, 0), 2.6), three);
+  for (int x = 0; x < 4; ++x)
+    for (int dy : {-1, 0}) two.insert({x, dy});
+  EXPECT_EQ(widePixels(at(0, 0), at(4, 0), 2.0), two);
+  EXPECT_EQ(widePixels(at(0, 0), at(4, 0), 0.4), pixels(at(0, 0), at(4, 0)));
+  std::set<std::pair<int, int>> vertical;
+  for (int y = 0; y < 3; ++y)
+    for (int dx : {-1, 0, 1}) vertical.insert({dx, y});
+  EXPECT_EQ(widePixels(at(0, 0), at(0, 3), 3.0), vertical);
+  // Every column of a slanted x-major wide line holds exactly w fragments, contiguous.
+  const auto slanted = widePixels(at(-7.3, 2.1), at(9.6, -3.4), 4.0);
+  std::map<int, std::vector<int>> rows;
+  for (const auto& [x, y] : slanted) rows[x].push_back(y);
+  for (const auto& [x, ys] : rows) {
+    ASSERT_EQ(ys.size(), 4u) << x;
+    EXPECT_EQ(ys.back() - ys.front(), 3) << x;
+  }
+}
+
 }  // namespace
 }  // namespace rc::ref
