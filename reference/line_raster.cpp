@@ -182,4 +182,27 @@ std::vector<LinePixel> rasterizeWideLine(const FixedVertex& a, const FixedVertex
   return out;
 }
 
+std::vector<LinePixel> rasterizePoint(const FixedVertex& center, double size, int subpixel_bits,
+                                      const PixelRect& clip) {
+  std::vector<LinePixel> out;
+  if (!(size > 0.0) || !std::isfinite(size)) return out;
+  // Compared in units of 2^-bits px: a centre c is covered iff low <= c < high on both axes,
+  // low = center - size / 2 (in double: exact for sizes on the grid, and the comparison of a
+  // centre, an integer, with it is then exact too).
+  const double half = size * std::ldexp(1.0, subpixel_bits) / 2.0;
+  const double unit = std::ldexp(1.0, subpixel_bits);
+  auto range = [&](std::int64_t c, int lo_clip, int hi_clip) {
+    const double low = static_cast<double>(c) - half, high = static_cast<double>(c) + half;
+    const int first = std::max(lo_clip, static_cast<int>(std::max(-1e9, std::ceil(low / unit))));
+    int last = static_cast<int>(std::min(1e9, std::ceil(high / unit))) - 1;  // centre < high
+    last = std::min(last, hi_clip - 1);
+    return std::pair<int, int>{first, last};
+  };
+  const auto [x0, x1] = range(center.x, clip.x0, clip.x1);
+  const auto [y0, y1] = range(center.y, clip.y0, clip.y1);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) out.push_back({x, y});
+  return out;
+}
+
 }  // namespace rc::ref

@@ -49,4 +49,12 @@ std::vector<LinePixel> rasterizeLine(const FixedVertex& a, const FixedVertex& b,
 std::vector<LinePixel> rasterizeWideLine(const FixedVertex& a, const FixedVertex& b, double width,
                                          int subpixel_bits, const PixelRect& clip);
 
+// A point (GL 4.6 core, 14.4: always a point sprite): the pixels whose centres lie in the
+// square of side `size` px centred at the snapped `center`. GL leaves centres on the
+// square's border to the implementation; this takes the triangles' rule (rasterizer.h:
+// left and bottom edges covered, right and top not), as a driver that draws a point as two
+// triangles does. For an integer size every position gives size x size pixels.
+std::vector<LinePixel> rasterizePoint(const FixedVertex& center, double size, int subpixel_bits,
+                                      const PixelRect& clip);
+
 }  // namespace rc::ref

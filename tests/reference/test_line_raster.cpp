@@ -158,5 +158,36 @@ TEST(LineRaster, WideLinesAreColumnsOfRoundedWidth) {
   }
 }
 
+std::set<std::pair<int, int>> pointPixels(double x, double y, double size) {
+  std::set<std::pair<int, int>> out;
+  for (const LinePixel& p : rasterizePoint(at(x, y), size, kBits, kClip)) out.insert({p.x, p.y});
+  return out;
+}
+
+// Points: the centres in the square of side `size`, the left and bottom borders included.
+TEST(LineRaster, PointsAreSquaresOfTheirSize) {
+  EXPECT_EQ(pointPixels(2, 3, 1), (std::set<std::pair<int, int>>{{2, 3}}));
+  // Centred on a pixel corner (half-way between centres): the square [1.5, 2.5) holds the
+  // centre on its left and bottom borders only.
+  EXPECT_EQ(pointPixels(1.5, 1.5, 1), (std::set<std::pair<int, int>>{{1, 1}}));
+  EXPECT_EQ(pointPixels(2, 2, 2), (std::set<std::pair<int, int>>{{1, 1}, {2, 1}, {1, 2}, {2, 2}}));
+  EXPECT_EQ(pointPixels(2, 2, 3).size(), 9u);
+  EXPECT_TRUE(pointPixels(2, 2, 0).empty());
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::int64_t> coord(-20 * kUnit, 20 * kUnit);
+  for (int n = 0; n < 500; ++n) {
+    const FixedVertex c{coord(rng), coord(rng)};
+    for (int size = 1; size <= 6; ++size) {
+      const auto got = rasterizePoint(c, size, kBits, kClip);
+      EXPECT_EQ(got.size(), static_cast<std::size_t>(size * size)) << n << " size " << size;
+      for (const LinePixel& p : got) {  // every centre within the square, half-open
+        const double dx = static_cast<double>((std::int64_t{p.x} << kBits) - c.x) / kUnit;
+        const double dy = static_cast<double>((std::int64_t{p.y} << kBits) - c.y) / kUnit;
+        EXPECT_TRUE(dx >= -size / 2.0 && dx < size / 2.0 && dy >= -size / 2.0 && dy < size / 2.0);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rc::ref
