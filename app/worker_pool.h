@@ -71,7 +71,7 @@ class WorkerPool {
   // returns what finished since the last call as (ticket, outcome).
   std::vector<std::pair<std::size_t, RenderOutcome>> poll(int wait_ms, bool start_more = true);
   // Renders queued or running.
-  std::size_t outstanding() const { return queue_.size() + busy_; }
+  std::size_t outstanding() const { return queued_ + busy_; }
   // Workers started so far (restarts included).
   int workersStarted() const { return started_; }
 
@@ -112,7 +112,10 @@ class WorkerPool {
 
   Options options_;
   std::vector<std::unique_ptr<Worker>> workers_;
-  std::deque<Task> queue_;
+  // Queued renders per backend (and whether they want a fresh worker), each in submission
+  // order: dispatch() looks at the fronts only, so a long queue costs nothing per render.
+  std::map<std::pair<std::string, bool>, std::deque<Task>> queues_;
+  std::size_t queued_ = 0;
   std::size_t next_ticket_ = 0;
   std::size_t busy_ = 0;
   // Per backend: renders finished and their seconds (from request to reply), for
