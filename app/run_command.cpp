@@ -16,6 +16,7 @@
 #include <deque>
 #include <exception>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -428,6 +429,21 @@ int runCommand(const RunArgs& args) {
       return runnerSuccess(
           withBaseline(now, it == runner.baseline.expected.end() ? std::string() : it->second));
     };
+    // Compares one pair and writes its images when it does not pass (always with
+    // --keep-frames); `pictures` keeps the frames the images show and names their color.png.
+    // The tolerances were checked up front; an InputError from here on (a fixture changed
+    // under us) ends the run with exit 2 and no report.
+    auto compareAndWrite = [&](const FixtureEntry& fx, const Frame& expected, const Frame& actual,
+                               const Frame& uncertainty,
+                               const std::function<PairPictures()>& pictures) {
+      const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
+      ClassMaps maps;
+      maps.want_flip = args.flip;  // --flip-threshold asks through tol as well
+      PairResult r = compareNamed(expected, actual, uncertainty, tol, &maps);
+      if (args.keep_frames || r.status != Status::Pass)
+        writePairImages(expected, actual, maps, folder.pairDirectory(r), r, pictures());
+      return r;
+    };
     auto compareFixture = [&](std::size_t f) {
       const FixtureEntry& fx = fixtures[f];
       std::map<std::string, RenderOutcome>& outs = got[f];
@@ -492,19 +508,12 @@ int runCommand(const RunArgs& args) {
                                                expected.height));
               uncertainty = &ref;
             }
-            // The tolerances were checked up front; an InputError from here on (a fixture
-            // changed under us) ends the run with exit 2 and no report.
-            const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
-            ClassMaps maps;
-            maps.want_flip = args.flip;  // --flip-threshold asks through tol as well
-            r = compareNamed(expected, actual, *uncertainty, tol, &maps);
-            if (args.keep_frames || r.status != Status::Pass) {
+            r = compareAndWrite(fx, expected, actual, *uncertainty, [&]() -> PairPictures {
               const fs::path da = keepFrame(against.text);
               const fs::path db = keepFrame(spec);
               if (use_ref) keepFrame("ref");
-              writePairImages(expected, actual, maps, folder.pairDirectory(r), r,
-                              {readyPicture(da, expected), readyPicture(db, actual)});
-            }
+              return {readyPicture(da, expected), readyPicture(db, actual)};
+            });
           } catch (const BackendError& e) {
             r = errorResult(fx.name, against.text, spec, e.what());
           }
@@ -610,12 +619,8 @@ int runCommand(const RunArgs& args) {
         if (!expected.hasUncertainty() && fs::exists(dir / "ref"))
           ref_frame = readFrameDir(dir / "ref");
         const Frame& uncertainty = ref_frame.width > 0 ? ref_frame : expected;
-        const Tolerances tol = pairTolerances(expected, o.frame, fx.tolerance, cli);
-        ClassMaps maps;
-        maps.want_flip = args.flip;
-        PairResult compared = compareNamed(expected, o.frame, uncertainty, tol, &maps);
-        if (compared.status != Status::Pass)
-          writePairImages(expected, o.frame, maps, folder.pairDirectory(compared), compared, {});
+        PairResult compared =
+            compareAndWrite(fx, expected, o.frame, uncertainty, [] { return PairPictures{}; });
         compared.attempts = std::move(r.attempts);
         compared.render_seconds = r.render_seconds;
         r = std::move(compared);

@@ -203,18 +203,24 @@ namespace {
 class FrameHash {
  public:
   void word(std::uint64_t w) { h_ = (h_ ^ w) * 0x100000001b3ull; }
+  // The buffer's bytes, eight at a time, the rest one by one.
   template <class T>
-  void plane(const std::vector<T>& v) {
-    word(v.size());
-    const std::size_t bytes = v.size() * sizeof(T);
+  void bytes(const std::vector<T>& v) {
+    const std::size_t n = v.size() * sizeof(T);
     const auto* p = reinterpret_cast<const unsigned char*>(v.data());
     std::size_t k = 0;
-    for (; k + 8 <= bytes; k += 8) {
+    for (; k + 8 <= n; k += 8) {
       std::uint64_t w;
       std::memcpy(&w, p + k, 8);
       word(w);
     }
-    for (; k < bytes; ++k) word(p[k]);
+    for (; k < n; ++k) word(p[k]);
+  }
+  // A plane: its length, then its bytes (an empty plane still counts).
+  template <class T>
+  void plane(const std::vector<T>& v) {
+    word(v.size());
+    bytes(v);
   }
   std::string hex() const { return fmt::format("{:016x}", h_); }
 
@@ -227,15 +233,7 @@ class FrameHash {
 std::string colorDigest(const Frame& frame) {
   FrameHash h;
   h.word(static_cast<std::uint64_t>(frame.width) << 32 | static_cast<std::uint32_t>(frame.height));
-  const std::size_t bytes = frame.color.size() * sizeof(float);
-  const auto* p = reinterpret_cast<const unsigned char*>(frame.color.data());
-  std::size_t k = 0;
-  for (; k + 8 <= bytes; k += 8) {
-    std::uint64_t w;
-    std::memcpy(&w, p + k, 8);
-    h.word(w);
-  }
-  for (; k < bytes; ++k) h.word(p[k]);
+  h.bytes(frame.color);
   return h.hex();
 }
 

@@ -284,9 +284,8 @@ bool keepsOneContext(const Session& s) {
 // slots that still reference old textures make a later resource map flush every cache), so
 // blending onto an 8-bit buffer may read the floats or the stored 8-bit values. Those renders
 // get a new context; without blending, or into rgba32f, the tile's values are what is stored.
-bool blendsOntoRgba8(const Scene& scene) {
+bool blendsOntoRgba8(const Scene& scene, const std::vector<DrawPass>& passes) {
   if (scene.state.color_format != ColorFormat::RGBA8) return false;
-  const std::vector<DrawPass> passes = drawPasses(scene);
   return std::any_of(passes.begin(), passes.end(), [](const DrawPass& p) { return p.blend; });
 }
 
@@ -299,12 +298,12 @@ bool blendsOntoRgba8(const Scene& scene) {
 // gets a new context per render. RASTERCHECK_GL_CONTEXT=new gives every driver but zink on
 // Mesa 22 a new context per render, =reuse reuses it on every driver and render (to test
 // one); it is read at every render.
-bool reusesContext(const Session& s, const Scene& scene) {
+bool reusesContext(const Session& s, bool blends_onto_rgba8) {
   if (keepsOneContext(s)) return true;
   const char* forced = std::getenv("RASTERCHECK_GL_CONTEXT");
   if (forced != nullptr && std::string_view(forced) == "new") return false;
   if (forced != nullptr && std::string_view(forced) == "reuse") return true;
-  if (s.driver == "softpipe") return !blendsOntoRgba8(scene);
+  if (s.driver == "softpipe") return !blends_onto_rgba8;
   return s.driver == "llvmpipe" || s.driver == "zink";
 }
 
@@ -406,7 +405,8 @@ void resetReusedContext(Session& s) {
 }
 
 // Returns the session for spec, made current on this thread.
-Session& acquireSession(const GlSpec& spec, const Scene& scene) {
+// `blends_onto_rgba8`: blendsOntoRgba8() of the scene about to be drawn.
+Session& acquireSession(const GlSpec& spec, bool blends_onto_rgba8) {
   // A missing GPU is the answer for an egl-device spec, whatever else this process runs.
   if (spec.platform == GlSpec::Platform::EglDevice) gl::findEglDevice(spec.device);
   if (g_session == nullptr) {
@@ -429,7 +429,7 @@ Session& acquireSession(const GlSpec& spec, const Scene& scene) {
         spec.driver, have.driver, toString(spec)));
   }
   Session& s = *g_session;
-  const bool reuse = reusesContext(s, scene);
+  const bool reuse = reusesContext(s, blends_onto_rgba8);
   s.context_use = !reuse ? "new" : s.render_unfinished ? "replaced" : "reused";
   if (!reuse) {
     renewContext(s);
@@ -1458,8 +1458,9 @@ void injectFlake(const gl::testing::Faults& faults, const std::string& fixture, 
 Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   validateForRendering(scene);  // bad input is exit 2 before any driver starts
   const gl::testing::Faults faults = activeFaults();  // bad RASTERCHECK_GL_FAULT: exit 2
+  const std::vector<DrawPass> passes = drawPasses(scene);
   auto start = Clock::now();
-  Session& s = acquireSession(spec, scene);
+  Session& s = acquireSession(spec, blendsOntoRgba8(scene, passes));
   struct Release {
     Session& s;
     ~Release() { s.context->release(); }
@@ -1530,7 +1531,6 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
 
   start = Clock::now();
   cpu_start = threadCpuMs();
-  const std::vector<DrawPass> passes = drawPasses(scene);
   gl::VertexData data = gl::buildVertexData(scene, passes, faults);
   // Scenes with polygon offset measure the driver's r first (single-sample frames).
   const bool probe_offset =

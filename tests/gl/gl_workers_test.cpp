@@ -2,13 +2,15 @@
 // crash, gl_backend/gl_testing.h): the render that hangs or crashes becomes one error row
 // naming the timeout or the signal, its worker is replaced, and the fixtures before and
 // after it are rendered and compared as usual. Also the faults themselves through
-// `render`, so that the run tests cannot pass by the faults doing nothing.
+// `render`, so that the run tests cannot pass by the faults doing nothing. Then `run --retries`
+// and deqp-runner's files (RunFlakes, below).
 
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -252,6 +254,246 @@ TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
     EXPECT_EQ(pool.workersStarted(), 1);
   }
   fs::remove_all(dir);
+}
+
+// `run --retries` and deqp-runner's files through the command (docs/ci.md): flaky renders
+// told apart from failures (test faults flaky=NAME, a render whose bits change every time,
+// and hang_once=NAME, a hang that happens once; drop_primitive, a failure that is the same
+// every time), results.csv and failures.csv, a baseline written by hand with every status, a
+// round trip of results.csv as the next run's baseline, skips, flakes, caselists and
+// --fraction.
+
+std::string readText(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// results.csv as name -> status (and every line checked for deqp-runner's three columns).
+std::map<std::string, std::string> resultsOf(const fs::path& out) {
+  std::map<std::string, std::string> m;
+  std::istringstream in(readText(out / "results.csv"));
+  std::string line, previous;
+  while (std::getline(in, line)) {
+    const std::size_t a = line.find(','), b = line.rfind(',');
+    EXPECT_TRUE(a != std::string::npos && b != a) << line;
+    const std::string name = line.substr(0, a);
+    EXPECT_LT(previous, name) << "sorted by name";
+    previous = name;
+    EXPECT_NO_THROW((void)std::stod(line.substr(b + 1))) << line;
+    m[name] = line.substr(a + 1, b - a - 1);
+  }
+  return m;
+}
+
+std::map<std::string, json> rowsOf(const fs::path& out) {
+  const json report = json::parse(std::ifstream(out / "report.json"));
+  std::map<std::string, json> m;
+  for (const json& row : report["results"]) m[row["fixture"].get<std::string>()] = row;
+  return m;
+}
+
+const std::vector<std::string> kNames = {"coverage/triangle_fan", "zbuffer/interpenetrating_ab",
+                                         "shading/sphere_gouraud_low",
+                                         "texture/checker_grazing_nearest_repeat"};
+std::string fixtures() {
+  std::string s;
+  for (const std::string& n : kNames) s += " " + catalog(n + ".json");
+  return s;
+}
+std::string test(const std::string& name) { return name + "@gl:egl:llvmpipe"; }
+
+class RunFlakes : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = scratch(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    if (!llvmpipeRuns(dir_)) GTEST_SKIP() << "llvmpipe does not start here";
+  }
+  fs::path dir_;
+};
+
+// Every render of the flaky fixture differs: the pair fails once, its retry gives other bits,
+// and it is a flake (its own status, attempts with two digests, the differing pixels), which
+// does not fail the run. A dropped triangle fails the same way twice and stays a failure.
+TEST_F(RunFlakes, ChangingBitsAreAFlakeTheSameFailureIsNot) {
+  const fs::path out = dir_ / "out";
+  const Result r =
+      run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants --out " + out.string(),
+          "RASTERCHECK_GL_FAULT=flaky=shading/sphere_gouraud_low");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("1 flake"), std::string::npos) << r.out;
+  auto rows = rowsOf(out);
+  const json& flake = rows["shading/sphere_gouraud_low"];
+  EXPECT_EQ(flake["status"], "flake") << flake.dump(1);
+  ASSERT_EQ(flake["attempts"].size(), 2u);
+  EXPECT_NE(flake["attempts"][0]["digest"], flake["attempts"][1]["digest"]);
+  EXPECT_GE(flake["flake"]["differing_pixels"].get<int>(), 1);
+  EXPECT_LE(flake["flake"]["differing_pixels"].get<int>(), 2);
+  for (const json& a : flake["attempts"])
+    EXPECT_TRUE(fs::exists(out / a["frame"].get<std::string>() / "frame.exr")) << a.dump();
+  for (const std::string& n : kNames)
+    if (n != "shading/sphere_gouraud_low") {
+      EXPECT_EQ(rows[n]["status"], "pass") << n;
+    }
+  EXPECT_EQ(resultsOf(out)[test("shading/sphere_gouraud_low")], "Flake");
+  EXPECT_EQ(readText(out / "failures.csv"), "") << "a flake is a success, as in deqp-runner";
+  const std::string junit = readText(out / "junit.xml");
+  EXPECT_NE(junit.find("type=\"flake\""), std::string::npos);
+
+  // Deterministic: the same failure on every render (drop_primitive) is retried, agrees,
+  // and stays a failure; --retries 0 renders once.
+  const fs::path det = dir_ / "det";
+  const Result d =
+      run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants --out " + det.string(),
+          "RASTERCHECK_GL_FAULT=drop_primitive=1");
+  EXPECT_EQ(d.code, 1) << d.out;
+  for (const auto& [name, row] : rowsOf(det)) {
+    SCOPED_TRACE(name);
+    EXPECT_NE(row["status"], "flake");
+    if (row["status"] == "fail") {
+      ASSERT_EQ(row["attempts"].size(), 2u);
+      EXPECT_EQ(row["attempts"][0]["digest"], row["attempts"][1]["digest"]);
+    }
+  }
+  EXPECT_NE(readText(det / "failures.csv").find(",Fail\n"), std::string::npos);
+  const fs::path once = dir_ / "once";
+  const Result o = run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants " +
+                           "--retries 0 --out " + once.string(),
+                       "RASTERCHECK_GL_FAULT=flaky=shading/sphere_gouraud_low");
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_EQ(rowsOf(once)["shading/sphere_gouraud_low"]["status"], "fail");
+}
+
+// A hang that happens once: the first render times out, the retry in a fresh worker
+// renders and passes: a flake (first attempt an error, second a digest), exit 0.
+TEST_F(RunFlakes, AHangThatHappensOnceIsAFlake) {
+  const fs::path out = dir_ / "out";
+  const fs::path tmp = dir_ / "tmp";
+  fs::create_directories(tmp);
+  const Result r =
+      run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants " +
+              "--timeout 10 --out " + out.string(),
+          "TMPDIR=" + tmp.string() + " RASTERCHECK_GL_FAULT=hang_once=zbuffer/interpenetrating_ab");
+  EXPECT_EQ(r.code, 0) << r.out;
+  const json row = rowsOf(out)["zbuffer/interpenetrating_ab"];
+  EXPECT_EQ(row["status"], "flake") << row.dump(1);
+  ASSERT_EQ(row["attempts"].size(), 2u);
+  EXPECT_NE(row["attempts"][0]["error"].get<std::string>().find("timed out"), std::string::npos);
+  EXPECT_TRUE(row["attempts"][1].contains("digest"));
+  EXPECT_EQ(row["shading"]["status"], "pass") << "compared from the retry that rendered";
+}
+
+// A Mesa-style baseline written by hand (fails, flakes, skips), every status: expected
+// failures, an unexpected pass, a regression, a known flake, a skip, an expected crash.
+TEST_F(RunFlakes, AHandWrittenBaselineGivesEveryStatus) {
+  std::ofstream(dir_ / "fails.txt") << "# deqp-runner baseline\n"
+                                    << test("coverage/triangle_fan") << ",Fail\n"
+                                    << test("zbuffer/interpenetrating_ab") << ",Fail\n"
+                                    << test("shading/sphere_gouraud_low") << ",Crash\n"
+                                    << "\n";
+  std::ofstream(dir_ / "flakes.txt") << "# known flakes\nsphere_flat_low@\n";
+  std::ofstream(dir_ / "skips.txt") << "^texture/checker_grazing_linear_clamp@\n";
+  const std::string files = " --baseline " + (dir_ / "fails.txt").string() + " --flakes " +
+                            (dir_ / "flakes.txt").string() + " --skips " +
+                            (dir_ / "skips.txt").string();
+  const fs::path out = dir_ / "out";
+  // Triangle 5 dropped: triangle_fan (12 triangles) fails, as listed; interpenetrating_ab
+  // and the checker (2 each) pass, the first listed (UnexpectedPass); sphere_gouraud_low
+  // crashes (listed Crash: ExpectedFail); sphere_flat_low renders wrong (flaky, rendered
+  // once), unlisted, but a flakes pattern matches it (KnownFlake); checker_grazing_linear_clamp
+  // is skipped.
+  const Result r =
+      run("run" + fixtures() + " " + catalog("shading/sphere_flat_low.json") + " " +
+              catalog("texture/checker_grazing_linear_clamp.json") +
+              " --backends gl:egl:llvmpipe --no-variants --retries 0 --out " + out.string() + files,
+          "RASTERCHECK_GL_FAULT=drop_primitive=5,crash=shading/sphere_gouraud_low,"
+          "flaky=shading/sphere_flat_low");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("does not match baseline: 1 unexpected"), std::string::npos) << r.out;
+  std::map<std::string, std::string> got = resultsOf(out);
+  EXPECT_EQ(got[test("coverage/triangle_fan")], "ExpectedFail");
+  EXPECT_EQ(got[test("zbuffer/interpenetrating_ab")], "UnexpectedPass");
+  EXPECT_EQ(got[test("shading/sphere_gouraud_low")], "ExpectedFail");
+  EXPECT_EQ(got[test("shading/sphere_flat_low")], "KnownFlake");
+  EXPECT_EQ(got[test("texture/checker_grazing_nearest_repeat")], "Pass");
+  EXPECT_EQ(got[test("texture/checker_grazing_linear_clamp")], "Skip");
+  EXPECT_EQ(readText(out / "failures.csv"),
+            test("zbuffer/interpenetrating_ab") + ",UnexpectedPass\n");
+  const json report = json::parse(std::ifstream(out / "report.json"));
+  EXPECT_EQ(report["runner"]["matches_baseline"], false);
+  EXPECT_EQ(report["exit_code"], 1);
+
+  // A new crash nobody expected: exit 3. (Without the baseline's Crash line.)
+  std::ofstream(dir_ / "fails2.txt") << test("coverage/triangle_fan") << ",Fail\n";
+  const Result crash =
+      run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants --retries 0 --out " +
+              (dir_ / "out2").string() + " --baseline " + (dir_ / "fails2.txt").string(),
+          "RASTERCHECK_GL_FAULT=crash=shading/sphere_gouraud_low");
+  EXPECT_EQ(crash.code, 3) << crash.out;
+  EXPECT_EQ(resultsOf(dir_ / "out2")[test("shading/sphere_gouraud_low")], "Crash");
+  EXPECT_EQ(resultsOf(dir_ / "out2")[test("coverage/triangle_fan")], "UnexpectedPass");
+
+  // Bad files are bad input: exit 2, one line naming file and line, nothing written.
+  std::ofstream(dir_ / "bad.txt") << "a,Fail\nb Fail\n";
+  const Result bad = run("run" + fixtures() + " --backends gl:egl:llvmpipe --out " +
+                         (dir_ / "out3").string() + " --baseline " + (dir_ / "bad.txt").string());
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_NE(bad.out.find((dir_ / "bad.txt").string() + ":2:"), std::string::npos) << bad.out;
+  EXPECT_FALSE(fs::exists(dir_ / "out3" / "report.json"));
+}
+
+// deqp-runner's round trip: a run's results.csv as the next run's baseline matches (exit 0),
+// though the run has failures.
+TEST_F(RunFlakes, ResultsCsvRoundTripsAsTheBaseline) {
+  const std::string fault = "RASTERCHECK_GL_FAULT=drop_primitive=1";
+  const fs::path first = dir_ / "first";
+  const Result a =
+      run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants --out " + first.string(),
+          fault);
+  EXPECT_EQ(a.code, 1) << a.out;
+  ASSERT_FALSE(readText(first / "failures.csv").empty());
+  const fs::path second = dir_ / "second";
+  const Result b = run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants --out " +
+                           second.string() + " --baseline " + (first / "results.csv").string(),
+                       fault);
+  EXPECT_EQ(b.code, 0) << b.out;
+  EXPECT_NE(b.out.find("deqp-runner: matches baseline"), std::string::npos) << b.out;
+  EXPECT_EQ(readText(second / "failures.csv"), "");
+  for (const auto& [name, status] : resultsOf(second))
+    EXPECT_TRUE(status == "Pass" || status == "Warn" || status == "ExpectedFail") << name;
+}
+
+// A caselist picks and orders the fixtures; --fraction N --fraction-start M keeps the list's
+// entries M, M + N, ... (deqp-runner's meaning); an unknown name is bad input.
+TEST_F(RunFlakes, CaselistAndFraction) {
+  std::ofstream(dir_ / "cases.txt") << "# three of the four, the last first\n"
+                                    << "texture/checker_grazing_nearest_repeat\n\n"
+                                    << "coverage/triangle_fan\n"
+                                    << "shading/sphere_gouraud_low\n";
+  const fs::path out = dir_ / "out";
+  const Result r =
+      run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants --caselist " +
+          (dir_ / "cases.txt").string() + " --fraction 2 --fraction-start 1 --out " + out.string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  const json report = json::parse(std::ifstream(out / "report.json"));
+  ASSERT_EQ(report["results"].size(), 2u);
+  EXPECT_EQ(report["results"][0]["fixture"], "texture/checker_grazing_nearest_repeat");
+  EXPECT_EQ(report["results"][1]["fixture"], "shading/sphere_gouraud_low");
+  const Result second =
+      run("run" + fixtures() + " --backends gl:egl:llvmpipe --no-variants --caselist " +
+          (dir_ / "cases.txt").string() + " --fraction 2 --fraction-start 2 --out " +
+          (dir_ / "out2").string());
+  const json other = json::parse(std::ifstream(dir_ / "out2" / "report.json"));
+  ASSERT_EQ(other["results"].size(), 1u);
+  EXPECT_EQ(other["results"][0]["fixture"], "coverage/triangle_fan");
+
+  std::ofstream(dir_ / "bad.txt") << "coverage/triangle_fan\nno/such_fixture\n";
+  const Result bad = run("run" + fixtures() + " --backends gl:egl:llvmpipe --caselist " +
+                         (dir_ / "bad.txt").string() + " --out " + (dir_ / "out3").string());
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("bad.txt:2: no fixture named \"no/such_fixture\""), std::string::npos)
+      << bad.out;
 }
 
 }  // namespace
