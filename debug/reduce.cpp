@@ -98,6 +98,9 @@ Scene subsetScene(const Scene& base, const std::vector<PrimitiveRef>& primitives
       Object o;
       o.name = src.name;
       o.model = src.model;
+      o.state = src.state;
+      // A strip's or loop's kept segments are written as explicit lines.
+      o.primitive = isLineKind(src.primitive) ? PrimitiveKind::Lines : src.primitive;
       auto m = material_of.find(src.material);
       if (m == material_of.end()) {
         m = material_of.emplace(src.material, s.materials.size()).first;
@@ -109,9 +112,11 @@ Scene subsetScene(const Scene& base, const std::vector<PrimitiveRef>& primitives
     }
     Object& dst = s.objects[it->second];
     std::map<std::uint32_t, std::uint32_t>& vmap = remap[p.object];
-    std::array<std::uint32_t, 3> tri{};
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = src.mesh.triangles[p.triangle][k];
+    std::uint32_t source[3];
+    const int n = primitiveVertices(src, p.triangle, source);
+    std::array<std::uint32_t, 3> kept{};
+    for (int k = 0; k < n; ++k) {
+      const std::uint32_t v = source[k];
       auto [slot, inserted] =
           vmap.emplace(v, static_cast<std::uint32_t>(dst.mesh.positions.size()));
       if (inserted) {
@@ -119,9 +124,11 @@ Scene subsetScene(const Scene& base, const std::vector<PrimitiveRef>& primitives
         dst.mesh.normals.push_back(src.mesh.normals[v]);
         if (!src.mesh.uvs.empty()) dst.mesh.uvs.push_back(src.mesh.uvs[v]);
       }
-      tri[k] = slot->second;
+      kept[static_cast<std::size_t>(k)] = slot->second;
     }
-    dst.mesh.triangles.push_back(tri);
+    if (n == 3) dst.mesh.triangles.push_back(kept);
+    if (n == 2) dst.mesh.lines.push_back({kept[0], kept[1]});
+    // A point is its position: one was appended above (each point its own vertex).
   }
   return s;
 }

@@ -15,7 +15,7 @@ namespace {
 
 constexpr const char* kValidFaults =
     "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
-    "shader_compile_error, move_vertex=ID, texel_offset=N, blend_factor=one|swapped, "
+    "shader_compile_error, move_vertex=ID, move_line_end=ID, move_point=ID, texel_offset=N, blend_factor=one|swapped, "
     "depth_func=inverted, stencil_op=shifted, blend_function=shifted, scissor_shift=N, "
     "lod_shift=N, lod_weight=inverted, "
     "hang=FIXTURE|*, crash=FIXTURE|*, flaky=FIXTURE|*, hang_once=FIXTURE|*";
@@ -42,6 +42,7 @@ T number(std::string_view entry, std::string_view value) {
 bool Faults::any() const {
   return drop_primitive != 0 || depth_bias_steps != 0 || light_scale != 1.0 ||
          no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
+         move_line_end != 0 || move_point != 0 ||
          texel_offset != 0.0 || blend_factor != Blend::Correct || depth_func_inverted ||
          stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 ||
          lod_weight_inverted || !hang.empty() || !crash.empty() || !flaky.empty() ||
@@ -64,6 +65,8 @@ std::string Faults::describe() const {
   if (shift_x_px != 0.0) parts.push_back(fmt::format("shift_x={}", shift_x_px));
   if (shader_compile_error) parts.emplace_back("shader_compile_error");
   if (move_vertex != 0) parts.push_back(fmt::format("move_vertex={}", move_vertex));
+  if (move_line_end != 0) parts.push_back(fmt::format("move_line_end={}", move_line_end));
+  if (move_point != 0) parts.push_back(fmt::format("move_point={}", move_point));
   if (texel_offset != 0.0) parts.push_back(fmt::format("texel_offset={}", texel_offset));
   if (blend_factor != Blend::Correct)
     parts.push_back(fmt::format("blend_factor={}", blend_factor == Blend::One ? "one" : "swapped"));
@@ -94,6 +97,7 @@ Faults parseFaults(std::string_view text) {
     const bool flag = name == "no_inverse_transpose" || name == "shader_compile_error";
     const bool valued = name == "drop_primitive" || name == "depth_bias" || name == "light_scale" ||
                         name == "shift_x" || name == "move_vertex" || name == "texel_offset" ||
+                        name == "move_line_end" || name == "move_point" ||
                         name == "blend_factor" || name == "hang" || name == "crash" ||
                         name == "flaky" || name == "hang_once" || name == "depth_func" ||
                         name == "stencil_op" || name == "blend_function" ||
@@ -112,6 +116,12 @@ Faults parseFaults(std::string_view text) {
     } else if (name == "move_vertex") {
       f.move_vertex = number<std::uint32_t>(entry, value);
       if (f.move_vertex == 0) badFault(entry, "primitive ids start at 1");
+    } else if (name == "move_line_end") {
+      f.move_line_end = number<std::uint32_t>(entry, value);
+      if (f.move_line_end == 0) badFault(entry, "primitive ids start at 1");
+    } else if (name == "move_point") {
+      f.move_point = number<std::uint32_t>(entry, value);
+      if (f.move_point == 0) badFault(entry, "primitive ids start at 1");
     } else if (name == "texel_offset") {
       f.texel_offset = number<double>(entry, value);
     } else if (name == "blend_factor") {

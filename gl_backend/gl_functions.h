@@ -46,6 +46,8 @@ namespace rc::gl {
   X(PFNGLFRONTFACEPROC, FrontFace)                                                     \
   X(PFNGLCULLFACEPROC, CullFace)                                                       \
   X(PFNGLPOLYGONMODEPROC, PolygonMode)                                                 \
+  X(PFNGLLINEWIDTHPROC, LineWidth)                                                     \
+  X(PFNGLPOINTSIZEPROC, PointSize)                                                     \
   X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)                                             \
   X(PFNGLCLEARBUFFERUIVPROC, ClearBufferuiv)                                           \
   X(PFNGLDRAWBUFFERSPROC, DrawBuffers)                                                 \

@@ -852,7 +852,8 @@ void setFixedState(const gl::Functions& gl, const Scene& scene) {
   gl.DepthRange(0.0, 1.0);
   for (GLenum cap : {GL_DITHER, GL_MULTISAMPLE, GL_FRAMEBUFFER_SRGB, GL_DEPTH_CLAMP,
                      GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_POLYGON_OFFSET_FILL,
-                     GL_SAMPLE_ALPHA_TO_COVERAGE, GL_RASTERIZER_DISCARD, GL_PRIMITIVE_RESTART}) {
+                     GL_SAMPLE_ALPHA_TO_COVERAGE, GL_RASTERIZER_DISCARD, GL_PRIMITIVE_RESTART,
+                     GL_LINE_SMOOTH, GL_PROGRAM_POINT_SIZE}) {
     gl.Disable(cap);
   }
   gl.PolygonMode(GL_FRONT_AND_BACK, GL_FILL);
@@ -931,6 +932,12 @@ void setPassState(const gl::Functions& gl, const DrawPass& pass,
       glCompare(faults.depth_func_inverted ? invertedFunc(pass.depth_func) : pass.depth_func));
   gl.DepthMask(pass.depth_write ? GL_TRUE : GL_FALSE);
   const FragmentOps& ops = pass.ops;
+  // Lines and points: the widths and the polygon mode (polygon_offset is
+  // GL_POLYGON_OFFSET_FILL alone: polygons drawn as lines or points are not offset).
+  constexpr std::array<GLenum, 3> kModes{GL_FILL, GL_LINE, GL_POINT};
+  gl.PolygonMode(GL_FRONT_AND_BACK, kModes.at(static_cast<std::size_t>(ops.polygon_mode)));
+  gl.LineWidth(static_cast<GLfloat>(ops.line_width));
+  gl.PointSize(static_cast<GLfloat>(ops.point_size));
   gl.DepthRange(ops.depth_range.x, ops.depth_range.y);
   if (ops.polygon_offset) {
     gl.Enable(GL_POLYGON_OFFSET_FILL);
@@ -985,6 +992,7 @@ void setPassState(const gl::Functions& gl, const DrawPass& pass,
 // Back to the state the readback draws expect (multisampling's sample copies).
 void resetPassState(const gl::Functions& gl) {
   for (GLenum cap : {GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_POLYGON_OFFSET_FILL}) gl.Disable(cap);
+  gl.PolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   gl.DepthRange(0.0, 1.0);
 }
@@ -1073,8 +1081,9 @@ void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
         setMaterialUniforms(gl, p, scene.materials[run.material], textures[run.material]);
         bound_material = run.material;
       }
-      gl.DrawArrays(GL_TRIANGLES, static_cast<GLint>(run.first_vertex),
-                    static_cast<GLsizei>(run.vertex_count));
+      constexpr std::array<GLenum, 3> kPrimitives{GL_TRIANGLES, GL_LINES, GL_POINTS};
+      gl.DrawArrays(kPrimitives.at(static_cast<std::size_t>(pass.state.primitive)),
+                    static_cast<GLint>(run.first_vertex), static_cast<GLsizei>(run.vertex_count));
     }
   }
 }

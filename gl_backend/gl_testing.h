@@ -27,6 +27,11 @@ struct Faults {
   // move_vertex=ID: the first vertex of triangle ID alone is moved one pixel right in
   // window space (the rest of the scene is untouched): a geometry error of one vertex.
   std::uint32_t move_vertex = 0;
+  // move_line_end=ID: the second vertex of segment ID (a line primitive) moved one pixel in
+  // the segment's minor window direction (y for an x-major segment); move_point=ID: point
+  // ID moved one pixel right. Geometry errors of lines and points.
+  std::uint32_t move_line_end = 0;
+  std::uint32_t move_point = 0;
   // texel_offset=N: every texture is sampled N texels to the right of the texel the
   // coordinate names (the neighbouring texel for N = 1): an addressing error.
   double texel_offset = 0.0;

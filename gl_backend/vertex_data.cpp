@@ -61,6 +61,23 @@ glm::dvec3 onePixelRight(const glm::dvec3& world, const glm::dmat4& view_project
   return glm::dvec3(back) / back.w;
 }
 
+// The fault move_line_end: `world` (a segment's end) moved one pixel in the segment's minor
+// window direction (y when the segment from `start` is x-major, else x), same clip w.
+glm::dvec3 onePixelAcross(const glm::dvec3& start, const glm::dvec3& world,
+                          const glm::dmat4& view_projection, int width, int height) {
+  const glm::dvec4 a = view_projection * glm::dvec4(start, 1.0);
+  glm::dvec4 clip = view_projection * glm::dvec4(world, 1.0);
+  const double dx = (clip.x / clip.w - a.x / a.w) * width;
+  const double dy = (clip.y / clip.w - a.y / a.w) * height;
+  if (std::abs(dx) >= std::abs(dy)) {
+    clip.y += 2.0 / height * clip.w;
+  } else {
+    clip.x += 2.0 / width * clip.w;
+  }
+  const glm::dvec4 back = glm::inverse(view_projection) * clip;
+  return glm::dvec3(back) / back.w;
+}
+
 }  // namespace
 
 VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& passes,
@@ -88,32 +105,46 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
       if (prim.id == faults.drop_primitive) continue;  // the fault drop_primitive=ID
       const Object& obj = scene.objects[prim.object];
       const WorldMesh& wm = world[prim.object];
-      const auto& tri = obj.mesh.triangles[prim.triangle];
-      if (!wm.finite[tri[0]] || !wm.finite[tri[1]] || !wm.finite[tri[2]]) {
+      std::uint32_t tri[3];
+      const int count = primitiveVertices(obj, prim.triangle, tri);
+      bool finite = true;
+      for (int k = 0; k < count; ++k) finite = finite && wm.finite[tri[k]];
+      if (!finite) {
         ++data.skipped_triangles;
         continue;
       }
-      const glm::dvec3 p0 = wm.positions[tri[0]];
-      const glm::dvec3 p1 = wm.positions[tri[1]];
-      const glm::dvec3 p2 = wm.positions[tri[2]];
-      const FlatFace face = flatFace(p0, p1, p2);
+      FlatFace face;
+      if (count == 3) {
+        face = flatFace(wm.positions[tri[0]], wm.positions[tri[1]], wm.positions[tri[2]]);
+      } else {
+        const std::uint32_t last = tri[count - 1];
+        face = flatSegment(wm.positions[tri[0]], wm.positions[last],
+                           glm::dvec3(wm.normals[tri[0]]), glm::dvec3(wm.normals[last]));
+      }
 
       const auto material = static_cast<std::uint32_t>(obj.material);
       const auto first = static_cast<std::uint32_t>(data.vertices.size());
       if (out.runs.empty() || out.runs.back().material != material)
         out.runs.push_back(DrawRun{material, first, 0});
-      out.runs.back().vertex_count += 3;
+      out.runs.back().vertex_count += static_cast<std::uint32_t>(count);
 
-      for (int k = 0; k < 3; ++k) {
+      for (int k = 0; k < count; ++k) {
         const std::uint32_t vi = tri[k];
         Vertex& v = data.vertices.emplace_back();
         // The fault move_vertex=ID: only this triangle's first vertex (the buffer is
         // unindexed, so the triangles sharing it keep theirs); lighting and the flat
-        // centroid stay where they were, so the error is geometry alone.
-        const bool moved = k == 0 && prim.id == faults.move_vertex;
-        store(v.world_position, moved
-                                    ? onePixelRight(wm.positions[vi], view_projection, scene.width)
-                                    : wm.positions[vi]);
+        // centroid stay where they were, so the error is geometry alone. move_line_end and
+        // move_point likewise for a segment's second vertex and a point.
+        glm::dvec3 position = wm.positions[vi];
+        if (k == 0 && count == 3 && prim.id == faults.move_vertex) {
+          position = onePixelRight(position, view_projection, scene.width);
+        } else if (k == 0 && count == 1 && prim.id == faults.move_point) {
+          position = onePixelRight(position, view_projection, scene.width);
+        } else if (k == 1 && count == 2 && prim.id == faults.move_line_end) {
+          position = onePixelAcross(wm.positions[tri[0]], position, view_projection, scene.width,
+                                    scene.height);
+        }
+        store(v.world_position, position);
         const glm::vec3& n = wm.normals[vi];
         v.world_normal[0] = n.x;
         v.world_normal[1] = n.y;

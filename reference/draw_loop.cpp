@@ -95,7 +95,7 @@ void Renderer::transformVertices() {
   const WindowSetup setup = windowSetup();
   for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
     const Object& obj = scene_.objects[o];
-    if (obj.mesh.triangles.empty()) {
+    if (primitiveCount(obj) == 0) {
       vertices_[o].clear();
       windows_[o].clear();
       continue;
@@ -179,6 +179,10 @@ Frame Renderer::run() {
     stencil_.assign(frame_.pixelCount(), static_cast<std::uint8_t>(scene_.clear_stencil));
   for (const DrawPass& pass : passes) {
     const std::vector<PrimitiveRef>& prims = pass.primitives;
+    if (pass.primitive != DrawnPrimitive::Triangles) {
+      for (const PrimitiveRef& prim : prims) drawLineOrPoint(prim, pass);
+      continue;
+    }
     for (std::size_t j = 0; j < prims.size(); ++j) {
       if (prefetch && j + PrefetchBox::kAhead < prims.size())
         prefetchRows(prims[j + PrefetchBox::kAhead]);
@@ -268,7 +272,7 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
 // false where drawPolygon() drops the polygon (w <= 0, only a degenerate camera gets
 // there, or a non-finite window position). reach and depth_reach only with the
 // uncertainty channels.
-inline bool Renderer::windowVertexSetup(const ClipVertex& c, WindowVertex& wv, FixedVertex& fv,
+bool Renderer::windowVertexSetup(const ClipVertex& c, WindowVertex& wv, FixedVertex& fv,
                                         double& reach, double& depth_reach) const {
   if (!(c.clip.w > 0.0)) return false;
   wv = toWindow(c, scene_.width, scene_.height);
@@ -420,6 +424,16 @@ void Renderer::drawPolygon(const PrimitiveRef& prim, const DrawPass& pass, const
 void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, const WindowVertex* wv,
                             const FixedVertex* fv, const double* reach, const double* depth_reach,
                             int count, bool clipped) {
+  if (pass.ops.polygon_mode != PolygonMode::Fill) {  // its edges or vertices (line_loop.cpp)
+    TriangleContext& t = context_;
+    t.prim = &prim;
+    t.pass = &pass;
+    t.constant = false;
+    prepareTriangle(t);
+    t.constant = false;
+    drawPolygonOutline(wv, fv, reach, depth_reach, count);
+    return;
+  }
   const bool ccw_is_front = pass.front_face == FrontFace::CCW;
   const Cull cull = pass.cull;
   auto culled = [&](bool ccw) {

@@ -3,6 +3,8 @@
 // `explain` beside it, the same expressions with a record per fragment.
 #include "reference/renderer_internal.h"
 
+#include <functional>
+#include <string_view>
 #include <type_traits>
 
 #include "fixtures/scene_geometry.h"
@@ -158,6 +160,17 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
     uv = b.x * t.v[0]->uv + b.y * t.v[1]->uv + b.z * t.v[2]->uv;
     if (t.chain != nullptr && interp != nullptr && row != nullptr) {
       tex = glm::dvec3(lodTexel(t, uv, b, *interp, *row, dx, terms));
+    } else if (t.chain != nullptr && !std::isnan(t.line_lambda)) {  // lines and points
+      const LodSample sample = sampleAtLod(*t.chain, uv, t.line_lambda, lod_state_);
+      tex = glm::dvec3(sample.color);
+      if (terms != nullptr) {
+        terms->lod.used = true;
+        terms->lod.lambda = t.line_lambda;
+        terms->lod.magnified = sample.magnified;
+        terms->lod.level0 = sample.level0;
+        terms->lod.level1 = sample.level1;
+        terms->lod.weight = sample.weight;
+      }
     } else {
       tex = glm::dvec3(
           sampleTexture(*t.texture, uv, magFilter(scene_.state), scene_.state.texture_wrap));
@@ -456,31 +469,135 @@ __attribute__((flatten)) void Renderer::shadeFanFormat(const TriangleContext& t,
   }
 }
 
-// GL's per-fragment operations in order (glspec 4.6 chapter 14.9 and 17.3): scissor,
-// stencil test, depth test (window z mapped by the depth range, polygon offset added,
-// clamped, quantized), the stencil op its outcome selects, depth write, id, blending and
-// the colour mask. Every fragment's colour is fragmentColor() (the definition); the
-// uncertainty channels count every depth comparison (UncertaintyTracker::compared()).
-template <Shading kShading>
-void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
-                                const FragmentInterpolator& interp) {
+GeneralSetup Renderer::generalSetup(const TriangleContext& t) const {
   const DrawPass& pass = *t.pass;
   const FragmentOps& ops = pass.ops;
-  const StencilFace* face = nullptr;
+  GeneralSetup g;
   if (ops.stencil && !stencil_.empty())
-    face = t.front_facing ? &ops.stencil->front : &ops.stencil->back;
-  const double near = ops.depth_range.x;
-  const double scale = ops.depth_range.y - ops.depth_range.x;
-  const bool mapped = ops.depth_range != glm::dvec2(0.0, 1.0);
-  const bool tested = pass.depth_func != DepthFunc::Always && pass.depth_func != DepthFunc::Never;
+    g.face = t.front_facing ? &ops.stencil->front : &ops.stencil->back;
+  g.near = ops.depth_range.x;
+  g.scale = ops.depth_range.y - ops.depth_range.x;
+  g.mapped = ops.depth_range != glm::dvec2(0.0, 1.0);
+  g.tested = pass.depth_func != DepthFunc::Always && pass.depth_func != DepthFunc::Never;
   const bool masked = ops.color_mask != std::array<bool, 4>{true, true, true, true};
   // What the channels weigh the old colour by: alpha-over (1 - alpha); a blend function or
   // a masked write keeps any part of it (the conservative 0).
-  const auto alpha = static_cast<float>(
+  g.alpha = static_cast<float>(
       pass.blend && !pass.blend_function ? std::clamp(t.material->opacity, 0.0, 1.0) : 0.0);
-  const bool composited = pass.blend || masked;
-  const bool notes = uncertainty_;
+  g.composited = pass.blend || masked;
+  return g;
+}
+
+// GL's per-fragment operations in order (glspec 4.6 chapter 14.9 and 17.3) for one fragment
+// at pixel (px, py), framebuffer index `index`, window z `z_window` (before the depth range
+// and offset): scissor, stencil test, depth test (window z mapped by the depth range,
+// polygon offset added, clamped, quantized), the stencil op its outcome selects, depth
+// write, id, blending and the colour mask. Its colour is fragmentColor() (the definition)
+// at the barycentrics bary() returns (w.r.t. the original primitive's vertices); the
+// uncertainty channels count every depth comparison (UncertaintyTracker::compared()).
+// `interp`, `row`, `dx`: the fan's interpolator at the fragment (null for lines and
+// points); `colour_reach` (8-bit units) joins the fragment's normal_reach.
+template <Shading kShading, class Bary>
+void Renderer::generalFragment(const TriangleContext& t, const GeneralSetup& g, int px, int py,
+                               std::size_t index, double z_window, float reach, Bary&& bary,
+                               const FragmentInterpolator* interp,
+                               const FragmentInterpolator::Row* row, double dx,
+                               float colour_reach) {
+  const DrawPass& pass = *t.pass;
+  const FragmentOps& ops = pass.ops;
   const std::uint32_t id = t.prim->id;
+  ++fragments_;
+  FragmentTrace f;
+  if (trace_ != nullptr) {
+    f.primitive = id;
+    f.object = t.prim->object;
+    f.barycentric = bary();
+    f.offset = t.offset;
+    f.line = t.line_trace;
+  }
+  auto traced = [&] {
+    if (trace_ == nullptr) return;
+    f.color_written = storedColor(index);
+    trace_->push_back(std::move(f));
+  };
+  if (ops.scissor) {
+    const Scissor& box = *ops.scissor;
+    if (px < box.x || py < box.y || px - box.x >= box.width || py - box.y >= box.height) {
+      f.scissor_pass = false;
+      traced();
+      return;
+    }
+  }
+  double z = z_window;
+  if (g.mapped) z = g.near + g.scale * z;
+  z = clampDepth(z + t.offset);
+  const std::uint32_t key = depthKey(z, depth_format_);
+  const std::uint32_t stored = depth_[index];
+  f.window_z = z;
+  f.stored_z = storedDepth(key, depth_format_);
+  f.depth_against = storedDepth(stored, depth_format_);
+  const StencilFace* face = g.face;
+  if (face != nullptr) {
+    const std::uint8_t s = stencil_[index];
+    f.stencil_before = s;
+    const auto mask = static_cast<unsigned>(face->read_mask);
+    f.stencil_pass = compares(face->func, static_cast<unsigned>(face->ref) & mask, s & mask);
+    if (!f.stencil_pass) {
+      stencil_[index] = applyStencilOp(face->fail, s, face->ref, face->write_mask);
+      f.stencil_after = stencil_[index];
+      if (uncertainty_)
+        gaps_.compared(index, z, t.depth_slope, reach, t.offset_steps, false, false, false);
+      if (trace_ != nullptr)
+        fragmentColor<kShading>(t, f.barycentric, &f.shading, nullptr, interp, row, dx);
+      traced();
+      return;
+    }
+  }
+  const bool depth_pass = compares(pass.depth_func, key, stored);
+  f.depth_pass = depth_pass;
+  if (uncertainty_)
+    gaps_.compared(index, z, t.depth_slope, reach, t.offset_steps, g.tested, pass.blend,
+                   plane_keys_[index] == t.plane_key);
+  if (face != nullptr) {
+    const StencilOp op = depth_pass ? face->pass : face->depth_fail;
+    stencil_[index] = applyStencilOp(op, stencil_[index], face->ref, face->write_mask);
+    f.stencil_after = stencil_[index];
+  }
+  if (!depth_pass) {
+    if (trace_ != nullptr)
+      fragmentColor<kShading>(t, f.barycentric, &f.shading, nullptr, interp, row, dx);
+    traced();
+    return;
+  }
+  if (pass.depth_write) {
+    depth_[index] = key;
+    plane_keys_[index] = t.plane_key;
+    if (uncertainty_) gaps_.storedDepth(index, z, t.depth_slope);
+  }
+  frame_.id[index] = id;
+  TexelNote note;
+  const glm::dvec3 b = trace_ != nullptr ? f.barycentric : bary();
+  const glm::dvec4 src = fragmentColor<kShading>(t, b, trace_ != nullptr ? &f.shading : nullptr,
+                                                 uncertainty_ ? &note : nullptr, interp, row, dx);
+  glm::dvec4 out = src;
+  if (pass.blend) {
+    const glm::dvec4 dst = storedColor(index);
+    out = pass.blend_function ? blendWithFunction(ops.blend_function, src, dst, color_format_)
+                              : blendSourceOver(src, dst, color_format_);
+  }
+  float* c = &frame_.color[4 * index];
+  for (int k = 0; k < 4; ++k)
+    if (ops.color_mask[static_cast<std::size_t>(k)]) c[k] = storeColor(out[k], color_format_);
+  if (uncertainty_)
+    gaps_.colourWritten(index, g.composited, g.alpha, note.dist, note.alt, note.gain, note.reach,
+                        note.shade, std::max(note.normal, colour_reach));
+  traced();
+}
+
+template <Shading kShading>
+void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
+                                const FragmentInterpolator& interp) {
+  const GeneralSetup g = generalSetup(t);
   ++triangles_drawn_;
   coverage.forEachSpan([&](int py, int x_begin, int x_end) {
     const double cy = py + 0.5;
@@ -488,96 +605,161 @@ void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage
     const std::size_t row_index =
         static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_);
     for (int px = x_begin; px < x_end; ++px) {
-      ++fragments_;
       const double dx = interp.dx(px + 0.5);
       const std::size_t index = row_index + static_cast<std::size_t>(px - clip_.x0);
-      FragmentTrace f;
-      if (trace_ != nullptr) {
-        f.primitive = id;
-        f.object = t.prim->object;
-        f.barycentric = interp.barycentric(px + 0.5, cy);
-        f.offset = t.offset;
-      }
-      auto traced = [&] {
-        if (trace_ == nullptr) return;
-        f.color_written = storedColor(index);
-        trace_->push_back(std::move(f));
-      };
-      if (ops.scissor) {
-        const Scissor& box = *ops.scissor;
-        if (px < box.x || py < box.y || px - box.x >= box.width || py - box.y >= box.height) {
-          f.scissor_pass = false;
-          traced();
-          continue;
-        }
-      }
-      double z = interp.depthAt(row, dx);
-      if (mapped) z = near + scale * z;
-      z = clampDepth(z + t.offset);
-      const std::uint32_t key = depthKey(z, depth_format_);
-      const std::uint32_t stored = depth_[index];
-      f.window_z = z;
-      f.stored_z = storedDepth(key, depth_format_);
-      f.depth_against = storedDepth(stored, depth_format_);
       const float reach = uncertainty_ ? t.depth_reach.at(px + 0.5, cy) : 0.0f;
-      if (face != nullptr) {
-        const std::uint8_t s = stencil_[index];
-        f.stencil_before = s;
-        const auto mask = static_cast<unsigned>(face->read_mask);
-        f.stencil_pass = compares(face->func, static_cast<unsigned>(face->ref) & mask, s & mask);
-        if (!f.stencil_pass) {
-          stencil_[index] = applyStencilOp(face->fail, s, face->ref, face->write_mask);
-          f.stencil_after = stencil_[index];
-          if (uncertainty_)
-            gaps_.compared(index, z, t.depth_slope, reach, t.offset_steps, false, false, false);
-          if (trace_ != nullptr)
-            fragmentColor<kShading>(t, f.barycentric, &f.shading, nullptr, &interp, &row, dx);
-          traced();
-          continue;
-        }
-      }
-      const bool depth_pass = compares(pass.depth_func, key, stored);
-      f.depth_pass = depth_pass;
-      if (uncertainty_)
-        gaps_.compared(index, z, t.depth_slope, reach, t.offset_steps, tested, pass.blend,
-                       plane_keys_[index] == t.plane_key);
-      if (face != nullptr) {
-        const StencilOp op = depth_pass ? face->pass : face->depth_fail;
-        stencil_[index] = applyStencilOp(op, stencil_[index], face->ref, face->write_mask);
-        f.stencil_after = stencil_[index];
-      }
-      if (!depth_pass) {
-        if (trace_ != nullptr)
-          fragmentColor<kShading>(t, f.barycentric, &f.shading, nullptr, &interp, &row, dx);
-        traced();
-        continue;
-      }
-      if (pass.depth_write) {
-        depth_[index] = key;
-        plane_keys_[index] = t.plane_key;
-        if (uncertainty_) gaps_.storedDepth(index, z, t.depth_slope);
-      }
-      frame_.id[index] = id;
-      TexelNote note;
-      const glm::dvec3 b = interp.barycentricAt(row, dx);
-      const glm::dvec4 src = fragmentColor<kShading>(t, b, trace_ != nullptr ? &f.shading : nullptr,
-                                                     notes ? &note : nullptr, &interp, &row, dx);
-      glm::dvec4 out = src;
-      if (pass.blend) {
-        const glm::dvec4 dst = storedColor(index);
-        out = pass.blend_function ? blendWithFunction(ops.blend_function, src, dst, color_format_)
-                                  : blendSourceOver(src, dst, color_format_);
-      }
-      float* c = &frame_.color[4 * index];
-      for (int k = 0; k < 4; ++k)
-        if (ops.color_mask[static_cast<std::size_t>(k)]) c[k] = storeColor(out[k], color_format_);
-      if (uncertainty_)
-        gaps_.colourWritten(index, composited, alpha, note.dist, note.alt, note.gain, note.reach,
-                            note.shade, note.normal);
-      traced();
+      auto bary = [&] {
+        return trace_ != nullptr ? interp.barycentric(px + 0.5, cy) : interp.barycentricAt(row, dx);
+      };
+      generalFragment<kShading>(t, g, px, py, index, interp.depthAt(row, dx), reach, bary, &interp,
+                                &row, dx, 0.0f);
     }
   });
 }
+
+// The fragments of one segment (or point, a == b): each fragment's parameter t is its centre
+// projected onto a -> b (GL 14.5.1), its depth (1 - t) z_a + t z_b, its other attributes
+// perspective-correct (the barycentrics w.r.t. the primitive's original vertices).
+template <Shading kShading>
+void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
+                                  const WindowVertex& b, bool segment, double size,
+                                  double depth_reach, bool polygon_edge) {
+  TriangleContext& t = context_;
+  const GeneralSetup g = generalSetup(t);
+  const glm::dvec2 pa(a.x, a.y);
+  const glm::dvec2 pb(b.x, b.y);
+  const glm::dvec2 d = pb - pa;
+  const double len2 = glm::dot(d, d);
+  const double len = std::sqrt(len2);
+  // Where GL's t and a driver's may part: drivers interpolate along the major axis (and
+  // wide lines over their whole width), up to max(1, w) / 2 px along the segment from the
+  // projection.
+  const double slack_px = segment ? 0.5 * std::max(1.0, size) : 0.0;
+  const double slack_t = len > 0.0 ? slack_px / len : 0.0;
+  const double major = std::max(std::fabs(d.x), std::fabs(d.y));
+  const double z_per_px =
+      major > 0.0 ? std::fabs(b.z - a.z) * g.scale / major * depth_steps_ : 0.0;
+  t.depth_slope = static_cast<float>(z_per_px);
+  const double fragment_reach = depth_reach + slack_px * z_per_px + 1.0;
+  const double planes[8] = {a.x, a.y, a.z, b.x, b.y, b.z, g.near, g.scale};
+  const std::size_t h = std::hash<std::string_view>{}(
+      std::string_view(reinterpret_cast<const char*>(planes), sizeof planes));
+  t.plane_key = h == 0 ? 1 : h;
+
+  auto param = [&](double px, double py) {
+    if (!(len2 > 0.0)) return 0.0;
+    return std::clamp(glm::dot(glm::dvec2(px, py) - pa, d) / len2, 0.0, 1.0);
+  };
+  auto bary_at = [&](double s) {
+    const double wa = (1.0 - s) * a.inv_w;
+    const double wb = s * b.inv_w;
+    const double q = wa + wb != 0.0 ? wb / (wa + wb) : s;
+    return (1.0 - q) * a.bary + q * b.bary;
+  };
+  // The level of detail at parameter s: the texture coordinate's derivative along the
+  // segment, the attribute constant across it (GL's t); NaN without mipmaps.
+  const Texture* tex = t.texture;
+  auto lambda_at = [&](double s, double& lo, double& hi) {
+    lo = hi = std::numeric_limits<double>::quiet_NaN();
+    if (t.chain == nullptr) return lo;
+    if (!segment || !(len > 0.0)) {  // a point: constant coordinates, magnified
+      lo = hi = lodOf(0.0, lod_state_);
+      return lo;
+    }
+    const double e = 1e-4;
+    const double s0 = std::max(0.0, s - e);
+    const double s1 = std::min(1.0, s + e);
+    auto uv = [&](double q) {
+      const glm::dvec3 w = bary_at(q);
+      return w.x * t.v[0]->uv + w.y * t.v[1]->uv + w.z * t.v[2]->uv;
+    };
+    const glm::dvec2 duv =
+        (uv(s1) - uv(s0)) / (s1 - s0) * glm::dvec2(tex->width, tex->height);  // per unit t
+    // GL's projection: d/dx = duv * dx / L^2; a driver interpolating along the major axis:
+    // duv / major. The two differ by up to a factor of 2 (at 45 degrees).
+    const double rho_spec = scaleFactor(duv * (d.x / len2), duv * (d.y / len2));
+    const double rho_major = glm::length(duv) / major;
+    const double l_spec = lodOf(rho_spec, lod_state_);
+    const double l_major = lodOf(rho_major, lod_state_);
+    lo = std::min(l_spec, l_major) - 0.5;
+    hi = std::max(l_spec, l_major) + 0.5;
+    return l_spec;
+  };
+  auto colour = [&](double s) {
+    double lo = 0.0;
+    double hi = 0.0;
+    t.line_lambda = lambda_at(s, lo, hi);
+    return fragmentColor<kShading>(t, bary_at(s), nullptr);
+  };
+
+  LineTrace& trace = t.line_trace;
+  trace = LineTrace{};
+  if (trace_ != nullptr) {
+    trace.kind = segment ? LineTrace::Kind::Segment : LineTrace::Kind::Point;
+    trace.polygon_edge = polygon_edge;
+    trace.a = pa;
+    trace.b = pb;
+    trace.size = size;
+  }
+  const bool varies = kShading != Shading::Flat || tex != nullptr;
+  for (const LinePixel& p : pixels) {
+    const double cx = p.x + 0.5;
+    const double cy = p.y + 0.5;
+    const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
+                              static_cast<std::size_t>(p.x - clip_.x0);
+    const double s = segment ? param(cx, cy) : 0.0;
+    const double z = (1.0 - s) * a.z + s * b.z;
+    // normal_reach: the colour's range over the parameters and levels of detail a
+    // conforming driver may use here, against the reference's own (8-bit units).
+    float colour_reach = 0.0f;
+    if (uncertainty_ && varies) {
+      const glm::dvec4 own = colour(s);
+      double lo = 0.0;
+      double hi = 0.0;
+      lambda_at(s, lo, hi);
+      constexpr int kSteps = 8;
+      double worst = 0.0;
+      for (int k = 0; k <= kSteps; ++k) {
+        const double q = std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, 0.0, 1.0);
+        const glm::dvec3 w = bary_at(q);
+        for (int l = 0; l < (std::isnan(lo) ? 1 : 3); ++l) {
+          double ignore_lo = 0.0;
+          double ignore_hi = 0.0;
+          t.line_lambda = std::isnan(lo) ? lambda_at(q, ignore_lo, ignore_hi)
+                                         : (l == 0 ? lo : (l == 1 ? hi : 0.5 * (lo + hi)));
+          const glm::dvec4 c = fragmentColor<kShading>(t, w, nullptr);
+          for (int ch = 0; ch < 3; ++ch) worst = std::max(worst, std::fabs(c[ch] - own[ch]));
+        }
+      }
+      colour_reach = static_cast<float>(255.0 * worst);
+    }
+    double lo = 0.0;
+    double hi = 0.0;
+    t.line_lambda = lambda_at(s, lo, hi);
+    if (trace_ != nullptr) {
+      trace.t = s;
+      trace.margin = frame_.edge_dist.empty() ? 0.0 : frame_.edge_dist[index];
+    }
+    generalFragment<kShading>(t, g, p.x, p.y, index, z,
+                              static_cast<float>(uncertainty_ ? fragment_reach : 0.0),
+                              [&] { return bary_at(s); }, nullptr, nullptr, 0.0, colour_reach);
+  }
+  t.line_lambda = std::numeric_limits<double>::quiet_NaN();
+  trace = LineTrace{};
+}
+
+template void Renderer::shadeLineFragments<Shading::Flat>(const std::vector<LinePixel>&,
+                                                           const WindowVertex&,
+                                                           const WindowVertex&, bool, double,
+                                                           double, bool);
+template void Renderer::shadeLineFragments<Shading::Gouraud>(const std::vector<LinePixel>&,
+                                                              const WindowVertex&,
+                                                              const WindowVertex&, bool, double,
+                                                              double, bool);
+template void Renderer::shadeLineFragments<Shading::Phong>(const std::vector<LinePixel>&,
+                                                            const WindowVertex&,
+                                                            const WindowVertex&, bool, double,
+                                                            double, bool);
 
 void Renderer::shadeFanGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
                                const FragmentInterpolator& interp) {

@@ -65,6 +65,21 @@ struct ReferenceOptions {
 Frame renderReference(const Scene& scene, const ReferenceOptions& options = {});
 
 // One fragment that reached a pixel, in draw order (`rastercheck explain`).
+// How a fragment of a line or point came about (explain): the primitive's window
+// positions, where the fragment lies along it, and how close its pixel came to going the
+// other way.
+struct LineTrace {
+  enum class Kind { None, Segment, Point };
+  Kind kind = Kind::None;
+  bool polygon_edge = false;  // an edge of a triangle drawn in polygon mode line or point
+  glm::dvec2 a{0.0};          // window position of the segment's start, or the point
+  glm::dvec2 b{0.0};          // of its end (segments)
+  double size = 1.0;          // line width (rounded) or point size, px
+  double t = 0.0;             // the fragment centre projected onto a -> b (0 at a, 1 at b)
+  double margin = 0.0;        // px its pixel centre is from the rule's boundary (0: a line end
+                              // or a clipped point, where GL leaves the pixel to the driver)
+};
+
 struct FragmentTrace {
   std::uint32_t primitive = 0;  // primitive id (1-based)
   std::uint32_t object = 0;     // index into Scene::objects
@@ -83,6 +98,7 @@ struct FragmentTrace {
   bool stencil_pass = true;
   int stencil_after = -1;  // the stencil value after its op
   double offset = 0.0;     // polygon offset added to window_z (window-z units)
+  LineTrace line;          // lines and points (kind None for filled triangles)
 };
 
 // A blended fragment of the A-buffer's sorted list at one pixel (`explain`).

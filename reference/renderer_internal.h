@@ -26,6 +26,7 @@
 #include "fixtures/scene_logic.h"
 #include "reference/clipper.h"
 #include "reference/interpolation.h"
+#include "reference/line_raster.h"
 #include "reference/rasterizer.h"
 #include "reference/reference_renderer.h"
 #include "reference/shading.h"
@@ -125,6 +126,21 @@ struct TriangleContext {
   double offset = 0.0;          // polygon offset, window-z units
   float offset_steps = 0.0f;    // |units| x r in depth-format steps (offset_steps channel)
   std::uint64_t plane_key = 0;  // its depth plane (compared() `invariant`), never 0
+  // Lines and points (line_loop.cpp): the level of detail of the sample being shaded (NaN:
+  // none, the fan's interpolator decides), and what explain records of the fragment.
+  double line_lambda = std::numeric_limits<double>::quiet_NaN();
+  LineTrace line_trace;
+};
+
+// What generalFragment() needs of a draw that does not change from fragment to fragment.
+struct GeneralSetup {
+  const StencilFace* face = nullptr;  // the stencil face the fragments test (none: no test)
+  double near = 0.0;                  // depth range: window z = near + scale * z
+  double scale = 1.0;
+  bool mapped = false;      // a depth range other than [0, 1]
+  bool tested = false;      // a depth function other than ALWAYS and NEVER
+  float alpha = 0.0f;       // what the channels weigh the old colour by (1 - alpha)
+  bool composited = false;  // blended or masked: the old colour shows through
 };
 
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
@@ -281,6 +297,31 @@ class Renderer {
                         const FragmentInterpolator& interp);
   void shadeFanGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
                        const FragmentInterpolator& interp);
+  GeneralSetup generalSetup(const TriangleContext& t) const;
+  template <Shading kShading, class Bary>
+  void generalFragment(const TriangleContext& t, const GeneralSetup& g, int px, int py,
+                       std::size_t index, double z_window, float reach, Bary&& bary,
+                       const FragmentInterpolator* interp, const FragmentInterpolator::Row* row,
+                       double dx, float colour_reach);
+  // Lines and points (line_loop.cpp): a line or point primitive of `pass`; the edges or
+  // vertices of a triangle's (clipped) polygon in polygon mode line or point; one segment
+  // or point in clip space (barycentrics w.r.t. the primitive's original vertices in
+  // context_.v), rasterized and shaded.
+  void drawLineOrPoint(const PrimitiveRef& prim, const DrawPass& pass);
+  void drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv, const double* reach,
+                          const double* depth_reach, int count);
+  void drawSegment(const ClipVertex& a, const ClipVertex& b, bool polygon_edge);
+  void drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b, const FixedVertex& fa,
+                           const FixedVertex& fb, double reach, double depth_reach,
+                           bool polygon_edge);
+  void drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, double reach,
+                         double depth_reach, bool polygon_vertex);
+  void markPointOutside(const WindowVertex& c, double size);
+  template <Shading kShading>
+  void shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
+                          const WindowVertex& b, bool segment, double size, double depth_reach,
+                          bool polygon_edge);
+  void prepareLine(TriangleContext& t, const std::uint32_t* vertices, int count) const;
   // Per fan triangle: facing, polygon offset, the depth plane's key and what range and
   // offset add to its depth reach (draw_loop.cpp).
   void setUpGeneralFan(TriangleContext& t, const FragmentInterpolator& interp,

@@ -119,9 +119,10 @@ TEST(LineRaster, AnXMajorSegmentHasOneFragmentPerColumn) {
     for (const auto& [x, y] : pixels(a, b)) ++per_column[x];
     for (const auto& [x, k] : per_column) EXPECT_EQ(k, 1) << "column " << x << " of case " << n;
     // Columns contiguous: no gap along the segment.
-    if (!per_column.empty())
+    if (!per_column.empty()) {
       EXPECT_EQ(per_column.rbegin()->first - per_column.begin()->first + 1,
                 static_cast<int>(per_column.size()));
+    }
   }
 }
 

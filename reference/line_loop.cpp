@@ -1,0 +1,302 @@
+// The reference renderer's lines and points: line and point primitives, and triangles in
+// polygon mode line or point. Each segment or point is clipped, set up in window
+// coordinates and snapped like a triangle's vertices, rasterized by reference/line_raster.h
+// (GL's diamond-exit rule, the column rule for wide lines, point squares), and every
+// fragment goes through generalFragment(), the same per-fragment operations as triangles.
+// The uncertainty channels get what GL leaves open about lines and points
+// (docs/tolerances.md "Lines and points"): which pixels a segment's ends and its ties
+// produce (edge_dist), and the interpolation parameter, which GL defines by projecting the
+// fragment centre onto the segment while drivers interpolate along the major axis (up to
+// half a pixel, more for wide lines, apart: depth_reach and normal_reach).
+#include <algorithm>
+#include <cmath>
+
+#include "fixtures/scene_geometry.h"
+#include "reference/renderer_internal.h"
+
+namespace rc::ref {
+namespace {
+
+// GL rounds a non-antialiased line's width to the nearest integer, 0 counting as 1.
+double roundedWidth(double width) { return std::max(1.0, std::round(width)); }
+
+// Clips the segment c0 -> c1 to the near and far planes and to the guard band (x and y
+// within +/- guard * w, where window coordinates stay in the snapped grid's budget);
+// false when nothing is left. The guard band cuts only beyond the viewport, where no pixel
+// is produced, so what is drawn is what clipping to the view volume draws.
+bool clipSegment(ClipVertex& c0, ClipVertex& c1, const ClipVolume& volume) {
+  double t0 = 0.0;
+  double t1 = 1.0;
+  auto plane = [&](double d0, double d1) {
+    if (d0 < 0.0 && d1 < 0.0) return false;
+    if (d0 < 0.0) t0 = std::max(t0, d0 / (d0 - d1));
+    if (d1 < 0.0) t1 = std::min(t1, d0 / (d0 - d1));
+    return t0 <= t1;
+  };
+  const glm::dvec4& a = c0.clip;
+  const glm::dvec4& b = c1.clip;
+  if (!plane(a.w + a.z, b.w + b.z) || !plane(a.w - a.z, b.w - b.z) ||
+      !plane(volume.guard_x * a.w - a.x, volume.guard_x * b.w - b.x) ||
+      !plane(volume.guard_x * a.w + a.x, volume.guard_x * b.w + b.x) ||
+      !plane(volume.guard_y * a.w - a.y, volume.guard_y * b.w - b.y) ||
+      !plane(volume.guard_y * a.w + a.y, volume.guard_y * b.w + b.y))
+    return false;
+  const ClipVertex from = c0;
+  const ClipVertex to = c1;
+  auto at = [&](double t) {
+    ClipVertex v;
+    v.clip = from.clip + t * (to.clip - from.clip);
+    v.bary = from.bary + t * (to.bary - from.bary);
+    v.err = glm::max(from.err, to.err);
+    return v;
+  };
+  if (t0 > 0.0) c0 = at(t0);
+  if (t1 < 1.0) c1 = at(t1);
+  return true;
+}
+
+}  // namespace
+
+void Renderer::prepareLine(TriangleContext& t, const std::uint32_t* vertices, int count) const {
+  const Object& obj = scene_.objects[t.prim->object];
+  t.material = &scene_.materials[obj.material];
+  t.shading = &shading_[obj.material];
+  t.texture = t.material->texture.get();
+  t.chain = lod_ && t.texture != nullptr ? &chains_[obj.material] : nullptr;
+  // v[0], v[1] the segment's ends (a point: its vertex twice); v[2] repeats the last.
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t vi = vertices[std::min(k, count - 1)];
+    t.v[k] = &vertices_[t.prim->object][vi];
+    if (scene_.state.shading == Shading::Gouraud) t.gouraud[k] = &gouraud_[t.prim->object][vi];
+  }
+  if (scene_.state.shading != Shading::Flat) return;
+  const FlatFace face = flatSegment(t.v[0]->world, t.v[1]->world, t.v[0]->normal, t.v[1]->normal);
+  t.centroid = face.centroid;
+  t.face_normal = face.normal;
+  t.flat = shadePrepared(*t.shading, t.centroid, t.face_normal);
+}
+
+void Renderer::drawLineOrPoint(const PrimitiveRef& prim, const DrawPass& pass) {
+  const Object& obj = scene_.objects[prim.object];
+  std::uint32_t vertices[3];
+  const int count = primitiveVertices(obj, prim.triangle, vertices);
+  const std::vector<VertexWindow>& windows = windows_[prim.object];
+  for (int k = 0; k < count; ++k)
+    if (!(windows[vertices[k]].flags & VertexWindow::kFinite)) return;  // NaN/Inf: dropped
+  TriangleContext& t = context_;
+  t.prim = &prim;
+  t.pass = &pass;
+  t.constant = false;
+  t.texel_choice = false;
+  t.thin = false;
+  t.short_normals = false;
+  t.front_facing = true;  // lines and points are front-facing (stencil: the front state)
+  t.offset = 0.0;         // polygon offset applies to polygons only
+  t.offset_steps = 0.0f;
+  prepareLine(t, vertices, count);
+  const std::vector<TransformedVertex>& verts = vertices_[prim.object];
+  if (count == 1) {
+    const TransformedVertex& v = verts[vertices[0]];
+    const ClipVertex c{v.clip, glm::dvec3(1.0, 0.0, 0.0), v.clip_err};
+    const glm::dvec4& p = c.clip;
+    WindowVertex wv{};
+    FixedVertex fv{};
+    double reach = 0.0;
+    double depth_reach = 0.0;
+    if (!windowVertexSetup(c, wv, fv, reach, depth_reach)) return;
+    // GL discards a point whose centre is outside the view volume (13.7.1).
+    if (std::fabs(p.z) > p.w) return;
+    if (std::fabs(p.x) > p.w || std::fabs(p.y) > p.w) {
+      if (uncertainty_) markPointOutside(wv, pass.ops.point_size);
+      return;
+    }
+    drawPointWindowed(wv, fv, reach, depth_reach, false);
+    return;
+  }
+  const TransformedVertex& va = verts[vertices[0]];
+  const TransformedVertex& vb = verts[vertices[1]];
+  drawSegment(ClipVertex{va.clip, glm::dvec3(1.0, 0.0, 0.0), va.clip_err},
+              ClipVertex{vb.clip, glm::dvec3(0.0, 1.0, 0.0), vb.clip_err}, false);
+}
+
+void Renderer::drawSegment(const ClipVertex& a, const ClipVertex& b, bool polygon_edge) {
+  ClipVertex c0 = a;
+  ClipVertex c1 = b;
+  if (!clipSegment(c0, c1, volume_)) return;
+  WindowVertex w0{};
+  WindowVertex w1{};
+  FixedVertex f0{};
+  FixedVertex f1{};
+  double r0 = 0.0;
+  double r1 = 0.0;
+  double d0 = 0.0;
+  double d1 = 0.0;
+  if (!windowVertexSetup(c0, w0, f0, r0, d0) || !windowVertexSetup(c1, w1, f1, r1, d1)) return;
+  drawSegmentWindowed(w0, w1, f0, f1, std::max(r0, r1), std::max(d0, d1), polygon_edge);
+}
+
+// A polygon (a triangle, clipped) in polygon mode line or point: after culling by its
+// facing, its boundary edges as segments, or its vertices as points. An edge made by
+// clipping (its ends on different original edges) is not a boundary edge of the triangle
+// and is not drawn, nor is a vertex made by clipping; GL leaves the edge flags of clipped
+// polygons to the implementation (docs/reference.md "Lines and points").
+void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
+                                  const double* reach, const double* depth_reach, int count) {
+  const DrawPass& pass = *context_.pass;
+  std::int64_t area2 = 0;
+  for (int i = 1; i + 1 < count; ++i) area2 += snappedArea2(fv[0], fv[i], fv[i + 1]);
+  const bool front = (area2 > 0) == (pass.front_face == FrontFace::CCW);
+  if (area2 == 0 && pass.cull != Cull::None) return;
+  if ((pass.cull == Cull::Back && !front) || (pass.cull == Cull::Front && front)) return;
+  TriangleContext& t = context_;
+  t.front_facing = area2 == 0 || front;
+  t.offset = 0.0;
+  t.offset_steps = 0.0f;
+  t.texel_choice = false;
+  t.thin = false;
+  t.short_normals = false;
+  auto original = [](const glm::dvec3& b) {
+    return (b.x == 1.0 && b.y == 0.0 && b.z == 0.0) || (b.x == 0.0 && b.y == 1.0 && b.z == 0.0) ||
+           (b.x == 0.0 && b.y == 0.0 && b.z == 1.0);
+  };
+  if (pass.ops.polygon_mode == PolygonMode::Point) {
+    for (int i = 0; i < count; ++i)
+      if (original(wv[i].bary)) drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
+    return;
+  }
+  for (int i = 0; i < count; ++i) {
+    const int j = (i + 1) % count;
+    bool boundary = false;
+    for (int k = 0; k < 3; ++k) boundary = boundary || (wv[i].bary[k] == 0.0 && wv[j].bary[k] == 0.0);
+    if (!boundary) continue;
+    drawSegmentWindowed(wv[i], wv[j], fv[i], fv[j], std::max(reach[i], reach[j]),
+                        std::max(depth_reach[i], depth_reach[j]), true);
+  }
+}
+
+void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
+                                   const FixedVertex& fa, const FixedVertex& fb, double reach,
+                                   double depth_reach, bool polygon_edge) {
+  const double width = context_.pass->ops.line_width;
+  const int bits = options_.subpixel_bits;
+  const std::vector<LinePixel> pixels = roundedWidth(width) == 1.0
+                                            ? rasterizeLine(fa, fb, bits, clip_)
+                                            : rasterizeWideLine(fa, fb, width, bits, clip_);
+  const double w = roundedWidth(width);
+  // edge_dist: how close each pixel near the segment came to the other decision, less the
+  // vertices' reach. In the segment's major direction, per column (x-major) or row: the
+  // one-pixel rule produces the pixel whose centre is within w/2 of the segment measured
+  // in the minor direction (the diamond test away from the ends; the column rule for
+  // wide lines), so a pixel's margin is | |minor offset| - w/2 |. At each end, the columns
+  // within a pixel of the end point are the driver's (GL's rules for the initial and
+  // final fragments allow another fragment count and fragments one pixel away there).
+  if (uncertainty_) {
+    const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
+    const double ma = x_major ? a.x : a.y;
+    const double mb = x_major ? b.x : b.y;
+    const double na = x_major ? a.y : a.x;
+    const double nb = x_major ? b.y : b.x;
+    const double lo = std::min(ma, mb);
+    const double hi = std::max(ma, mb);
+    const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
+    const int major_lo = x_major ? clip_.x0 : clip_.y0;
+    const int major_hi = x_major ? clip_.x1 : clip_.y1;
+    const int minor_lo = x_major ? clip_.y0 : clip_.x0;
+    const int minor_hi = x_major ? clip_.y1 : clip_.x1;
+    const int first = std::max(major_lo, static_cast<int>(std::floor(lo - 1.5)));
+    const int last = std::min(major_hi - 1, static_cast<int>(std::ceil(hi + 1.5)));
+    for (int m = first; m <= last; ++m) {
+      const double mc = m + 0.5;
+      if (mc <= lo - 1.0 || mc >= hi + 1.0) continue;
+      const bool end = std::fabs(mc - ma) < 1.0 || std::fabs(mc - mb) < 1.0 || mc <= lo ||
+                       mc >= hi;
+      const double n_line = na + (std::clamp(mc, lo, hi) - ma) * slope;
+      const int n_first = std::max(minor_lo, static_cast<int>(std::floor(n_line - w / 2 - 1.5)));
+      const int n_last = std::min(minor_hi - 1, static_cast<int>(std::ceil(n_line + w / 2 + 1.5)));
+      for (int n = n_first; n <= n_last; ++n) {
+        const double off = std::fabs(n + 0.5 - n_line);
+        if (off >= w / 2 + 1.0) continue;
+        const double margin = end ? 0.0 : std::max(0.0, std::fabs(off - w / 2) - reach);
+        const int px = x_major ? m : n;
+        const int py = x_major ? n : m;
+        const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
+                                  static_cast<std::size_t>(px - clip_.x0);
+        float& e = frame_.edge_dist[index];
+        e = std::min(e, static_cast<float>(margin));
+      }
+    }
+  }
+  if (pixels.empty()) return;
+  ++triangles_drawn_;
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      shadeLineFragments<Shading::Flat>(pixels, a, b, true, w, depth_reach, polygon_edge);
+      break;
+    case Shading::Gouraud:
+      shadeLineFragments<Shading::Gouraud>(pixels, a, b, true, w, depth_reach, polygon_edge);
+      break;
+    case Shading::Phong:
+      shadeLineFragments<Shading::Phong>(pixels, a, b, true, w, depth_reach, polygon_edge);
+      break;
+  }
+}
+
+// A point whose centre is outside the viewport is discarded (GL), but a driver that
+// clips points as squares draws the part inside: those pixels are its choice.
+void Renderer::markPointOutside(const WindowVertex& c, double size) {
+  const double h = size / 2.0;
+  for (int py = std::max(clip_.y0, static_cast<int>(std::floor(c.y - h - 1.0)));
+       py < std::min(clip_.y1, static_cast<int>(std::ceil(c.y + h + 1.0))); ++py) {
+    for (int px = std::max(clip_.x0, static_cast<int>(std::floor(c.x - h - 1.0)));
+         px < std::min(clip_.x1, static_cast<int>(std::ceil(c.x + h + 1.0))); ++px) {
+      const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
+                                static_cast<std::size_t>(px - clip_.x0);
+      frame_.edge_dist[index] = 0.0f;
+    }
+  }
+}
+
+void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, double reach,
+                                 double depth_reach, bool polygon_vertex) {
+  const double size = context_.pass->ops.point_size;
+  const std::vector<LinePixel> pixels =
+      rasterizePoint(fc, size, options_.subpixel_bits, clip_);
+  // edge_dist: a pixel centre's distance to the square's border (inside or out), less the
+  // vertex's reach: GL leaves centres on the border to the implementation.
+  if (uncertainty_) {
+    const double h = size / 2.0;
+    for (int py = std::max(clip_.y0, static_cast<int>(std::floor(c.y - h - 1.5)));
+         py < std::min(clip_.y1, static_cast<int>(std::ceil(c.y + h + 1.5))); ++py) {
+      for (int px = std::max(clip_.x0, static_cast<int>(std::floor(c.x - h - 1.5)));
+           px < std::min(clip_.x1, static_cast<int>(std::ceil(c.x + h + 1.5))); ++px) {
+        const double dx = std::fabs(px + 0.5 - c.x) - h;
+        const double dy = std::fabs(py + 0.5 - c.y) - h;
+        // Inside: the nearer border; outside: how far beyond the farther one.
+        const double d = dx <= 0.0 && dy <= 0.0 ? std::min(-dx, -dy) : std::max(dx, dy);
+        if (d >= 1.0) continue;
+        const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
+                                  static_cast<std::size_t>(px - clip_.x0);
+        float& e = frame_.edge_dist[index];
+        e = std::min(e, static_cast<float>(std::max(0.0, d - reach)));
+      }
+    }
+  }
+  if (pixels.empty()) return;
+  ++triangles_drawn_;
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      shadeLineFragments<Shading::Flat>(pixels, c, c, false, size, depth_reach,
+                                        polygon_vertex);
+      break;
+    case Shading::Gouraud:
+      shadeLineFragments<Shading::Gouraud>(pixels, c, c, false, size, depth_reach,
+                                           polygon_vertex);
+      break;
+    case Shading::Phong:
+      shadeLineFragments<Shading::Phong>(pixels, c, c, false, size, depth_reach,
+                                         polygon_vertex);
+      break;
+  }
+}
+
+}  // namespace rc::ref
