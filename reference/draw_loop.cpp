@@ -116,7 +116,9 @@ void Renderer::transformVertices() {
     // triangles that array is 128 bytes a vertex of memory written for nothing. At the first
     // vertex outside, the pieces so far are transformed again into the array (the same
     // bits) and the rest are written there as before.
-    bool records_unread = shading == Shading::Flat && trace_ == nullptr &&
+    // (Lines and points read their vertices' clip coordinates: line_loop.cpp.)
+    bool records_unread = obj.primitive == PrimitiveKind::Triangles &&
+                          shading == Shading::Flat && trace_ == nullptr &&
                           scene_.materials[obj.material].texture == nullptr &&
                           prepared.lights.empty();
     // In pieces that stay in the cache from the transform to the window set-up (and

@@ -502,7 +502,7 @@ void Renderer::generalFragment(const TriangleContext& t, const GeneralSetup& g, 
                                std::size_t index, double z_window, float reach, Bary&& bary,
                                const FragmentInterpolator* interp,
                                const FragmentInterpolator::Row* row, double dx,
-                               float colour_reach) {
+                               const TexelNote& extra) {
   const DrawPass& pass = *t.pass;
   const FragmentOps& ops = pass.ops;
   const std::uint32_t id = t.prim->id;
@@ -589,8 +589,10 @@ void Renderer::generalFragment(const TriangleContext& t, const GeneralSetup& g, 
   for (int k = 0; k < 4; ++k)
     if (ops.color_mask[static_cast<std::size_t>(k)]) c[k] = storeColor(out[k], color_format_);
   if (uncertainty_)
-    gaps_.colourWritten(index, g.composited, g.alpha, note.dist, note.alt, note.gain, note.reach,
-                        note.shade, std::max(note.normal, colour_reach));
+    gaps_.colourWritten(index, g.composited, g.alpha, std::min(note.dist, extra.dist),
+                        std::max(note.alt, extra.alt), std::max(note.gain, extra.gain),
+                        std::max(note.reach, extra.reach), std::max(note.shade, extra.shade),
+                        std::max(note.normal, extra.normal));
   traced();
 }
 
@@ -612,7 +614,7 @@ void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage
         return trace_ != nullptr ? interp.barycentric(px + 0.5, cy) : interp.barycentricAt(row, dx);
       };
       generalFragment<kShading>(t, g, px, py, index, interp.depthAt(row, dx), reach, bary, &interp,
-                                &row, dx, 0.0f);
+                                &row, dx, TexelNote{});
     }
   });
 }
@@ -711,7 +713,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     const double z = (1.0 - s) * a.z + s * b.z;
     // normal_reach: the colour's range over the parameters and levels of detail a
     // conforming driver may use here, against the reference's own (8-bit units).
-    float colour_reach = 0.0f;
+    TexelNote extra;
+    float& colour_reach = extra.normal;
     if (uncertainty_ && varies) {
       const glm::dvec4 own = colour(s);
       double lo = 0.0;
@@ -733,6 +736,48 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       }
       colour_reach = static_cast<float>(255.0 * worst);
     }
+    // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
+    // level of the lambda interval), as triangles' level-of-detail fragments record them
+    // (texel_dist 0: always within; texel_alt the range times the light, plus a unit).
+    if (uncertainty_ && tex != nullptr) {
+      const glm::dvec3 w = bary_at(s);
+      const glm::dvec2 uv = w.x * t.v[0]->uv + w.y * t.v[1]->uv + w.z * t.v[2]->uv;
+      glm::dvec4 range(0.0);
+      if (t.chain != nullptr) {
+        double lo = 0.0;
+        double hi = 0.0;
+        lambda_at(s, lo, hi);
+        const auto& chain = *t.chain;
+        const int q = static_cast<int>(chain.size()) - 1;
+        const auto coarsest =
+            static_cast<std::size_t>(std::clamp(static_cast<int>(std::ceil(hi)), 0, q));
+        const glm::dvec2 shift(1.0 / (256.0 * chain[coarsest]->width),
+                               1.0 / (256.0 * chain[coarsest]->height));
+        range = lodRange(chain, uv, lo, hi, shift, lod_state_);
+      } else {
+        range = linearReachRange(*tex, uv, scene_.state.texture_wrap, 0.0, 0.0,
+                                 textureRangeOf(tex));
+      }
+      LitColor lit = t.flat;
+      if constexpr (kShading == Shading::Gouraud) {
+        lit.ambient_diffuse = w.x * t.gouraud[0]->ambient_diffuse +
+                              w.y * t.gouraud[1]->ambient_diffuse +
+                              w.z * t.gouraud[2]->ambient_diffuse;
+      } else if constexpr (kShading == Shading::Phong) {
+        lit = shadePrepared(*t.shading, w.x * t.v[0]->world + w.y * t.v[1]->world + w.z * t.v[2]->world,
+                            safeNormalize(w.x * t.v[0]->normal + w.y * t.v[1]->normal +
+                                          w.z * t.v[2]->normal));
+      }
+      double alt = 0.0;
+      double light = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        alt = std::max(alt, std::fabs(lit.ambient_diffuse[c] * range[c]));
+        light = std::max(light, lit.ambient_diffuse[c]);
+      }
+      const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+      extra.dist = 0.0f;
+      extra.alt = static_cast<float>(weight * (255.0 * alt + light));
+    }
     double lo = 0.0;
     double hi = 0.0;
     t.line_lambda = lambda_at(s, lo, hi);
@@ -742,7 +787,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     }
     generalFragment<kShading>(t, g, p.x, p.y, index, z,
                               static_cast<float>(uncertainty_ ? fragment_reach : 0.0),
-                              [&] { return bary_at(s); }, nullptr, nullptr, 0.0, colour_reach);
+                              [&] { return bary_at(s); }, nullptr, nullptr, 0.0, extra);
   }
   t.line_lambda = std::numeric_limits<double>::quiet_NaN();
   trace = LineTrace{};

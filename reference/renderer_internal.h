@@ -302,7 +302,7 @@ class Renderer {
   void generalFragment(const TriangleContext& t, const GeneralSetup& g, int px, int py,
                        std::size_t index, double z_window, float reach, Bary&& bary,
                        const FragmentInterpolator* interp, const FragmentInterpolator::Row* row,
-                       double dx, float colour_reach);
+                       double dx, const TexelNote& extra);
   // Lines and points (line_loop.cpp): a line or point primitive of `pass`; the edges or
   // vertices of a triangle's (clipped) polygon in polygon mode line or point; one segment
   // or point in clip space (barycentrics w.r.t. the primitive's original vertices in
