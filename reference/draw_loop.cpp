@@ -105,8 +105,11 @@ void Renderer::transformVertices() {
     windows_[o].resize(n);
     if (shading == Shading::Gouraud) gouraud_[o].resize(n);
     // Flat shading lights the face normal: vertex normals would go unused (unless traced).
-    const ObjectTransform transform(obj, camera_, shading != Shading::Flat || trace_ != nullptr,
-                                    uncertainty_);
+    // (Flat line and point primitives light their vertices' normals: prepareLine().)
+    const ObjectTransform transform(
+        obj, camera_,
+        shading != Shading::Flat || trace_ != nullptr || obj.primitive != PrimitiveKind::Triangles,
+        uncertainty_);
     const PreparedShading& prepared = shading_[obj.material];
     // Flat, unlit, untextured and not traced, nothing reads a vertex's record after its
     // window set-up (prepareTriangle() and the fragment loops read the windows) unless one

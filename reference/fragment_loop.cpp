@@ -20,6 +20,10 @@
 namespace rc::ref {
 namespace {
 
+// How far beyond a segment's ends (in units of its length) a fragment's parameter is taken
+// (a short wide line's end fragments lie up to w / 2 px beyond them).
+constexpr double kMaxLineOvershoot = 0.5;
+
 struct PhongQuad {
   static constexpr int kMax = 8;
   const FragmentInterpolator* interp = nullptr;
@@ -640,7 +644,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
   const double slack_t = len > 0.0 ? slack_px / len : 0.0;
   const double major = std::max(std::fabs(d.x), std::fabs(d.y));
   const double z_per_px =
-      major > 0.0 ? std::fabs(b.z - a.z) * g.scale / major * depth_steps_ : 0.0;
+      major > 0.0 ? std::fabs((b.z - a.z) * g.scale) / major * depth_steps_ : 0.0;
   t.depth_slope = static_cast<float>(z_per_px);
   const double fragment_reach = depth_reach + slack_px * z_per_px + 1.0;
   const double planes[8] = {a.x, a.y, a.z, b.x, b.y, b.z, g.near, g.scale};
@@ -650,12 +654,16 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
 
   auto param = [&](double px, double py) {
     if (!(len2 > 0.0)) return 0.0;
-    return std::clamp(glm::dot(glm::dvec2(px, py) - pa, d) / len2, 0.0, 1.0);
+    // Not clamped (GL's t): a fragment centre beyond an end extrapolates, as the attribute
+    // planes of a driver's line quad do; bounded so that the perspective weights stay
+    // positive.
+    return std::clamp(glm::dot(glm::dvec2(px, py) - pa, d) / len2, -kMaxLineOvershoot,
+                      1.0 + kMaxLineOvershoot);
   };
   auto bary_at = [&](double s) {
     const double wa = (1.0 - s) * a.inv_w;
     const double wb = s * b.inv_w;
-    const double q = wa + wb != 0.0 ? wb / (wa + wb) : s;
+    const double q = wa + wb > 0.0 ? wb / (wa + wb) : s;
     return (1.0 - q) * a.bary + q * b.bary;
   };
   // The level of detail at parameter s: the texture coordinate's derivative along the
@@ -723,7 +731,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       constexpr int kSteps = 8;
       double worst = 0.0;
       for (int k = 0; k <= kSteps; ++k) {
-        const double q = std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, 0.0, 1.0);
+        const double q = std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, -kMaxLineOvershoot,
+                                    1.0 + kMaxLineOvershoot);
         const glm::dvec3 w = bary_at(q);
         for (int l = 0; l < (std::isnan(lo) ? 1 : 3); ++l) {
           double ignore_lo = 0.0;

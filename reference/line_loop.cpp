@@ -107,7 +107,8 @@ void Renderer::drawLineOrPoint(const PrimitiveRef& prim, const DrawPass& pass) {
     // GL discards a point whose centre is outside the view volume (13.7.1).
     if (std::fabs(p.z) > p.w) return;
     if (std::fabs(p.x) > p.w || std::fabs(p.y) > p.w) {
-      if (uncertainty_) markPointOutside(wv, pass.ops.point_size);
+      // GL discards it; a driver that clips points as squares draws the part inside.
+      if (uncertainty_) markAmbiguous(wv, wv, pass.ops.point_size / 2.0 + 1.0);
       return;
     }
     drawPointWindowed(wv, fv, reach, depth_reach, false);
@@ -159,18 +160,101 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
     return (b.x == 1.0 && b.y == 0.0 && b.z == 0.0) || (b.x == 0.0 && b.y == 1.0 && b.z == 0.0) ||
            (b.x == 0.0 && b.y == 0.0 && b.z == 1.0);
   };
-  if (pass.ops.polygon_mode == PolygonMode::Point) {
-    for (int i = 0; i < count; ++i)
-      if (original(wv[i].bary)) drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
+  // Where GL's polygon clipping and a driver's differ (docs/reference.md "Lines and
+  // points"): the reference clips in a guard band and draws the triangle's own edges and
+  // vertices; a driver may clip at the viewport (new vertices on its border, and edges
+  // along it) and at the near and far planes, and draw those too. Their pixels are the
+  // driver's choice: edges made by clipping, vertices made by clipping or beyond the
+  // viewport, and where an edge crosses the viewport's border, the border there.
+  const bool points = pass.ops.polygon_mode == PolygonMode::Point;
+  const double reach_px = points ? pass.ops.point_size / 2.0 + 1.0
+                                 : roundedWidth(pass.ops.line_width) / 2.0 + 1.0;
+  if (uncertainty_) {
+    const double bounds[2] = {static_cast<double>(scene_.width), static_cast<double>(scene_.height)};
+    double lo[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}};  // [axis][side]
+    double hi[2][2] = {{-INFINITY, -INFINITY}, {-INFINITY, -INFINITY}};
+    for (int i = 0; i < count; ++i) {
+      const WindowVertex& p = wv[i];
+      const WindowVertex& q = wv[(i + 1) % count];
+      const double pp[2] = {p.x, p.y};
+      const double qq[2] = {q.x, q.y};
+      for (int axis = 0; axis < 2; ++axis) {
+        for (int side = 0; side < 2; ++side) {
+          const double at = side == 0 ? 0.0 : bounds[axis];
+          if ((pp[axis] - at) * (qq[axis] - at) > 0.0 || pp[axis] == qq[axis]) continue;
+          const double f = (at - pp[axis]) / (qq[axis] - pp[axis]);
+          const double other = pp[1 - axis] + f * (qq[1 - axis] - pp[1 - axis]);
+          lo[axis][side] = std::min(lo[axis][side], other);
+          hi[axis][side] = std::max(hi[axis][side], other);
+          WindowVertex c = p;
+          (axis == 0 ? c.x : c.y) = at;
+          (axis == 0 ? c.y : c.x) = other;
+          markAmbiguous(c, c, reach_px);
+        }
+      }
+    }
+    if (!points) {
+      for (int axis = 0; axis < 2; ++axis) {
+        for (int side = 0; side < 2; ++side) {
+          if (!(lo[axis][side] <= hi[axis][side])) continue;
+          WindowVertex a = wv[0];
+          WindowVertex b = wv[0];
+          const double at = side == 0 ? 0.0 : bounds[axis];
+          (axis == 0 ? a.x : a.y) = at;
+          (axis == 0 ? b.x : b.y) = at;
+          (axis == 0 ? a.y : a.x) = lo[axis][side];
+          (axis == 0 ? b.y : b.x) = hi[axis][side];
+          markAmbiguous(a, b, reach_px);
+        }
+      }
+    }
+  }
+  if (points) {
+    for (int i = 0; i < count; ++i) {
+      const bool inside = wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 &&
+                          wv[i].y <= scene_.height;
+      if (original(wv[i].bary) && inside) {
+        drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
+      } else if (uncertainty_) {
+        markAmbiguous(wv[i], wv[i], reach_px);
+      }
+    }
     return;
   }
   for (int i = 0; i < count; ++i) {
     const int j = (i + 1) % count;
     bool boundary = false;
     for (int k = 0; k < 3; ++k) boundary = boundary || (wv[i].bary[k] == 0.0 && wv[j].bary[k] == 0.0);
-    if (!boundary) continue;
+    if (!boundary) {
+      if (uncertainty_) markAmbiguous(wv[i], wv[j], reach_px);
+      continue;
+    }
     drawSegmentWindowed(wv[i], wv[j], fv[i], fv[j], std::max(reach[i], reach[j]),
                         std::max(depth_reach[i], depth_reach[j]), true);
+  }
+}
+
+// Pixels whose centre lies within `radius` px (in x and in y) of the nearest point of the
+// segment a -> b (a point when a == b):
+// edge_dist 0, the driver's choice (no fragment of the reference's).
+void Renderer::markAmbiguous(const WindowVertex& a, const WindowVertex& b, double radius) {
+  const glm::dvec2 pa(a.x, a.y);
+  const glm::dvec2 d = glm::dvec2(b.x, b.y) - pa;
+  const double len2 = glm::dot(d, d);
+  const int x0 = std::max(clip_.x0, static_cast<int>(std::floor(std::min(a.x, b.x) - radius)));
+  const int x1 = std::min(clip_.x1, static_cast<int>(std::ceil(std::max(a.x, b.x) + radius)) + 1);
+  const int y0 = std::max(clip_.y0, static_cast<int>(std::floor(std::min(a.y, b.y) - radius)));
+  const int y1 = std::min(clip_.y1, static_cast<int>(std::ceil(std::max(a.y, b.y) + radius)) + 1);
+  for (int py = y0; py < y1; ++py) {
+    for (int px = x0; px < x1; ++px) {
+      const glm::dvec2 c(px + 0.5, py + 0.5);
+      const double t = len2 > 0.0 ? std::clamp(glm::dot(c - pa, d) / len2, 0.0, 1.0) : 0.0;
+      const glm::dvec2 off = glm::abs(c - (pa + t * d));
+      if (std::max(off.x, off.y) > radius) continue;  // squares: a point's shape
+      const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
+                                static_cast<std::size_t>(px - clip_.x0);
+      frame_.edge_dist[index] = 0.0f;
+    }
   }
 }
 
@@ -238,21 +322,6 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
     case Shading::Phong:
       shadeLineFragments<Shading::Phong>(pixels, a, b, true, w, depth_reach, polygon_edge);
       break;
-  }
-}
-
-// A point whose centre is outside the viewport is discarded (GL), but a driver that
-// clips points as squares draws the part inside: those pixels are its choice.
-void Renderer::markPointOutside(const WindowVertex& c, double size) {
-  const double h = size / 2.0;
-  for (int py = std::max(clip_.y0, static_cast<int>(std::floor(c.y - h - 1.0)));
-       py < std::min(clip_.y1, static_cast<int>(std::ceil(c.y + h + 1.0))); ++py) {
-    for (int px = std::max(clip_.x0, static_cast<int>(std::floor(c.x - h - 1.0)));
-         px < std::min(clip_.x1, static_cast<int>(std::ceil(c.x + h + 1.0))); ++px) {
-      const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
-                                static_cast<std::size_t>(px - clip_.x0);
-      frame_.edge_dist[index] = 0.0f;
-    }
   }
 }
 

@@ -316,7 +316,7 @@ class Renderer {
                            bool polygon_edge);
   void drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, double reach,
                          double depth_reach, bool polygon_vertex);
-  void markPointOutside(const WindowVertex& c, double size);
+  void markAmbiguous(const WindowVertex& a, const WindowVertex& b, double radius);
   template <Shading kShading>
   void shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
                           const WindowVertex& b, bool segment, double size, double depth_reach,
