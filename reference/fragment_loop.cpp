@@ -23,6 +23,8 @@ namespace {
 // How far beyond a segment's ends (in units of its length) a fragment's parameter is taken
 // (a short wide line's end fragments lie up to w / 2 px beyond them).
 constexpr double kMaxLineOvershoot = 0.5;
+// The parameter slack (px along the segment) at a pixel two edges of one polygon produce.
+constexpr double kSharedSlackPx = 2.5;
 
 struct PhongQuad {
   static constexpr int kMax = 8;
@@ -641,12 +643,10 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
   // wide lines over their whole width), up to max(1, w) / 2 px along the segment from the
   // projection.
   const double slack_px = segment ? 0.5 * std::max(1.0, size) : 0.0;
-  const double slack_t = len > 0.0 ? slack_px / len : 0.0;
   const double major = std::max(std::fabs(d.x), std::fabs(d.y));
   const double z_per_px =
       major > 0.0 ? std::fabs((b.z - a.z) * g.scale) / major * depth_steps_ : 0.0;
   t.depth_slope = static_cast<float>(z_per_px);
-  const double fragment_reach = depth_reach + slack_px * z_per_px + 1.0;
   const double planes[8] = {a.x, a.y, a.z, b.x, b.y, b.z, g.near, g.scale};
   const std::size_t h = std::hash<std::string_view>{}(
       std::string_view(reinterpret_cast<const char*>(planes), sizeof planes));
@@ -719,6 +719,17 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
                               static_cast<std::size_t>(p.x - clip_.x0);
     const double s = segment ? param(cx, cy) : 0.0;
     const double z = (1.0 - s) * a.z + s * b.z;
+    // A pixel another edge (vertex) of the same polygon also produces (outline_shared_):
+    // the fragment stored there may be the other one, whose parameter lies within a few
+    // pixels of the shared vertex (kSharedSlackPx covers a wide line's column).
+    const bool shared = !outline_shared_.empty() &&
+                        std::binary_search(outline_shared_.begin(), outline_shared_.end(), index);
+    const double shared_px = shared ? std::max(kSharedSlackPx, size + 1.0) : 0.0;
+    const double slack_t = len > 0.0 ? std::max(slack_px, shared_px) / len : 0.0;
+    // (Two points of one polygon: the other vertex's depth and colour, unknown here: any.)
+    const double fragment_reach = shared && !segment
+                                      ? std::numeric_limits<double>::infinity()
+                                      : depth_reach + std::max(slack_px, shared_px) * z_per_px + 1.0;
     // normal_reach: the colour's range over the parameters and levels of detail a
     // conforming driver may use here, against the reference's own (8-bit units).
     TexelNote extra;
@@ -728,8 +739,12 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       double lo = 0.0;
       double hi = 0.0;
       lambda_at(s, lo, hi);
-      constexpr int kSteps = 8;
+      // Sampled at kSteps + 1 parameters; untextured, the largest change between neighbouring
+      // samples is added (how far the smooth lighting can go past the samples between two).
+      constexpr int kSteps = 24;
       double worst = 0.0;
+      double step = 0.0;
+      glm::dvec4 last(0.0);
       for (int k = 0; k <= kSteps; ++k) {
         const double q = std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, -kMaxLineOvershoot,
                                     1.0 + kMaxLineOvershoot);
@@ -740,10 +755,15 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
           t.line_lambda = std::isnan(lo) ? lambda_at(q, ignore_lo, ignore_hi)
                                          : (l == 0 ? lo : (l == 1 ? hi : 0.5 * (lo + hi)));
           const glm::dvec4 c = fragmentColor<kShading>(t, w, nullptr);
-          for (int ch = 0; ch < 3; ++ch) worst = std::max(worst, std::fabs(c[ch] - own[ch]));
+          for (int ch = 0; ch < 3; ++ch) {
+            worst = std::max(worst, std::fabs(c[ch] - own[ch]));
+            if (l == 0 && k > 0) step = std::max(step, std::fabs(c[ch] - last[ch]));
+          }
+          if (l == 0) last = c;
         }
       }
-      colour_reach = static_cast<float>(255.0 * worst);
+      if (tex == nullptr) worst += step;
+      colour_reach = static_cast<float>(shared && !segment ? 255.0 : 255.0 * worst);
     }
     // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
     // level of the lambda interval), as triangles' level-of-detail fragments record them

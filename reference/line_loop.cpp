@@ -9,6 +9,7 @@
 // fragment centre onto the segment while drivers interpolate along the major axis (up to
 // half a pixel, more for wide lines, apart: depth_reach and normal_reach).
 #include <algorithm>
+#include <vector>
 #include <cmath>
 
 #include "fixtures/scene_geometry.h"
@@ -17,14 +18,16 @@
 namespace rc::ref {
 namespace {
 
-// GL rounds a non-antialiased line's width to the nearest integer, 0 counting as 1.
-double roundedWidth(double width) { return std::max(1.0, std::round(width)); }
+// GL rounds a non-antialiased line's width to the nearest integer, 0 counting as 1 (halves
+// up here, as in line_raster.h).
+double roundedWidth(double width) { return std::max(1.0, std::floor(width + 0.5)); }
 
-// Clips the segment c0 -> c1 to the near and far planes and to the guard band (x and y
-// within +/- guard * w, where window coordinates stay in the snapped grid's budget);
-// false when nothing is left. The guard band cuts only beyond the viewport, where no pixel
-// is produced, so what is drawn is what clipping to the view volume draws.
-bool clipSegment(ClipVertex& c0, ClipVertex& c1, const ClipVolume& volume) {
+// Clips the segment c0 -> c1 to the view volume (GL 13.7: |x|, |y|, |z| <= w); false when
+// nothing is left. Against x and y too: a wide line is widened from its clipped centre
+// line, so the part of its width that reaches into the viewport past the segment's exit
+// is not drawn (llvmpipe and zink clip so). A clipped end lies on the viewport's border,
+// where GL's end rules leave the last fragments to the driver.
+bool clipSegment(ClipVertex& c0, ClipVertex& c1) {
   double t0 = 0.0;
   double t1 = 1.0;
   auto plane = [&](double d0, double d1) {
@@ -36,10 +39,8 @@ bool clipSegment(ClipVertex& c0, ClipVertex& c1, const ClipVolume& volume) {
   const glm::dvec4& a = c0.clip;
   const glm::dvec4& b = c1.clip;
   if (!plane(a.w + a.z, b.w + b.z) || !plane(a.w - a.z, b.w - b.z) ||
-      !plane(volume.guard_x * a.w - a.x, volume.guard_x * b.w - b.x) ||
-      !plane(volume.guard_x * a.w + a.x, volume.guard_x * b.w + b.x) ||
-      !plane(volume.guard_y * a.w - a.y, volume.guard_y * b.w - b.y) ||
-      !plane(volume.guard_y * a.w + a.y, volume.guard_y * b.w + b.y))
+      !plane(a.w - a.x, b.w - b.x) || !plane(a.w + a.x, b.w + b.x) ||
+      !plane(a.w - a.y, b.w - b.y) || !plane(a.w + a.y, b.w + b.y))
     return false;
   const ClipVertex from = c0;
   const ClipVertex to = c1;
@@ -52,6 +53,37 @@ bool clipSegment(ClipVertex& c0, ClipVertex& c1, const ClipVolume& volume) {
   };
   if (t0 > 0.0) c0 = at(t0);
   if (t1 < 1.0) c1 = at(t1);
+  return true;
+}
+
+// The window-space segment a -> b clipped to [0, width] x [0, height]: x, y, z and 1/w are
+// affine along it in window space, the barycentrics divided by w too; false when nothing
+// is left.
+bool clipToViewport(WindowVertex& a, WindowVertex& b, int width, int height) {
+  double t0 = 0.0;
+  double t1 = 1.0;
+  auto plane = [&](double d0, double d1) {
+    if (d0 < 0.0 && d1 < 0.0) return false;
+    if (d0 < 0.0) t0 = std::max(t0, d0 / (d0 - d1));
+    if (d1 < 0.0) t1 = std::min(t1, d0 / (d0 - d1));
+    return t0 <= t1;
+  };
+  if (!plane(a.x, b.x) || !plane(width - a.x, width - b.x) || !plane(a.y, b.y) ||
+      !plane(height - a.y, height - b.y))
+    return false;
+  const WindowVertex from = a;
+  const WindowVertex to = b;
+  auto at = [&](double t) {
+    WindowVertex v;
+    v.x = from.x + t * (to.x - from.x);
+    v.y = from.y + t * (to.y - from.y);
+    v.z = from.z + t * (to.z - from.z);
+    v.inv_w = from.inv_w + t * (to.inv_w - from.inv_w);
+    v.bary = (from.bary * from.inv_w + t * (to.bary * to.inv_w - from.bary * from.inv_w)) / v.inv_w;
+    return v;
+  };
+  if (t0 > 0.0) a = at(t0);
+  if (t1 < 1.0) b = at(t1);
   return true;
 }
 
@@ -123,7 +155,7 @@ void Renderer::drawLineOrPoint(const PrimitiveRef& prim, const DrawPass& pass) {
 void Renderer::drawSegment(const ClipVertex& a, const ClipVertex& b, bool polygon_edge) {
   ClipVertex c0 = a;
   ClipVertex c1 = b;
-  if (!clipSegment(c0, c1, volume_)) return;
+  if (!clipSegment(c0, c1)) return;
   WindowVertex w0{};
   WindowVertex w1{};
   FixedVertex f0{};
@@ -209,6 +241,34 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
       }
     }
   }
+  // GL does not order a polygon's edges (or vertices) among themselves: where two of them
+  // produce the same pixel, which one is drawn last is the driver's choice (Mesa's draw
+  // module starts with the edge from the last vertex). Those pixels get a wider parameter
+  // slack (shadeLineFragments()), covering the other fragment's depth and colour.
+  outline_shared_.clear();
+  if (uncertainty_) {
+    std::vector<std::size_t> hits;
+    const int bits = options_.subpixel_bits;
+    for (int i = 0; i < count; ++i) {
+      std::vector<LinePixel> pixels;
+      if (points) {
+        if (original(wv[i].bary)) pixels = rasterizePoint(fv[i], pass.ops.point_size, bits, clip_);
+      } else {
+        const int j = (i + 1) % count;
+        pixels = roundedWidth(pass.ops.line_width) == 1.0
+                     ? rasterizeLine(fv[i], fv[j], bits, clip_)
+                     : rasterizeWideLine(fv[i], fv[j], pass.ops.line_width, bits, clip_);
+      }
+      for (const LinePixel& p : pixels)
+        hits.push_back(static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
+                       static_cast<std::size_t>(p.x - clip_.x0));
+    }
+    std::sort(hits.begin(), hits.end());
+    for (std::size_t k = 1; k < hits.size(); ++k)
+      if (hits[k] == hits[k - 1] &&
+          (outline_shared_.empty() || outline_shared_.back() != hits[k]))
+        outline_shared_.push_back(hits[k]);
+  }
   if (points) {
     for (int i = 0; i < count; ++i) {
       const bool inside = wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 &&
@@ -219,6 +279,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
         markAmbiguous(wv[i], wv[i], reach_px);
       }
     }
+    outline_shared_.clear();
     return;
   }
   for (int i = 0; i < count; ++i) {
@@ -229,9 +290,17 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
       if (uncertainty_) markAmbiguous(wv[i], wv[j], reach_px);
       continue;
     }
-    drawSegmentWindowed(wv[i], wv[j], fv[i], fv[j], std::max(reach[i], reach[j]),
+    // Clipped to the viewport, as GL clips the polygon before it draws its edges (a wide
+    // edge's band past the viewport's border is not drawn).
+    WindowVertex a = wv[i];
+    WindowVertex b = wv[j];
+    if (!clipToViewport(a, b, scene_.width, scene_.height)) continue;
+    const FixedVertex fa = a.x == wv[i].x && a.y == wv[i].y ? fv[i] : snapVertexScaled(a.x, a.y, snap_scale_);
+    const FixedVertex fb = b.x == wv[j].x && b.y == wv[j].y ? fv[j] : snapVertexScaled(b.x, b.y, snap_scale_);
+    drawSegmentWindowed(a, b, fa, fb, std::max(reach[i], reach[j]),
                         std::max(depth_reach[i], depth_reach[j]), true);
   }
+  outline_shared_.clear();
 }
 
 // Pixels whose centre lies within `radius` px (in x and in y) of the nearest point of the
@@ -267,6 +336,7 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
                                             ? rasterizeLine(fa, fb, bits, clip_)
                                             : rasterizeWideLine(fa, fb, width, bits, clip_);
   const double w = roundedWidth(width);
+  const bool half = width > 1.0 && width - std::floor(width) == 0.5;
   // edge_dist: how close each pixel near the segment came to the other decision, less the
   // vertices' reach. In the segment's major direction, per column (x-major) or row: the
   // one-pixel rule produces the pixel whose centre is within w/2 of the segment measured
@@ -300,7 +370,10 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
       for (int n = n_first; n <= n_last; ++n) {
         const double off = std::fabs(n + 0.5 - n_line);
         if (off >= w / 2 + 1.0) continue;
-        const double margin = end ? 0.0 : std::max(0.0, std::fabs(off - w / 2) - reach);
+        // A width of k + 1/2 may be drawn k or k + 1 wide: the rows between are open.
+        const bool half_open = half && off < w / 2 + 0.5;
+        const double margin =
+            end || half_open ? 0.0 : std::max(0.0, std::fabs(off - w / 2) - reach);
         const int px = x_major ? m : n;
         const int py = x_major ? n : m;
         const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +

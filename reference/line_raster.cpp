@@ -9,7 +9,8 @@
 namespace rc::ref {
 namespace {
 
-using Wide = __int128;
+// 128 bits: products of two 64-bit snapped coordinates (a GCC and Clang extension).
+__extension__ typedef __int128 Wide;
 
 // c0 + c1 e + c2 e^2 for an infinitesimal e > 0.
 struct Sym {
@@ -154,7 +155,9 @@ std::vector<LinePixel> rasterizeLine(const FixedVertex& a, const FixedVertex& b,
 
 std::vector<LinePixel> rasterizeWideLine(const FixedVertex& a, const FixedVertex& b, double width,
                                          int subpixel_bits, const PixelRect& clip) {
-  const auto w = static_cast<int>(std::max(1.0, std::nearbyint(width)));
+  // Halves up (2.5 draws 3), as Mesa's drivers round; GL says only "the nearest integer",
+  // so a half's other width is the driver's choice (line_loop.cpp marks it).
+  const auto w = static_cast<int>(std::max(1.0, std::floor(width + 0.5)));
   if (w == 1) return rasterizeLine(a, b, subpixel_bits, clip);
   const bool x_major = std::llabs(b.x - a.x) >= std::llabs(b.y - a.y);
   // (w - 1) / 2 px in snapped units: exact, also for an even w (half a pixel) unless the

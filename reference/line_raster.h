@@ -41,7 +41,7 @@ std::vector<LinePixel> rasterizeLine(const FixedVertex& a, const FixedVertex& b,
                                      const PixelRect& clip);
 
 // A non-antialiased wide line by GL's column rule (14.5.2.1): w = the width rounded to the
-// nearest integer (0 counts as 1); the segment moved by -(w - 1) / 2 px in its minor
+// nearest integer, halves up (0 counts as 1); the segment moved by -(w - 1) / 2 px in its minor
 // direction (y for an x-major segment, |dx| >= |dy|; else x) is rasterized by the one-pixel
 // rule, and each of its fragments becomes a column (x-major) or row of w fragments, the
 // fragment itself the lowest (leftmost). GL also lets an implementation draw a wide line as

@@ -380,6 +380,9 @@ class Renderer {
   // textureRange() of each texture met so far (linear filtering with uncertainty).
   std::vector<std::pair<const Texture*, glm::dvec4>> texture_ranges_;
   const glm::dvec4& textureRangeOf(const Texture* texture);
+  // drawPolygonOutline(): the pixels (framebuffer indices, sorted) two of the polygon's
+  // edges or vertices produce, whose last fragment GL leaves to the driver.
+  std::vector<std::size_t> outline_shared_;
 };
 
 // How far a float32 implementation may put the vertex beyond snapping (its clip
