@@ -20,11 +20,6 @@
 namespace rc::ref {
 namespace {
 
-// How far beyond a segment's ends (in units of its length) a fragment's parameter is taken
-// (a short wide line's end fragments lie up to w / 2 px beyond them).
-constexpr double kMaxLineOvershoot = 0.5;
-// The parameter slack (px along the segment) at a pixel two edges of one polygon produce.
-constexpr double kSharedSlackPx = 2.5;
 
 struct PhongQuad {
   static constexpr int kMax = 8;
@@ -652,13 +647,16 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       std::string_view(reinterpret_cast<const char*>(planes), sizeof planes));
   t.plane_key = h == 0 ? 1 : h;
 
+  // How far beyond the ends a parameter is taken: the fragments of a line's ends lie up to
+  // w / 2 + 1 px past them (slack included), while the perspective weights stay positive
+  // (bary_at() falls back to the window-space parameter where they would not).
+  const double overshoot = len > 0.0 ? (std::max(1.0, size) / 2.0 + 1.0 + slack_px) / len : 0.0;
   auto param = [&](double px, double py) {
     if (!(len2 > 0.0)) return 0.0;
     // Not clamped (GL's t): a fragment centre beyond an end extrapolates, as the attribute
     // planes of a driver's line quad do; bounded so that the perspective weights stay
     // positive.
-    return std::clamp(glm::dot(glm::dvec2(px, py) - pa, d) / len2, -kMaxLineOvershoot,
-                      1.0 + kMaxLineOvershoot);
+    return std::clamp(glm::dot(glm::dvec2(px, py) - pa, d) / len2, -overshoot, 1.0 + overshoot);
   };
   auto bary_at = [&](double s) {
     const double wa = (1.0 - s) * a.inv_w;
@@ -719,17 +717,32 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
                               static_cast<std::size_t>(p.x - clip_.x0);
     const double s = segment ? param(cx, cy) : 0.0;
     const double z = (1.0 - s) * a.z + s * b.z;
-    // A pixel another edge (vertex) of the same polygon also produces (outline_shared_):
-    // the fragment stored there may be the other one, whose parameter lies within a few
-    // pixels of the shared vertex (kSharedSlackPx covers a wide line's column).
+    // A pixel another edge (vertex) of the same polygon also produces (outline_shared_): the
+    // dry run records this fragment; the drawing run widens its depth reach and colour reach
+    // by the spread of all of them there (outline_spread_).
     const bool shared = !outline_shared_.empty() &&
                         std::binary_search(outline_shared_.begin(), outline_shared_.end(), index);
-    const double shared_px = shared ? std::max(kSharedSlackPx, size + 1.0) : 0.0;
-    const double slack_t = len > 0.0 ? std::max(slack_px, shared_px) / len : 0.0;
-    // (Two points of one polygon: the other vertex's depth and colour, unknown here: any.)
-    const double fragment_reach = shared && !segment
-                                      ? std::numeric_limits<double>::infinity()
-                                      : depth_reach + std::max(slack_px, shared_px) * z_per_px + 1.0;
+    if (outline_dry_) {
+      if (shared) {
+        const glm::dvec3 c(colour(s));
+        outline_spread_.push_back({index, z, z, c, c});
+      }
+      continue;
+    }
+    const double slack_t = len > 0.0 ? slack_px / len : 0.0;
+    double spread_z = 0.0;
+    double spread_c = 0.0;
+    if (shared) {
+      const auto it = std::lower_bound(
+          outline_spread_.begin(), outline_spread_.end(), index,
+          [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
+      if (it != outline_spread_.end() && it->index == index) {
+        spread_z = (it->z_hi - it->z_lo) * std::fabs(g.scale) * depth_steps_;
+        const glm::dvec3 range = it->c_hi - it->c_lo;
+        spread_c = 255.0 * std::max({range.x, range.y, range.z});
+      }
+    }
+    const double fragment_reach = depth_reach + slack_px * z_per_px + 1.0 + spread_z;
     // normal_reach: the colour's range over the parameters and levels of detail a
     // conforming driver may use here, against the reference's own (8-bit units).
     TexelNote extra;
@@ -746,8 +759,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       double step = 0.0;
       glm::dvec4 last(0.0);
       for (int k = 0; k <= kSteps; ++k) {
-        const double q = std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, -kMaxLineOvershoot,
-                                    1.0 + kMaxLineOvershoot);
+        const double q =
+            std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, -overshoot, 1.0 + overshoot);
         const glm::dvec3 w = bary_at(q);
         for (int l = 0; l < (std::isnan(lo) ? 1 : 3); ++l) {
           double ignore_lo = 0.0;
@@ -763,7 +776,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
         }
       }
       if (tex == nullptr) worst += step;
-      colour_reach = static_cast<float>(shared && !segment ? 255.0 : 255.0 * worst);
+      colour_reach = static_cast<float>(255.0 * worst);
     }
     // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
     // level of the lambda interval), as triangles' level-of-detail fragments record them
@@ -807,6 +820,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       extra.dist = 0.0f;
       extra.alt = static_cast<float>(weight * (255.0 * alt + light));
     }
+    // (The stored fragment may be another one there, at its own slack: the two add.)
+    colour_reach += static_cast<float>(spread_c);
     double lo = 0.0;
     double hi = 0.0;
     t.line_lambda = lambda_at(s, lo, hi);

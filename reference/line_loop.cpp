@@ -243,8 +243,8 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
   }
   // GL does not order a polygon's edges (or vertices) among themselves: where two of them
   // produce the same pixel, which one is drawn last is the driver's choice (Mesa's draw
-  // module starts with the edge from the last vertex). Those pixels get a wider parameter
-  // slack (shadeLineFragments()), covering the other fragment's depth and colour.
+  // module starts with the edge from the last vertex). Those pixels' channels cover every
+  // fragment the polygon puts there (outline_spread_).
   outline_shared_.clear();
   if (uncertainty_) {
     std::vector<std::size_t> hits;
@@ -269,38 +269,67 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
           (outline_shared_.empty() || outline_shared_.back() != hits[k]))
         outline_shared_.push_back(hits[k]);
   }
-  if (points) {
-    for (int i = 0; i < count; ++i) {
-      const bool inside = wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 &&
-                          wv[i].y <= scene_.height;
-      if (original(wv[i].bary) && inside) {
-        drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
-      } else if (uncertainty_) {
-        markAmbiguous(wv[i], wv[i], reach_px);
+  auto draw = [&] {
+    if (points) {
+      for (int i = 0; i < count; ++i) {
+        const bool inside = wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 &&
+                            wv[i].y <= scene_.height;
+        if (original(wv[i].bary) && inside) {
+          drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
+        } else if (uncertainty_) {
+          markAmbiguous(wv[i], wv[i], reach_px);
+        }
       }
+      return;
     }
-    outline_shared_.clear();
-    return;
-  }
-  for (int i = 0; i < count; ++i) {
-    const int j = (i + 1) % count;
-    bool boundary = false;
-    for (int k = 0; k < 3; ++k) boundary = boundary || (wv[i].bary[k] == 0.0 && wv[j].bary[k] == 0.0);
-    if (!boundary) {
-      if (uncertainty_) markAmbiguous(wv[i], wv[j], reach_px);
-      continue;
+    for (int i = 0; i < count; ++i) {
+      const int j = (i + 1) % count;
+      bool boundary = false;
+      for (int k = 0; k < 3; ++k)
+        boundary = boundary || (wv[i].bary[k] == 0.0 && wv[j].bary[k] == 0.0);
+      if (!boundary) {
+        if (uncertainty_) markAmbiguous(wv[i], wv[j], reach_px);
+        continue;
+      }
+      // Clipped to the viewport, as GL clips the polygon before it draws its edges (a wide
+      // edge's band past the viewport's border is not drawn).
+      WindowVertex a = wv[i];
+      WindowVertex b = wv[j];
+      if (!clipToViewport(a, b, scene_.width, scene_.height)) continue;
+      const FixedVertex fa =
+          a.x == wv[i].x && a.y == wv[i].y ? fv[i] : snapVertexScaled(a.x, a.y, snap_scale_);
+      const FixedVertex fb =
+          b.x == wv[j].x && b.y == wv[j].y ? fv[j] : snapVertexScaled(b.x, b.y, snap_scale_);
+      drawSegmentWindowed(a, b, fa, fb, std::max(reach[i], reach[j]),
+                          std::max(depth_reach[i], depth_reach[j]), true);
     }
-    // Clipped to the viewport, as GL clips the polygon before it draws its edges (a wide
-    // edge's band past the viewport's border is not drawn).
-    WindowVertex a = wv[i];
-    WindowVertex b = wv[j];
-    if (!clipToViewport(a, b, scene_.width, scene_.height)) continue;
-    const FixedVertex fa = a.x == wv[i].x && a.y == wv[i].y ? fv[i] : snapVertexScaled(a.x, a.y, snap_scale_);
-    const FixedVertex fb = b.x == wv[j].x && b.y == wv[j].y ? fv[j] : snapVertexScaled(b.x, b.y, snap_scale_);
-    drawSegmentWindowed(a, b, fa, fb, std::max(reach[i], reach[j]),
-                        std::max(depth_reach[i], depth_reach[j]), true);
+  };
+  // Shared pixels: a dry run records every fragment the polygon puts there (depth and
+  // colour), whose spread then joins the channels of the fragments drawn there.
+  outline_spread_.clear();
+  if (!outline_shared_.empty()) {
+    outline_dry_ = true;
+    draw();
+    outline_dry_ = false;
+    std::sort(outline_spread_.begin(), outline_spread_.end(),
+              [](const OutlineSpread& x, const OutlineSpread& y) { return x.index < y.index; });
+    std::vector<OutlineSpread> merged;
+    for (const OutlineSpread& f : outline_spread_) {
+      if (merged.empty() || merged.back().index != f.index) {
+        merged.push_back(f);
+        continue;
+      }
+      OutlineSpread& m = merged.back();
+      m.z_lo = std::min(m.z_lo, f.z_lo);
+      m.z_hi = std::max(m.z_hi, f.z_hi);
+      m.c_lo = glm::min(m.c_lo, f.c_lo);
+      m.c_hi = glm::max(m.c_hi, f.c_hi);
+    }
+    outline_spread_ = std::move(merged);
   }
+  draw();
   outline_shared_.clear();
+  outline_spread_.clear();
 }
 
 // Pixels whose centre lies within `radius` px (in x and in y) of the nearest point of the
@@ -384,7 +413,7 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
     }
   }
   if (pixels.empty()) return;
-  ++triangles_drawn_;
+  if (!outline_dry_) ++triangles_drawn_;
   switch (scene_.state.shading) {
     case Shading::Flat:
       shadeLineFragments<Shading::Flat>(pixels, a, b, true, w, depth_reach, polygon_edge);
@@ -424,7 +453,7 @@ void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, d
     }
   }
   if (pixels.empty()) return;
-  ++triangles_drawn_;
+  if (!outline_dry_) ++triangles_drawn_;
   switch (scene_.state.shading) {
     case Shading::Flat:
       shadeLineFragments<Shading::Flat>(pixels, c, c, false, size, depth_reach,

@@ -383,6 +383,17 @@ class Renderer {
   // drawPolygonOutline(): the pixels (framebuffer indices, sorted) two of the polygon's
   // edges or vertices produce, whose last fragment GL leaves to the driver.
   std::vector<std::size_t> outline_shared_;
+  // ... and, from a dry run of its fragments there (outline_dry_), their window depths and
+  // colours, merged per pixel (sorted by index).
+  struct OutlineSpread {
+    std::size_t index = 0;
+    double z_lo = 0.0;
+    double z_hi = 0.0;
+    glm::dvec3 c_lo{0.0};
+    glm::dvec3 c_hi{0.0};
+  };
+  std::vector<OutlineSpread> outline_spread_;
+  bool outline_dry_ = false;
 };
 
 // How far a float32 implementation may put the vertex beyond snapping (its clip
