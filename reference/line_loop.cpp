@@ -179,8 +179,21 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
   std::int64_t area2 = 0;
   for (int i = 1; i + 1 < count; ++i) area2 += snappedArea2(fv[0], fv[i], fv[i + 1]);
   const bool front = (area2 > 0) == (pass.front_face == FrontFace::CCW);
-  if (area2 == 0 && pass.cull != Cull::None) return;
-  if ((pass.cull == Cull::Back && !front) || (pass.cull == Cull::Front && front)) return;
+  const bool culled = (area2 == 0 && pass.cull != Cull::None) ||
+                      (pass.cull == Cull::Back && !front) || (pass.cull == Cull::Front && front);
+  // A polygon so thin that float32 vertices could give its area the other sign: another
+  // implementation may cull what this one draws, or draw what it culls.
+  if (uncertainty_ && pass.cull != Cull::None) {
+    double max_reach = 0.0;
+    for (int i = 0; i < count; ++i) max_reach = std::max(max_reach, reach[i]);
+    if (area2 == 0 || cullCouldFlip(wv, count, max_reach)) {
+      const double radius = pass.ops.polygon_mode == PolygonMode::Point
+                                ? pass.ops.point_size / 2.0 + 1.0
+                                : roundedWidth(pass.ops.line_width) / 2.0 + 1.0;
+      for (int i = 0; i < count; ++i) markAmbiguous(wv[i], wv[(i + 1) % count], radius);
+    }
+  }
+  if (culled) return;
   TriangleContext& t = context_;
   t.front_facing = area2 == 0 || front;
   t.offset = 0.0;
