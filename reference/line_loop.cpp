@@ -271,6 +271,9 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
         pixels = roundedWidth(pass.ops.line_width) == 1.0
                      ? rasterizeLine(fv[i], fv[j], bits, clip_)
                      : rasterizeWideLine(fv[i], fv[j], pass.ops.line_width, bits, clip_);
+        const std::vector<LinePixel> ends =
+            endCandidates(wv[i], wv[j], roundedWidth(pass.ops.line_width));
+        pixels.insert(pixels.end(), ends.begin(), ends.end());
       }
       for (const LinePixel& p : pixels)
         hits.push_back(static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
@@ -345,6 +348,36 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
   outline_spread_.clear();
 }
 
+// The pixels GL's end rules leave to the driver at the segment's two ends: in the columns
+// (an x-major segment; else rows) within a pixel of an end point, those within w / 2 + 1 px
+// of the segment in the minor direction.
+std::vector<LinePixel> Renderer::endCandidates(const WindowVertex& a, const WindowVertex& b,
+                                               double w) const {
+  std::vector<LinePixel> out;
+  const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
+  const double ma = x_major ? a.x : a.y;
+  const double mb = x_major ? b.x : b.y;
+  const double na = x_major ? a.y : a.x;
+  const double nb = x_major ? b.y : b.x;
+  for (const double end : {ma, mb}) {
+    const double n_end = end == ma ? na : nb;
+    for (int m = static_cast<int>(std::floor(end - 1.5)); m <= static_cast<int>(end + 1.5); ++m) {
+      const double mc = m + 0.5;
+      if (std::fabs(mc - end) >= 1.0) continue;
+      const double n_line = ma != mb ? na + (mc - ma) * (nb - na) / (mb - ma) : n_end;
+      for (int n = static_cast<int>(std::floor(n_line - w / 2 - 1.5));
+           n <= static_cast<int>(std::ceil(n_line + w / 2 + 1.5)); ++n) {
+        if (std::fabs(n + 0.5 - n_line) >= w / 2 + 1.0) continue;
+        const int px = x_major ? m : n;
+        const int py = x_major ? n : m;
+        if (px < clip_.x0 || px >= clip_.x1 || py < clip_.y0 || py >= clip_.y1) continue;
+        out.push_back({px, py});
+      }
+    }
+  }
+  return out;
+}
+
 // Pixels whose centre lies within `radius` px (in x and in y) of the nearest point of the
 // segment a -> b (a point when a == b):
 // edge_dist 0, the driver's choice (no fragment of the reference's).
@@ -374,10 +407,16 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
                                    double depth_reach, bool polygon_edge) {
   const double width = context_.pass->ops.line_width;
   const int bits = options_.subpixel_bits;
-  const std::vector<LinePixel> pixels = roundedWidth(width) == 1.0
-                                            ? rasterizeLine(fa, fb, bits, clip_)
-                                            : rasterizeWideLine(fa, fb, width, bits, clip_);
+  std::vector<LinePixel> pixels = roundedWidth(width) == 1.0
+                                      ? rasterizeLine(fa, fb, bits, clip_)
+                                      : rasterizeWideLine(fa, fb, width, bits, clip_);
   const double w = roundedWidth(width);
+  // The dry run of a polygon outline also records the fragments a driver may add at the
+  // segment's ends (another edge's pixel there may then hold this edge's depth and colour).
+  if (outline_dry_) {
+    const std::vector<LinePixel> ends = endCandidates(a, b, w);
+    pixels.insert(pixels.end(), ends.begin(), ends.end());
+  }
   const bool half = width > 1.0 && width - std::floor(width) == 0.5;
   // edge_dist: how close each pixel near the segment came to the other decision, less the
   // vertices' reach. In the segment's major direction, per column (x-major) or row: the

@@ -317,6 +317,8 @@ class Renderer {
   void drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, double reach,
                          double depth_reach, bool polygon_vertex);
   void markAmbiguous(const WindowVertex& a, const WindowVertex& b, double radius);
+  std::vector<LinePixel> endCandidates(const WindowVertex& a, const WindowVertex& b,
+                                       double w) const;
   template <Shading kShading>
   void shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
                           const WindowVertex& b, bool segment, double size, double depth_reach,
