@@ -718,37 +718,21 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     const double s = segment ? param(cx, cy) : 0.0;
     const double z = (1.0 - s) * a.z + s * b.z;
     // A pixel another edge (vertex) of the same polygon also produces (outline_shared_): the
-    // dry run records this fragment; the drawing run widens its depth reach and colour reach
-    // by the spread of all of them there (outline_spread_).
+    // dry run records this fragment's depth and colour over its slack; the drawing run
+    // widens its reaches to the range of all of them there (outline_spread_).
     const bool shared = !outline_shared_.empty() &&
                         std::binary_search(outline_shared_.begin(), outline_shared_.end(), index);
-    if (outline_dry_) {
-      if (shared) {
-        const glm::dvec3 c(colour(s));
-        outline_spread_.push_back({index, z, z, c, c});
-      }
-      continue;
-    }
+    if (outline_dry_ && !shared) continue;
     const double slack_t = len > 0.0 ? slack_px / len : 0.0;
-    double spread_z = 0.0;
-    double spread_c = 0.0;
-    if (shared) {
-      const auto it = std::lower_bound(
-          outline_spread_.begin(), outline_spread_.end(), index,
-          [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
-      if (it != outline_spread_.end() && it->index == index) {
-        spread_z = (it->z_hi - it->z_lo) * std::fabs(g.scale) * depth_steps_;
-        const glm::dvec3 range = it->c_hi - it->c_lo;
-        spread_c = 255.0 * std::max({range.x, range.y, range.z});
-      }
-    }
-    const double fragment_reach = depth_reach + slack_px * z_per_px + 1.0 + spread_z;
     // normal_reach: the colour's range over the parameters and levels of detail a
     // conforming driver may use here, against the reference's own (8-bit units).
     TexelNote extra;
     float& colour_reach = extra.normal;
-    if (uncertainty_ && varies) {
+    glm::dvec3 c_lo(0.0);
+    glm::dvec3 c_hi(0.0);
+    if (uncertainty_ && (varies || outline_dry_)) {
       const glm::dvec4 own = colour(s);
+      c_lo = c_hi = glm::dvec3(own);
       double lo = 0.0;
       double hi = 0.0;
       lambda_at(s, lo, hi);
@@ -768,6 +752,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
           t.line_lambda = std::isnan(lo) ? lambda_at(q, ignore_lo, ignore_hi)
                                          : (l == 0 ? lo : (l == 1 ? hi : 0.5 * (lo + hi)));
           const glm::dvec4 c = fragmentColor<kShading>(t, w, nullptr);
+          c_lo = glm::min(c_lo, glm::dvec3(c));
+          c_hi = glm::max(c_hi, glm::dvec3(c));
           for (int ch = 0; ch < 3; ++ch) {
             worst = std::max(worst, std::fabs(c[ch] - own[ch]));
             if (l == 0 && k > 0) step = std::max(step, std::fabs(c[ch] - last[ch]));
@@ -775,9 +761,44 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
           if (l == 0) last = c;
         }
       }
-      if (tex == nullptr) worst += step;
+      if (tex == nullptr) {
+        worst += step;
+        c_lo -= step;
+        c_hi += step;
+      }
       colour_reach = static_cast<float>(255.0 * worst);
+      if (shared && !outline_dry_) {
+        const auto it = std::lower_bound(
+            outline_spread_.begin(), outline_spread_.end(), index,
+            [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
+        if (it != outline_spread_.end() && it->index == index) {
+          const glm::dvec3 d_lo = glm::dvec3(own) - it->c_lo;
+          const glm::dvec3 d_hi = it->c_hi - glm::dvec3(own);
+          const double spread = std::max({d_lo.x, d_lo.y, d_lo.z, d_hi.x, d_hi.y, d_hi.z});
+          colour_reach = std::max(colour_reach, static_cast<float>(255.0 * spread));
+        }
+      }
     }
+    // Depth: the slack's reach, or at a shared pixel the farthest any of the polygon's
+    // fragments there may be (each at its own slack).
+    const double z_lo = std::min((1.0 - s + slack_t) * a.z + (s - slack_t) * b.z,
+                                 (1.0 - s - slack_t) * a.z + (s + slack_t) * b.z);
+    const double z_hi = std::max((1.0 - s + slack_t) * a.z + (s - slack_t) * b.z,
+                                 (1.0 - s - slack_t) * a.z + (s + slack_t) * b.z);
+    if (outline_dry_) {
+      outline_spread_.push_back({index, z_lo, z_hi, c_lo, c_hi});
+      continue;
+    }
+    double spread_z = slack_px * z_per_px;
+    if (shared) {
+      const auto it = std::lower_bound(
+          outline_spread_.begin(), outline_spread_.end(), index,
+          [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
+      if (it != outline_spread_.end() && it->index == index)
+        spread_z = std::max(spread_z, std::max(z - it->z_lo, it->z_hi - z) * std::fabs(g.scale) *
+                                          depth_steps_);
+    }
+    const double fragment_reach = depth_reach + spread_z + 1.0;
     // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
     // level of the lambda interval), as triangles' level-of-detail fragments record them
     // (texel_dist 0: always within; texel_alt the range times the light, plus a unit).
@@ -820,8 +841,6 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       extra.dist = 0.0f;
       extra.alt = static_cast<float>(weight * (255.0 * alt + light));
     }
-    // (The stored fragment may be another one there, at its own slack: the two add.)
-    colour_reach += static_cast<float>(spread_c);
     double lo = 0.0;
     double hi = 0.0;
     t.line_lambda = lambda_at(s, lo, hi);
