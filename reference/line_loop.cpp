@@ -56,6 +56,18 @@ bool clipSegment(ClipVertex& c0, ClipVertex& c1) {
   return true;
 }
 
+// The point a fraction f of the way from a to b in window space: x, y, z and 1/w affine, the
+// barycentrics divided by w too.
+WindowVertex lerpWindow(const WindowVertex& a, const WindowVertex& b, double f) {
+  WindowVertex v;
+  v.x = a.x + f * (b.x - a.x);
+  v.y = a.y + f * (b.y - a.y);
+  v.z = a.z + f * (b.z - a.z);
+  v.inv_w = a.inv_w + f * (b.inv_w - a.inv_w);
+  v.bary = (a.bary * a.inv_w + f * (b.bary * b.inv_w - a.bary * a.inv_w)) / v.inv_w;
+  return v;
+}
+
 // The window-space segment a -> b clipped to [0, width] x [0, height]: x, y, z and 1/w are
 // affine along it in window space, the barycentrics divided by w too; false when nothing
 // is left.
@@ -73,17 +85,8 @@ bool clipToViewport(WindowVertex& a, WindowVertex& b, int width, int height) {
     return false;
   const WindowVertex from = a;
   const WindowVertex to = b;
-  auto at = [&](double t) {
-    WindowVertex v;
-    v.x = from.x + t * (to.x - from.x);
-    v.y = from.y + t * (to.y - from.y);
-    v.z = from.z + t * (to.z - from.z);
-    v.inv_w = from.inv_w + t * (to.inv_w - from.inv_w);
-    v.bary = (from.bary * from.inv_w + t * (to.bary * to.inv_w - from.bary * from.inv_w)) / v.inv_w;
-    return v;
-  };
-  if (t0 > 0.0) a = at(t0);
-  if (t1 < 1.0) b = at(t1);
+  if (t0 > 0.0) a = lerpWindow(from, to, t0);
+  if (t1 < 1.0) b = lerpWindow(from, to, t1);
   return true;
 }
 
@@ -212,12 +215,18 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
   // driver's choice: edges made by clipping, vertices made by clipping or beyond the
   // viewport, and where an edge crosses the viewport's border, the border there.
   const bool points = pass.ops.polygon_mode == PolygonMode::Point;
+  // What a driver that clips at the viewport adds: vertices where the edges cross its
+  // border, and edges along it between them (their depth and colour join the dry run).
+  std::vector<WindowVertex> crossings;
+  std::vector<std::pair<WindowVertex, WindowVertex>> border_edges;
   const double reach_px = points ? pass.ops.point_size / 2.0 + 1.0
                                  : roundedWidth(pass.ops.line_width) / 2.0 + 1.0;
   if (uncertainty_) {
     const double bounds[2] = {static_cast<double>(scene_.width), static_cast<double>(scene_.height)};
     double lo[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}};  // [axis][side]
     double hi[2][2] = {{-INFINITY, -INFINITY}, {-INFINITY, -INFINITY}};
+    WindowVertex border_lo[2][2]{};
+    WindowVertex border_hi[2][2]{};
     for (int i = 0; i < count; ++i) {
       const WindowVertex& p = wv[i];
       const WindowVertex& q = wv[(i + 1) % count];
@@ -229,27 +238,28 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
           if ((pp[axis] - at) * (qq[axis] - at) > 0.0 || pp[axis] == qq[axis]) continue;
           const double f = (at - pp[axis]) / (qq[axis] - pp[axis]);
           const double other = pp[1 - axis] + f * (qq[1 - axis] - pp[1 - axis]);
-          lo[axis][side] = std::min(lo[axis][side], other);
-          hi[axis][side] = std::max(hi[axis][side], other);
-          WindowVertex c = p;
+          WindowVertex c = lerpWindow(p, q, f);
           (axis == 0 ? c.x : c.y) = at;
           (axis == 0 ? c.y : c.x) = other;
           markAmbiguous(c, c, reach_px);
+          if (other < lo[axis][side]) {
+            lo[axis][side] = other;
+            border_lo[axis][side] = c;
+          }
+          if (other > hi[axis][side]) {
+            hi[axis][side] = other;
+            border_hi[axis][side] = c;
+          }
+          crossings.push_back(c);
         }
       }
     }
     if (!points) {
       for (int axis = 0; axis < 2; ++axis) {
         for (int side = 0; side < 2; ++side) {
-          if (!(lo[axis][side] <= hi[axis][side])) continue;
-          WindowVertex a = wv[0];
-          WindowVertex b = wv[0];
-          const double at = side == 0 ? 0.0 : bounds[axis];
-          (axis == 0 ? a.x : a.y) = at;
-          (axis == 0 ? b.x : b.y) = at;
-          (axis == 0 ? a.y : a.x) = lo[axis][side];
-          (axis == 0 ? b.y : b.x) = hi[axis][side];
-          markAmbiguous(a, b, reach_px);
+          if (!(lo[axis][side] < hi[axis][side])) continue;
+          markAmbiguous(border_lo[axis][side], border_hi[axis][side], reach_px);
+          border_edges.emplace_back(border_lo[axis][side], border_hi[axis][side]);
         }
       }
     }
@@ -265,7 +275,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
     for (int i = 0; i < count; ++i) {
       std::vector<LinePixel> pixels;
       if (points) {
-        if (original(wv[i].bary)) pixels = rasterizePoint(fv[i], pass.ops.point_size, bits, clip_);
+        if (original(wv[i].bary)) pixels = pointCandidates(wv[i], pass.ops.point_size);
       } else {
         const int j = (i + 1) % count;
         pixels = roundedWidth(pass.ops.line_width) == 1.0
@@ -279,6 +289,20 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
         hits.push_back(static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
                        static_cast<std::size_t>(p.x - clip_.x0));
     }
+    auto add = [&](const std::vector<LinePixel>& pixels) {
+      for (const LinePixel& p : pixels)
+        hits.push_back(static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
+                       static_cast<std::size_t>(p.x - clip_.x0));
+    };
+    if (points) {
+      for (const WindowVertex& c : crossings) add(pointCandidates(c, pass.ops.point_size));
+    } else {
+      for (const auto& [a, b] : border_edges) {
+        add(rasterizeLine(snapVertexScaled(a.x, a.y, snap_scale_),
+                          snapVertexScaled(b.x, b.y, snap_scale_), bits, clip_));
+        add(endCandidates(a, b, roundedWidth(pass.ops.line_width)));
+      }
+    }
     std::sort(hits.begin(), hits.end());
     for (std::size_t k = 1; k < hits.size(); ++k)
       if (hits[k] == hits[k - 1] &&
@@ -286,12 +310,22 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
         outline_shared_.push_back(hits[k]);
   }
   auto draw = [&] {
+    if (outline_dry_) {
+      for (const WindowVertex& c : crossings)
+        if (points) drawPointWindowed(c, snapVertexScaled(c.x, c.y, snap_scale_), 0.0, 0.0, true);
+      for (const auto& [a, b] : border_edges)
+        if (!points)
+          drawSegmentWindowed(a, b, snapVertexScaled(a.x, a.y, snap_scale_),
+                              snapVertexScaled(b.x, b.y, snap_scale_), 0.0, 0.0, true);
+    }
     if (points) {
       for (int i = 0; i < count; ++i) {
         const bool inside = wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 &&
                             wv[i].y <= scene_.height;
-        if (original(wv[i].bary) && inside) {
+        // (The dry run also records a vertex beyond the viewport: a driver may draw it.)
+        if (original(wv[i].bary) && (inside || outline_dry_)) {
           drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
+          if (!inside && uncertainty_) markAmbiguous(wv[i], wv[i], reach_px);
         } else if (uncertainty_) {
           markAmbiguous(wv[i], wv[i], reach_px);
         }
@@ -373,6 +407,21 @@ std::vector<LinePixel> Renderer::endCandidates(const WindowVertex& a, const Wind
         if (px < clip_.x0 || px >= clip_.x1 || py < clip_.y0 || py >= clip_.y1) continue;
         out.push_back({px, py});
       }
+    }
+  }
+  return out;
+}
+
+// The pixels a point of `size` at c may produce: centres within the square grown by half a
+// pixel (the square's own, and those a tie on its border or the vertex's reach may add).
+std::vector<LinePixel> Renderer::pointCandidates(const WindowVertex& c, double size) const {
+  std::vector<LinePixel> out;
+  const double h = size / 2.0 + 0.5;
+  for (int py = std::max(clip_.y0, static_cast<int>(std::floor(c.y - h - 0.5)));
+       py < std::min(clip_.y1, static_cast<int>(std::ceil(c.y + h + 0.5))); ++py) {
+    for (int px = std::max(clip_.x0, static_cast<int>(std::floor(c.x - h - 0.5)));
+         px < std::min(clip_.x1, static_cast<int>(std::ceil(c.x + h + 0.5))); ++px) {
+      if (std::fabs(px + 0.5 - c.x) <= h && std::fabs(py + 0.5 - c.y) <= h) out.push_back({px, py});
     }
   }
   return out;
@@ -482,12 +531,16 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
 void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, double reach,
                                  double depth_reach, bool polygon_vertex) {
   const double size = context_.pass->ops.point_size;
-  const std::vector<LinePixel> pixels =
-      rasterizePoint(fc, size, options_.subpixel_bits, clip_);
+  // (A polygon outline's dry run: also the pixels a tie on the square's border may add.)
+  const std::vector<LinePixel> pixels = outline_dry_
+                                            ? pointCandidates(c, size)
+                                            : rasterizePoint(fc, size, options_.subpixel_bits, clip_);
   // edge_dist: a pixel centre's distance to the square's border (inside or out), less the
   // vertex's reach: GL leaves centres on the border to the implementation.
   if (uncertainty_) {
     const double h = size / 2.0;
+    const bool crosses = c.x - h < 0.0 || c.y - h < 0.0 || c.x + h > scene_.width ||
+                         c.y + h > scene_.height;
     for (int py = std::max(clip_.y0, static_cast<int>(std::floor(c.y - h - 1.5)));
          py < std::min(clip_.y1, static_cast<int>(std::ceil(c.y + h + 1.5))); ++py) {
       for (int px = std::max(clip_.x0, static_cast<int>(std::floor(c.x - h - 1.5)));
@@ -497,10 +550,13 @@ void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, d
         // Inside: the nearer border; outside: how far beyond the farther one.
         const double d = dx <= 0.0 && dy <= 0.0 ? std::min(-dx, -dy) : std::max(dx, dy);
         if (d >= 1.0) continue;
+        // A square that crosses the viewport's border: Mesa's drivers may draw it as two
+        // triangles through their draw module, which offsets it by (1/8, -1/8) px.
+        const double bias = crosses ? 0.125 : 0.0;
         const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
                                   static_cast<std::size_t>(px - clip_.x0);
         float& e = frame_.edge_dist[index];
-        e = std::min(e, static_cast<float>(std::max(0.0, d - reach)));
+        e = std::min(e, static_cast<float>(std::max(0.0, d - reach - bias)));
       }
     }
   }

@@ -319,6 +319,7 @@ class Renderer {
   void markAmbiguous(const WindowVertex& a, const WindowVertex& b, double radius);
   std::vector<LinePixel> endCandidates(const WindowVertex& a, const WindowVertex& b,
                                        double w) const;
+  std::vector<LinePixel> pointCandidates(const WindowVertex& c, double size) const;
   template <Shading kShading>
   void shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
                           const WindowVertex& b, bool segment, double size, double depth_reach,
