@@ -55,7 +55,7 @@ MutationScene sceneFacts(const Scene& scene) {
   m.depth_format = toString(scene.state.depth_format);
   for (const Object& o : scene.objects) {
     const Material& mat = scene.materials[o.material];
-    if (o.mesh.triangles.empty()) continue;
+    if (primitiveCount(o) == 0) continue;
     m.textured = m.textured || mat.texture != nullptr;
     m.blended = m.blended || (scene.state.blend == Blend::Alpha && mat.opacity < 1.0);
     m.lod = m.lod || (mat.texture != nullptr && lodSampling(scene.state));
@@ -63,6 +63,11 @@ MutationScene sceneFacts(const Scene& scene) {
     m.lod_blend = m.lod_blend ||
                   (mat.texture != nullptr &&
                    (min == MinFilter::NearestMipmapLinear || min == MinFilter::LinearMipmapLinear));
+  }
+  for (const PrimitiveRef& p : flattenPrimitives(scene)) {
+    const PrimitiveKind kind = scene.objects[p.object].primitive;
+    if (isLineKind(kind)) m.line_ids.push_back(p.id);
+    if (kind == PrimitiveKind::Points) m.point_ids.push_back(p.id);
   }
   for (const DrawPass& p : drawPasses(scene)) {
     if (p.primitives.empty()) continue;

@@ -16,7 +16,7 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::array<MutationFault, 12> kFaults = {{
+constexpr std::array<MutationFault, 14> kFaults = {{
     {"light_scale", "shading", "every light 1% brighter"},
     {"depth_bias", "depth", "stored depth 4 x the fail threshold further (8 d16 / 64 d24 steps)"},
     {"drop_primitive", "visibility", "one visible triangle not drawn"},
@@ -30,6 +30,9 @@ constexpr std::array<MutationFault, 12> kFaults = {{
     {"scissor_shift", "visibility", "scissor box one pixel off (to the right)"},
     {"lod_shift", "shading", "level of detail one level off (GL_TEXTURE_LOD_BIAS + 1)"},
     {"lod_weight", "shading", "two mip levels blended with the weight inverted (1 - f for f)"},
+    {"move_line_end", "visibility",
+     "one end of one visible line segment one pixel off, across the segment"},
+    {"move_point", "visibility", "one visible point one pixel right"},
 }};
 
 constexpr std::array<MutationVerdict, 6> kVerdicts = {
@@ -89,13 +92,27 @@ std::string faultSetting(const MutationFault& fault, const MutationScene& scene,
   if (name == "scissor_shift") return scene.scissor ? "scissor_shift=1" : "";
   if (name == "lod_shift") return scene.lod ? "lod_shift=1" : "";
   if (name == "lod_weight") return scene.lod_blend ? "lod_weight=inverted" : "";
-  if (scene.visible_ids.empty()) return "";
+  // The candidates: visible segments, points, or (move_vertex) the other visible ids.
+  std::vector<std::uint32_t> ids;
+  auto in = [](const std::vector<std::uint32_t>& sorted, std::uint32_t id) {
+    return std::binary_search(sorted.begin(), sorted.end(), id);
+  };
+  for (std::uint32_t id : scene.visible_ids) {
+    const bool line = in(scene.line_ids, id);
+    const bool point = in(scene.point_ids, id);
+    if (name == "move_line_end" ? line
+        : name == "move_point"  ? point
+        : name == "move_vertex" ? !line && !point
+                                : true)
+      ids.push_back(id);
+  }
+  if (ids.empty()) return "";
   // The same primitive on every run: a stream seeded by (seed, index, fault).
   RandomStream stream(RandomStream::mix(seed) ^ RandomStream::mix(index + 0x632be59bd9b4e019ull) ^
                       nameHash(fault.name));
-  const auto pick = static_cast<std::size_t>(
-      stream.integer(0, static_cast<std::int64_t>(scene.visible_ids.size()) - 1));
-  return fmt::format("{}={}", name, scene.visible_ids[pick]);
+  const auto pick =
+      static_cast<std::size_t>(stream.integer(0, static_cast<std::int64_t>(ids.size()) - 1));
+  return fmt::format("{}={}", name, ids[pick]);
 }
 
 const char* toString(MutationVerdict v) {

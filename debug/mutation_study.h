@@ -43,7 +43,8 @@ struct MutationFault {
 // texel_offset and blend_factor (shading); the fragment operations' depth_func (visibility),
 // stencil_op (depth: the stencil buffer is compared in that class), blend_function
 // (shading) and scissor_shift (visibility); lod_shift (shading) for textures sampled with a
-// level of detail, lod_weight (shading) for textures blended between two mip levels.
+// level of detail, lod_weight (shading) for textures blended between two mip levels;
+// move_line_end and move_point (visibility) for line and point primitives.
 std::span<const MutationFault> mutationFaults();
 // Throws InputError naming the valid names.
 const MutationFault& mutationFault(const std::string& name);
@@ -60,6 +61,11 @@ struct MutationScene {
   bool scissor = false;                    // some pass has a scissor box
   bool lod = false;  // textured, sampled with a level of detail (fixtures/scene.h lodSampling())
   bool lod_blend = false;  // textured with a *_mipmap_linear min filter (two levels blended)
+  // Primitive ids of line segments and of points (line and point primitives; triangles in
+  // polygon mode line or point are triangles), ascending: move_line_end and move_point pick
+  // from the visible ones, move_vertex from the visible others.
+  std::vector<std::uint32_t> line_ids;
+  std::vector<std::uint32_t> point_ids;
 };
 
 // The RASTERCHECK_GL_FAULT value of `fault` for scene `index` of `seed`, e.g.
