@@ -127,6 +127,38 @@ std::string fmtVec(const Json& v) {
   return out + ")";
 }
 
+// "triangle", "segment" or "point", by what the fragment's primitive is.
+std::string primitiveNoun(const Json& f) {
+  const std::string kind = f.value("primitive_kind", std::string("triangles"));
+  if (kind == "points") return "point";
+  if (kind == "triangles") return "triangle";
+  return "segment";
+}
+
+// How a line or point fragment came about: the rule, the parameter, the margin.
+std::string lineStory(const Json& l) {
+  const double margin = l["margin"].is_null() ? 0.0 : l["margin"].get<double>();
+  const std::string decided =
+      margin > 0.0 ? fmt::format("its centre is {} px from where the rule decides the other way",
+                                 fmtNum(l["margin"]))
+                   : "a line end, a tie or a clipped point: GL leaves this pixel to the driver";
+  if (l["kind"] == "point") {
+    return fmt::format(
+        "  {}point at window {}, size {}: the pixels whose centres lie in the square of that "
+        "side; {}\n",
+        l["polygon_edge"].get<bool>() ? "a polygon vertex drawn as a " : "", fmtVec(l["a"]),
+        fmtNum(l["size"]), decided);
+  }
+  const std::string rule = l["rule"] == "column"
+                               ? fmt::format("GL's column rule for width {}", fmtNum(l["size"]))
+                               : std::string("GL's diamond-exit rule");
+  return fmt::format(
+      "  {}segment from window {} to {} ({}); the centre projects to t = {} along it (the "
+      "parameter its depth and attributes take); {}\n",
+      l["polygon_edge"].get<bool>() ? "polygon edge (polygon mode line): " : "", fmtVec(l["a"]),
+      fmtVec(l["b"]), rule, fmtNum(l["t"]), decided);
+}
+
 std::string story(const Json& doc) {
   std::string s;
   const Json& px = doc["pixel"];
@@ -155,11 +187,13 @@ std::string story(const Json& doc) {
   }
   for (const Json& f : frags) {
     s += fmt::format(
-        "\nfragment {}: primitive {}, triangle {} of '{}' ({} pass {}), barycentric "
+        "\nfragment {}: primitive {}, {} {} of '{}' ({} pass {}), barycentric "
         "{}\n",
-        f["index"].get<int>(), f["primitive"].get<int>(), f["triangle"].get<int>(),
+        f["index"].get<int>(), f["primitive"].get<int>(), primitiveNoun(f),
+        f["triangle"].get<int>(),
         f["object"].get<std::string>(), f["draw"]["kind"].get<std::string>(),
         f["draw"]["pass"].get<int>(), fmtVec(f["barycentric"]));
+    if (f.contains("line")) s += lineStory(f["line"]);
     const Json& d = f["depth"];
     s += fmt::format(
         "  window depth {}, stored as {}{}\n", fmtNum(d["window"]), fmtNum(d["stored"]),
@@ -401,6 +435,7 @@ Json pixelHistory(const Scene& scene, const PixelQuery& query, const Frame& fram
         {"object", scene.objects[f.object].name},
         {"object_index", f.object},
         {"triangle", prim.triangle},
+        {"primitive_kind", toString(scene.objects[prim.object].primitive)},
         {"draw",
          {{"pass", pass_index},
           {"kind", passKind(scene, pass, options.force_painter)},
@@ -423,6 +458,17 @@ Json pixelHistory(const Scene& scene, const PixelQuery& query, const Frame& fram
           {"against_source", depth_source},
           {"write", depth_write}}}};
     j["shading"] = shadingJson(scene, f);
+    if (f.line.kind != LineTrace::Kind::None) {
+      const bool segment = f.line.kind == LineTrace::Kind::Segment;
+      j["line"] = {{"kind", segment ? "segment" : "point"},
+                   {"polygon_edge", f.line.polygon_edge},
+                   {"a", {num(f.line.a.x), num(f.line.a.y)}},
+                   {"b", segment ? Json{num(f.line.b.x), num(f.line.b.y)} : Json(nullptr)},
+                   {"size", num(f.line.size)},
+                   {"rule", segment ? (f.line.size > 1.0 ? "column" : "diamond-exit") : "square"},
+                   {"t", segment ? num(f.line.t) : Json(nullptr)},
+                   {"margin", num(f.line.margin)}};
+    }
     // The fragment operations before the depth test, in GL's order (null: not set).
     const FragmentOps& ops = pass.ops;
     Json stencil = nullptr;

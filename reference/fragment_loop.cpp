@@ -700,6 +700,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     return fragmentColor<kShading>(t, bary_at(s), nullptr);
   };
 
+  const bool half_width = segment && t.pass->ops.line_width > 1.0 &&
+                          t.pass->ops.line_width - std::floor(t.pass->ops.line_width) == 0.5;
   LineTrace& trace = t.line_trace;
   trace = LineTrace{};
   if (trace_ != nullptr) {
@@ -846,7 +848,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     t.line_lambda = lambda_at(s, lo, hi);
     if (trace_ != nullptr) {
       trace.t = s;
-      trace.margin = frame_.edge_dist.empty() ? 0.0 : frame_.edge_dist[index];
+      trace.margin = segment ? segmentMargin(a, b, size, half_width, cx, cy)
+                             : pointMargin(a, size, cx, cy);
     }
     generalFragment<kShading>(t, g, p.x, p.y, index, z,
                               static_cast<float>(uncertainty_ ? fragment_reach : 0.0),

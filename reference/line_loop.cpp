@@ -492,18 +492,15 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
     for (int m = first; m <= last; ++m) {
       const double mc = m + 0.5;
       if (mc <= lo - 1.0 || mc >= hi + 1.0) continue;
-      const bool end = std::fabs(mc - ma) < 1.0 || std::fabs(mc - mb) < 1.0 || mc <= lo ||
-                       mc >= hi;
       const double n_line = na + (std::clamp(mc, lo, hi) - ma) * slope;
       const int n_first = std::max(minor_lo, static_cast<int>(std::floor(n_line - w / 2 - 1.5)));
       const int n_last = std::min(minor_hi - 1, static_cast<int>(std::ceil(n_line + w / 2 + 1.5)));
       for (int n = n_first; n <= n_last; ++n) {
         const double off = std::fabs(n + 0.5 - n_line);
         if (off >= w / 2 + 1.0) continue;
-        // A width of k + 1/2 may be drawn k or k + 1 wide: the rows between are open.
-        const bool half_open = half && off < w / 2 + 0.5;
-        const double margin =
-            end || half_open ? 0.0 : std::max(0.0, std::fabs(off - w / 2) - reach);
+        const double cx = x_major ? mc : n + 0.5;
+        const double cy = x_major ? n + 0.5 : mc;
+        const double margin = std::max(0.0, segmentMargin(a, b, w, half, cx, cy) - reach);
         const int px = x_major ? m : n;
         const int py = x_major ? n : m;
         const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +

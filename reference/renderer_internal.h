@@ -143,6 +143,35 @@ struct GeneralSetup {
   bool composited = false;  // blended or masked: the old colour shows through
 };
 
+// How close the pixel centre (cx, cy) comes to the other decision of GL's rule for the
+// segment a -> b of rounded width w (px, measured in the minor direction: | |offset| - w/2 |),
+// 0 in the columns (rows) within a pixel of an end, where GL leaves the fragment to the
+// driver, and for a width of k + 1/2 (either width) within the wider band. The reach of the
+// vertices is not subtracted.
+inline double segmentMargin(const WindowVertex& a, const WindowVertex& b, double w, bool half,
+                            double cx, double cy) {
+  const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
+  const double ma = x_major ? a.x : a.y;
+  const double mb = x_major ? b.x : b.y;
+  const double na = x_major ? a.y : a.x;
+  const double nb = x_major ? b.y : b.x;
+  const double mc = x_major ? cx : cy;
+  const double nc = x_major ? cy : cx;
+  const double lo = std::min(ma, mb);
+  const double hi = std::max(ma, mb);
+  const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
+  const double off = std::fabs(nc - (na + (std::clamp(mc, lo, hi) - ma) * slope));
+  const bool end = std::fabs(mc - ma) < 1.0 || std::fabs(mc - mb) < 1.0 || mc <= lo || mc >= hi;
+  if (end || (half && off < w / 2 + 0.5)) return 0.0;
+  return std::fabs(off - w / 2);
+}
+// For a point of side `size` at c: the distance to the square's border, inside or out.
+inline double pointMargin(const WindowVertex& c, double size, double cx, double cy) {
+  const double dx = std::fabs(cx - c.x) - size / 2.0;
+  const double dy = std::fabs(cy - c.y) - size / 2.0;
+  return dx <= 0.0 && dy <= 0.0 ? std::min(-dx, -dy) : std::max(dx, dy);
+}
+
 // What a drawn fragment adds to the texel channels (frame.h): nothing unless textured.
 // And, despite the name, what it adds to shade_reach (interpolated colours).
 struct TexelNote {
