@@ -16,6 +16,7 @@
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
 #include "fixtures/scene_writer.h"
+#include "reference/reference_renderer.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -58,7 +59,8 @@ const std::map<std::string, Scene>& probeScenes() {
   static const std::map<std::string, Scene> probes = [] {
     std::map<std::string, Scene> p = {{"subpixel", variants::subpixelProbe()},
                                       {"tie_break", variants::tieBreakProbe().scene},
-                                      {"depth_rounding", variants::depthProbe().scene}};
+                                      {"depth_rounding", variants::depthProbe().scene},
+                                      {"lines", variants::lineProbe().scene}};
     for (const auto& [name, format] : kOffsetProbes) p[name] = offsetProbe(format);
     return p;
   }();
@@ -132,6 +134,15 @@ nlohmann::json analyseVariants(const VariantProbes& probes,
               toString(format), it->get<double>()));
       }
       v["polygon_offset_r"] = r;
+      // Lines and points, against the reference's frame of the same file.
+      ReferenceOptions line_options;
+      line_options.uncertainty = false;
+      const variants::LineRuleResult lines = variants::analyseLines(
+          variants::lineProbe(), got.at("lines")->frame,
+          renderReference(loadScene(probes.files.at("lines")), line_options));
+      v["lines"] = variants::toJson(lines);
+      if (!lines.matches_reference)
+        v["findings"].push_back(variants::describeLines(lines));
       v["probe_seconds"] = shared_seconds;
     } catch (const InputError& e) {
       v = {{"error", e.what()}};

@@ -272,13 +272,13 @@ void variantsSection(const AccuracyData& data, const Line& line) {
   line();
   line(
       "| backend | stack | GL_SUBPIXEL_BITS | rasterizes like | snap band | tie-break | depth "
-      "rounding |");
-  line("|---|---|---|---|---|---|---|");
+      "rounding | lines and points |");
+  line("|---|---|---|---|---|---|---|---|");
   std::vector<std::string> findings;
   for (const auto& [spec, v] : data.variants) {
     if (!v.is_object()) continue;
     if (v.contains("error")) {
-      line(fmt::format("| `{}` | error: {} | | | | | |", spec, variantText(v, "error")));
+      line(fmt::format("| `{}` | error: {} | | | | | | |", spec, variantText(v, "error")));
       continue;
     }
     std::string observed = "-";
@@ -291,10 +291,10 @@ void variantsSection(const AccuracyData& data, const Line& line) {
     }
     const std::string band = v.contains("band_subpixel_bits") ? variantText(v, "band_subpixel_bits")
                                                               : variantText(v, "subpixel_bits");
-    line(fmt::format("| `{}` | {} | {} | {} | {} | {} | {} |", spec,
+    line(fmt::format("| `{}` | {} | {} | {} | {} | {} | {} | {} |", spec,
                      v.contains("stack") ? variantText(v, "stack") : variantText(v, "renderer"),
                      variantText(v, "subpixel_bits"), observed, band, variantRule(v, "tie_break"),
-                     variantRule(v, "depth_rounding")));
+                     variantRule(v, "depth_rounding"), variantRule(v, "lines")));
     if (v.contains("findings") && v["findings"].is_array())
       for (const json& f : v["findings"])
         if (f.is_string()) findings.push_back(fmt::format("`{}`: {}", spec, f.get<std::string>()));

@@ -130,7 +130,7 @@ std::string variantsTable(const Report& report) {
   std::string out =
       "<h2>Backend variants</h2><table id=\"variants\"><tr><th>backend</th><th>renderer</th>"
       "<th>GL_SUBPIXEL_BITS</th><th>snap band bits</th><th>subpixel precision</th>"
-      "<th>tie-break</th><th>depth rounding</th><th>findings</th></tr>";
+      "<th>tie-break</th><th>depth rounding</th><th>lines and points</th><th>findings</th></tr>";
   for (const auto& [spec, v] : report.variants.items()) {
     out += fmt::format("<tr><td>{}</td>", esc(spec));
     if (v.contains("error")) {
@@ -152,6 +152,11 @@ std::string variantsTable(const Report& report) {
     out += fmt::format("<td>{} {}</td>",
                        mark(v, "depth_rounding", "matches_reference", "as ref", "differs"),
                        esc(text(v, "depth_rounding")));
+    out += fmt::format("<td>{} {}</td>",
+                       v.contains("lines") ? mark(v, "lines", "matches_reference", "as ref",
+                                                  "differs")
+                                           : std::string(),
+                       esc(text(v, "lines")));
     std::string findings;
     if (v.contains("findings") && v["findings"].is_array()) {
       for (const nlohmann::json& f : v["findings"])

@@ -579,6 +579,146 @@ std::string describeDepthRounding(const DepthRoundingResult& r) {
   return s;
 }
 
+// ---- (d) lines and points -------------------------------------------------------------------
+
+LineProbe lineProbe() {
+  LineProbe probe;
+  probe.scene = probeScene("lines", "Line rule, wide-line method and point squares", 128, 96);
+  probe.scene.state.depth_test = false;
+  std::uint32_t id = 1;
+  auto add = [&](LineProbeItem::Kind kind, glm::dvec2 a, glm::dvec2 b, double size) {
+    Object o;
+    o.name = fmt::format("p{}", id);
+    o.primitive = kind == LineProbeItem::Kind::Point ? PrimitiveKind::Points : PrimitiveKind::Lines;
+    o.mesh.positions.emplace_back(static_cast<float>(a.x), static_cast<float>(a.y), -2.0f);
+    if (kind != LineProbeItem::Kind::Point) {
+      o.mesh.positions.emplace_back(static_cast<float>(b.x), static_cast<float>(b.y), -2.0f);
+      o.mesh.lines = {{0, 1}};
+      o.state.line_width = size;
+    } else {
+      o.state.point_size = size;
+    }
+    o.mesh.normals.assign(o.mesh.positions.size(), glm::vec3(0.0f, 0.0f, 1.0f));
+    probe.scene.objects.push_back(std::move(o));
+    probe.items.push_back({id++, kind, a, b, size});
+  };
+  // Sixteen one-pixel segments, 12 px long, in a 4 x 4 grid of 21 x 15 px cells (x < 84,
+  // y < 60); ends at dyadic positions (exact in float32) off centres and diamond borders.
+  auto dyadic = [](glm::dvec2 v) { return glm::round(v * 64.0) / 64.0; };
+  for (int k = 0; k < 16; ++k) {
+    const double angle = 2.0 * 3.14159265358979323846 * (k + 0.37) / 16.0;
+    const glm::dvec2 c(10.5 + 21.0 * (k % 4) + 0.3125, 7.5 + 15.0 * (k / 4) + 0.1875);
+    const glm::dvec2 d(std::cos(angle), std::sin(angle));
+    add(LineProbeItem::Kind::Thin, dyadic(c - 6.0 * d), dyadic(c + 6.0 * d), 1.0);
+  }
+  // Width 4 at 30 degrees (x-major) and 60 degrees (y-major), 30 px long, above them.
+  add(LineProbeItem::Kind::Wide, dyadic({4.3125, 66.1875}), dyadic({30.3125, 81.1875}), 4.0);
+  add(LineProbeItem::Kind::Wide, dyadic({44.3125, 64.1875}), dyadic({59.3125, 90.1875}), 4.0);
+  // Points of size 3.5 and 5 at quarter-pixel positions, right of the segments.
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec2 c(92.0 + 9.0 * (k % 4) + 0.25 * k, 10.0 + 12.0 * (k / 4) + 0.125);
+    add(LineProbeItem::Kind::Point, c, c, k % 2 == 0 ? 3.5 : 5.0);
+  }
+  return probe;
+}
+
+LineRuleResult analyseLines(const LineProbe& probe, const Frame& driver, const Frame& reference) {
+  const int w = probe.scene.width;
+  const int h = probe.scene.height;
+  checkSize(driver, w, h, "lines");
+  checkSize(reference, w, h, "lines");
+  LineRuleResult r;
+  for (const LineProbeItem& item : probe.items) {
+    // The item's pixels in each frame (image coordinates), and where they differ.
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = driver.index(x, y);
+        const bool in_ref = reference.id[i] == item.primitive;
+        const bool in_drv = driver.id[i] == item.primitive;
+        const double cx = x + 0.5;
+        const double cy = h - 1 - y + 0.5;
+        if (item.kind == LineProbeItem::Kind::Thin) {
+          r.thin_pixels += in_ref ? 1 : 0;
+          if (in_ref == in_drv) continue;
+          const bool x_major = std::fabs(item.b.x - item.a.x) >= std::fabs(item.b.y - item.a.y);
+          const double mc = x_major ? cx : cy;
+          const double ma = x_major ? item.a.x : item.a.y;
+          const double mb = x_major ? item.b.x : item.b.y;
+          const bool end = std::fabs(mc - ma) < 1.0 || std::fabs(mc - mb) < 1.0;
+          (end ? r.thin_end_off : r.thin_interior_off) += 1;
+        } else if (item.kind == LineProbeItem::Kind::Point) {
+          r.point_pixels += in_ref ? 1 : 0;
+          if (in_ref != in_drv) ++r.point_off;
+        }
+      }
+    }
+  }
+  // Wide segments: fragments per column (x-major) or row inside, away from the ends.
+  int lines_counted = 0;
+  double per_line_sum = 0.0;
+  for (const LineProbeItem& item : probe.items) {
+    if (item.kind != LineProbeItem::Kind::Wide) continue;
+    const bool x_major = std::fabs(item.b.x - item.a.x) >= std::fabs(item.b.y - item.a.y);
+    const double lo = x_major ? std::min(item.a.x, item.b.x) : std::min(item.a.y, item.b.y);
+    const double hi = x_major ? std::max(item.a.x, item.b.x) : std::max(item.a.y, item.b.y);
+    int total = 0;
+    int groups = 0;
+    for (int m = static_cast<int>(lo) + 3; m <= static_cast<int>(hi) - 3; ++m) {
+      int count = 0;
+      const int other = x_major ? h : w;
+      for (int n = 0; n < other; ++n) {
+        const int x = x_major ? m : n;
+        const int gy = x_major ? n : m;  // GL window y
+        if (x < 0 || x >= w || gy < 0 || gy >= h) continue;
+        if (driver.id[driver.index(x, h - 1 - gy)] == item.primitive) ++count;
+      }
+      total += count;
+      ++groups;
+    }
+    if (groups == 0) continue;
+    per_line_sum += static_cast<double>(total) / groups / item.size;
+    ++lines_counted;
+  }
+  r.wide_per_column = lines_counted > 0 ? 4.0 * per_line_sum / lines_counted : 0.0;
+  // 4 per column for the column rule; 4 / cos(30 deg) = 4.62 for a rectangle.
+  r.wide_lines = std::fabs(r.wide_per_column - 4.0) < 0.15   ? "column"
+                 : std::fabs(r.wide_per_column - 4.62) < 0.2 ? "rectangle"
+                                                               : "other";
+  r.line_rule = r.thin_interior_off == 0 && r.thin_end_off == 0 ? "diamond-exit"
+                : r.thin_interior_off == 0                      ? "diamond-exit, own ends"
+                                                                : "other";
+  r.point_rule = r.point_off == 0 ? "square" : "other";
+  // Ends of its own are GL's to allow (the reference's allowance takes them).
+  r.matches_reference = r.line_rule != "other" && r.wide_lines == "column" && r.point_rule == "square";
+  return r;
+}
+
+nlohmann::json toJson(const LineRuleResult& r) {
+  const std::string summary =
+      fmt::format("{}; wide: {}; points: {}", r.line_rule, r.wide_lines, r.point_rule);
+  return {{"summary", summary},
+          {"rule", summary},
+          {"line_rule", r.line_rule},
+          {"thin_pixels", r.thin_pixels},
+          {"thin_interior_off", r.thin_interior_off},
+          {"thin_end_off", r.thin_end_off},
+          {"wide_lines", r.wide_lines},
+          {"wide_per_column", r.wide_per_column},
+          {"point_rule", r.point_rule},
+          {"point_pixels", r.point_pixels},
+          {"point_off", r.point_off},
+          {"matches_reference", r.matches_reference}};
+}
+
+std::string describeLines(const LineRuleResult& r) {
+  return fmt::format(
+      "lines: {} ({} of {} one-pixel fragments differ inside, {} at the ends); wide lines: {} "
+      "({:.2f} fragments per column at width 4); points: {} ({} of {} pixels differ){}",
+      r.line_rule, r.thin_interior_off, r.thin_pixels, r.thin_end_off, r.wide_lines,
+      r.wide_per_column, r.point_rule, r.point_off, r.point_pixels,
+      r.matches_reference ? ", as the reference" : "");
+}
+
 std::map<int, Frame> subpixelReferences(const Scene& scene) {
   std::map<int, Frame> reference;
   for (int n = kMinCandidateBits; n <= kMaxCandidateBits; ++n) {

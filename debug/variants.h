@@ -161,17 +161,60 @@ struct DepthRoundingResult {
 
 DepthRoundingResult analyseDepthRounding(const DepthProbe& probe, const Frame& driver);
 
+// ---- (d) lines and points ---------------------------------------------------------------
+
+// One primitive of the line probe and what it tests.
+struct LineProbeItem {
+  std::uint32_t primitive = 0;
+  enum class Kind { Thin, Wide, Point } kind = Kind::Thin;
+  glm::dvec2 a{0.0};  // window position of the segment's start (or the point)
+  glm::dvec2 b{0.0};  // of its end
+  double size = 1.0;  // line width or point size
+};
+
+struct LineProbe {
+  Scene scene;
+  std::vector<LineProbeItem> items;
+};
+
+// One-pixel segments at 16 angles with ends off the pixel grid (the diamond-exit rule's
+// ends and interiors), width-4 segments at 30 and 60 degrees (GL's column rule gives 4
+// fragments per column or row; a rectangle of that width 4 / cos(angle)), and points of
+// size 3.5 and 5 at quarter-pixel positions. Each primitive apart from the others,
+// depth test off. 128x96 px.
+LineProbe lineProbe();
+
+struct LineRuleResult {
+  int thin_pixels = 0;        // the reference's fragments of the one-pixel segments
+  int thin_interior_off = 0;  // pixels (either side) where the driver differs, away from ends
+  int thin_end_off = 0;       // ... within a pixel of an end (GL leaves those open)
+  std::string line_rule;      // "diamond-exit", "diamond-exit, own ends", "other"
+  double wide_per_column = 0.0;  // mean fragments per column (row) inside the wide segments
+  std::string wide_lines;        // "column", "rectangle", "other"
+  int point_pixels = 0;          // the reference's point fragments
+  int point_off = 0;             // pixels where the driver's points differ
+  std::string point_rule;        // "square", "other"
+  // The reference's rules where GL fixes them: the diamond-exit interior (ends may differ:
+  // GL leaves them open), the column rule and point squares.
+  bool matches_reference = false;
+};
+
+// `reference` is the reference's frame of lineProbe() (no channels), `driver` the driver's.
+LineRuleResult analyseLines(const LineProbe& probe, const Frame& driver, const Frame& reference);
+
 // ---- report.json ------------------------------------------------------------------------
 
 nlohmann::json toJson(const SubpixelResult& r);
 nlohmann::json toJson(const TieBreakResult& r);
 nlohmann::json toJson(const DepthRoundingResult& r);
+nlohmann::json toJson(const LineRuleResult& r);
 
 // One line per variant for people, e.g. "subpixel: 8 bits (GL_SUBPIXEL_BITS 8, confirmed:
 // ref:subpixel=8 reproduces the probe exactly)".
 std::string describeSubpixel(const SubpixelResult& r);
 std::string describeTieBreak(const TieBreakResult& r);
 std::string describeDepthRounding(const DepthRoundingResult& r);
+std::string describeLines(const LineRuleResult& r);
 
 // The reference's frames of the subpixel probe `scene` at every candidate precision
 // (kMinCandidateBits..kMaxCandidateBits), without uncertainty channels: what

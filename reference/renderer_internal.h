@@ -146,7 +146,7 @@ struct GeneralSetup {
 // How close the pixel centre (cx, cy) comes to the other decision of GL's rule for the
 // segment a -> b of rounded width w (px, measured in the minor direction: | |offset| - w/2 |),
 // 0 in the columns (rows) within a pixel of an end, where GL leaves the fragment to the
-// driver, and for a width of k + 1/2 (either width) within the wider band. The reach of the
+// driver, and for a width of k + 1/2 (either width) between the two bands. The reach of the
 // vertices is not subtracted.
 inline double segmentMargin(const WindowVertex& a, const WindowVertex& b, double w, bool half,
                             double cx, double cy) {
@@ -162,8 +162,11 @@ inline double segmentMargin(const WindowVertex& a, const WindowVertex& b, double
   const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
   const double off = std::fabs(nc - (na + (std::clamp(mc, lo, hi) - ma) * slope));
   const bool end = std::fabs(mc - ma) < 1.0 || std::fabs(mc - mb) < 1.0 || mc <= lo || mc >= hi;
-  if (end || (half && off < w / 2 + 0.5)) return 0.0;
-  return std::fabs(off - w / 2);
+  if (end) return 0.0;
+  if (!half) return std::fabs(off - w / 2);
+  // Either width, w or w - 1: the rows between are open, the rest decided by the nearer.
+  if (off >= (w - 1) / 2 && off < w / 2) return 0.0;
+  return std::min(std::fabs(off - w / 2), std::fabs(off - (w - 1) / 2));
 }
 // For a point of side `size` at c: the distance to the square's border, inside or out.
 inline double pointMargin(const WindowVertex& c, double size, double cx, double cy) {

@@ -43,7 +43,8 @@ fs::path tempDir(const std::string& name) {
 TEST(Variants, ProbesSurviveTheFixtureFileBitForBit) {
   // GL renders the probes from a fixture file; the analysis assumes the same vertices.
   const fs::path dir = tempDir("roundtrip");
-  const std::vector<Scene> probes = {subpixelProbe(), tieBreakProbe().scene, depthProbe().scene};
+  const std::vector<Scene> probes = {subpixelProbe(), tieBreakProbe().scene, depthProbe().scene,
+                                     lineProbe().scene};
   for (const Scene& probe : probes) {
     SCOPED_TRACE(probe.name);
     const fs::path file = dir / "probe.json";
@@ -53,6 +54,7 @@ TEST(Variants, ProbesSurviveTheFixtureFileBitForBit) {
     for (std::size_t o = 0; o < probe.objects.size(); ++o) {
       EXPECT_EQ(loaded.objects[o].mesh.positions, probe.objects[o].mesh.positions);
       EXPECT_EQ(loaded.objects[o].mesh.triangles, probe.objects[o].mesh.triangles);
+      EXPECT_EQ(loaded.objects[o].mesh.lines, probe.objects[o].mesh.lines);
       EXPECT_EQ(loaded.objects[o].model, probe.objects[o].model);
     }
     EXPECT_EQ(renderAt(loaded, 8).id, renderAt(probe, 8).id);
@@ -251,6 +253,62 @@ TEST(Variants, DepthRoundingTellsTruncationAndInexactReadbackApart) {
   const DepthRoundingResult o = analyseDepthRounding(probe, off);
   EXPECT_FALSE(o.readback_exact);
   EXPECT_EQ(o.rule, "none");
+}
+
+// ---- (d) lines and points ----
+
+TEST(Variants, LineProbeTellsTheRulesApart) {
+  const LineProbe probe = lineProbe();
+  const Frame reference = renderAt(probe.scene, 8);
+  // The reference against itself: every rule its own.
+  const LineRuleResult same = analyseLines(probe, reference, reference);
+  EXPECT_EQ(same.line_rule, "diamond-exit");
+  EXPECT_EQ(same.wide_lines, "column");
+  EXPECT_EQ(same.point_rule, "square");
+  EXPECT_TRUE(same.matches_reference);
+  EXPECT_GT(same.thin_pixels, 16 * 10);
+  EXPECT_GT(same.point_pixels, 8 * 9);
+  EXPECT_NEAR(same.wide_per_column, 4.0, 0.01);
+
+  // A driver whose one-pixel segments sit a row off inside (softpipe's truncated ends),
+  // whose wide lines are rectangles (a fifth fragment every other column) and whose points
+  // lose a column: each rule reported as another.
+  Frame other = reference;
+  const int h = probe.scene.height;
+  auto at = [&](int x, int gy) -> std::uint32_t& { return other.id[other.index(x, h - 1 - gy)]; };
+  const LineProbeItem& thin = probe.items[0];
+  const LineProbeItem& wide = probe.items[16];
+  const LineProbeItem& point = probe.items.back();
+  ASSERT_EQ(thin.kind, LineProbeItem::Kind::Thin);
+  ASSERT_EQ(wide.kind, LineProbeItem::Kind::Wide);
+  ASSERT_EQ(point.kind, LineProbeItem::Kind::Point);
+  for (int x = 0; x < probe.scene.width; ++x) {
+    for (int gy = h - 1; gy > 0; --gy) {
+      // Thin segment 0 (x-major or not, its pixels move up one row in its middle third).
+      const double mid = (thin.a.x + thin.b.x) / 2.0;
+      if (reference.id[reference.index(x, h - 1 - gy)] == thin.primitive && std::abs(x + 0.5 - mid) < 2.0) {
+        at(x, gy) = 0;
+        at(x, gy + 1) = thin.primitive;
+      }
+    }
+    // The wide segment: one more fragment on top of every column.
+    int top = -1;
+    for (int gy = 0; gy < h; ++gy)
+      if (reference.id[reference.index(x, h - 1 - gy)] == wide.primitive) top = gy;
+    if (top >= 0 && top + 1 < h) at(x, top + 1) = wide.primitive;
+  }
+  for (int x = 0; x < probe.scene.width; ++x)
+    for (int gy = 0; gy < h; ++gy)
+      if (reference.id[reference.index(x, h - 1 - gy)] == point.primitive &&
+          x == static_cast<int>(std::floor(point.a.x + point.size / 2.0 - 0.5)))
+        at(x, gy) = 0;
+  const LineRuleResult r = analyseLines(probe, other, reference);
+  EXPECT_EQ(r.line_rule, "other");
+  EXPECT_GT(r.thin_interior_off, 0);
+  EXPECT_NE(r.wide_lines, "column");
+  EXPECT_EQ(r.point_rule, "other");
+  EXPECT_FALSE(r.matches_reference);
+  EXPECT_NE(describeLines(r).find("lines: other"), std::string::npos);
 }
 
 }  // namespace
