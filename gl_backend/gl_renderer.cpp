@@ -184,6 +184,8 @@ struct Session {
   // A render that did not finish (its context state unknown): the next gets a new context
   // even where contexts are reused (reusesContext).
   bool render_unfinished = false;
+  // The last render drew lines or points (softpipe: the next render gets a new context).
+  bool drew_lines = false;
   const char* context_use = "new";       // frame.json "context": new, reused or replaced
   const char* program_use = "compiled";  // frame.json "program": compiled or reused
 };
@@ -289,6 +291,14 @@ bool blendsOntoRgba8(const Scene& scene, const std::vector<DrawPass>& passes) {
   return std::any_of(passes.begin(), passes.end(), [](const DrawPass& p) { return p.blend; });
 }
 
+// Lines, points or polygon modes: in a reused context softpipe draws them differently from a
+// new one, and a render after them too (docs/results/findings.md "softpipe: lines after lines
+// in a reused context"): they get a new context, and so does the render after them.
+bool drawsLines(const std::vector<DrawPass>& passes) {
+  return std::any_of(passes.begin(), passes.end(),
+                     [](const DrawPass& p) { return p.rasterizesLinesOrPoints(); });
+}
+
 // Whether the next render reuses this process's context, and with it the programs it
 // compiled, instead of starting from a new one (resetReusedContext() restores what a render
 // does not set itself): where the isolation test shows that a frame is the one a new context
@@ -298,12 +308,12 @@ bool blendsOntoRgba8(const Scene& scene, const std::vector<DrawPass>& passes) {
 // gets a new context per render. RASTERCHECK_GL_CONTEXT=new gives every driver but zink on
 // Mesa 22 a new context per render, =reuse reuses it on every driver and render (to test
 // one); it is read at every render.
-bool reusesContext(const Session& s, bool blends_onto_rgba8) {
+bool reusesContext(const Session& s, bool blends_onto_rgba8, bool lines) {
   if (keepsOneContext(s)) return true;
   const char* forced = std::getenv("RASTERCHECK_GL_CONTEXT");
   if (forced != nullptr && std::string_view(forced) == "new") return false;
   if (forced != nullptr && std::string_view(forced) == "reuse") return true;
-  if (s.driver == "softpipe") return !blends_onto_rgba8;
+  if (s.driver == "softpipe") return !blends_onto_rgba8 && !lines && !s.drew_lines;
   return s.driver == "llvmpipe" || s.driver == "zink";
 }
 
@@ -405,8 +415,9 @@ void resetReusedContext(Session& s) {
 }
 
 // Returns the session for spec, made current on this thread.
-// `blends_onto_rgba8`: blendsOntoRgba8() of the scene about to be drawn.
-Session& acquireSession(const GlSpec& spec, bool blends_onto_rgba8) {
+// `blends_onto_rgba8`, `lines`: blendsOntoRgba8() and drawsLines() of the scene about to be
+// drawn.
+Session& acquireSession(const GlSpec& spec, bool blends_onto_rgba8, bool lines) {
   // A missing GPU is the answer for an egl-device spec, whatever else this process runs.
   if (spec.platform == GlSpec::Platform::EglDevice) gl::findEglDevice(spec.device);
   if (g_session == nullptr) {
@@ -429,7 +440,7 @@ Session& acquireSession(const GlSpec& spec, bool blends_onto_rgba8) {
         spec.driver, have.driver, toString(spec)));
   }
   Session& s = *g_session;
-  const bool reuse = reusesContext(s, blends_onto_rgba8);
+  const bool reuse = reusesContext(s, blends_onto_rgba8, lines);
   s.context_use = !reuse ? "new" : s.render_unfinished ? "replaced" : "reused";
   if (!reuse) {
     renewContext(s);
@@ -1469,7 +1480,9 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   const gl::testing::Faults faults = activeFaults();  // bad RASTERCHECK_GL_FAULT: exit 2
   const std::vector<DrawPass> passes = drawPasses(scene);
   auto start = Clock::now();
-  Session& s = acquireSession(spec, blendsOntoRgba8(scene, passes));
+  const bool lines = drawsLines(passes);
+  Session& s = acquireSession(spec, blendsOntoRgba8(scene, passes), lines);
+  s.drew_lines = lines;
   struct Release {
     Session& s;
     ~Release() { s.context->release(); }

@@ -547,9 +547,10 @@ void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, d
         // Inside: the nearer border; outside: how far beyond the farther one.
         const double d = dx <= 0.0 && dy <= 0.0 ? std::min(-dx, -dy) : std::max(dx, dy);
         if (d >= 1.0) continue;
-        // A square that crosses the viewport's border: Mesa's drivers may draw it as two
-        // triangles through their draw module, which offsets it by (1/8, -1/8) px.
-        const double bias = crosses ? 0.125 : 0.0;
+        // A square that crosses the viewport's border, or a polygon's vertex: Mesa's drivers
+        // may draw it through their draw module (its clipper, its unfilled stage), whose
+        // wide-point stage offsets it by (1/8, -1/8) px.
+        const double bias = crosses || polygon_vertex ? 0.125 : 0.0;
         const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
                                   static_cast<std::size_t>(px - clip_.x0);
         float& e = frame_.edge_dist[index];

@@ -122,8 +122,15 @@ TEST(CampaignGl, ShortCampaignFindsGroupsAndReproducesEveryOne) {
   EXPECT_EQ(summary["scenes"]["run"], 50);
   for (const char* b : {"gl:egl:llvmpipe", "gl:egl:softpipe", "gl:egl:zink"})
     EXPECT_EQ(summary["backends"][b]["pairs"], 50) << b;
-  for (const char* b : {"gl:egl:llvmpipe", "gl:egl:zink"})
-    EXPECT_EQ(summary["backends"][b]["fail"], 0) << b;
+  // No unexplained failure on llvmpipe or zink: each of their groups is a Mesa difference an
+  // expectations entry names (seed 11 meets mesa-polygon-mode-stencil-front: a back-facing
+  // polygon in polygon mode point tested with the front stencil state).
+  for (const json& g : summary["groups"]) {
+    const std::string actual = g["actual"].get<std::string>();
+    if (actual == "gl:egl:llvmpipe" || actual == "gl:egl:zink") {
+      EXPECT_TRUE(g["expectation"]["entry"].is_string()) << g.dump();
+    }
+  }
   EXPECT_EQ(summary["exit_code"], first.code);
 
   // The runs' own reports, read independently: every failing class is one failure.
@@ -361,7 +368,8 @@ TEST(CampaignGl, ShortMutationStudyCatchesEveryFaultInItsClass) {
       {"texel_offset", "shading"},      {"blend_factor", "shading"},
       {"depth_func", "visibility"},     {"stencil_op", "depth"},
       {"blend_function", "shading"},    {"scissor_shift", "visibility"},
-      {"lod_shift", "shading"},         {"lod_weight", "shading"}};
+      {"lod_shift", "shading"},         {"lod_weight", "shading"},
+      {"move_line_end", "visibility"},  {"move_point", "visibility"}};
   for (const json& result : study["results"]) {
     const std::string c = cls.at(result["fault"]);
     const auto has = [&](const char* key) {

@@ -150,6 +150,9 @@ TEST(Accuracy, VariantsAndFindingsOfEachStackAreListed) {
         {"subpixel", {{"best", 8}, {"exact", true}}},
         {"tie_break", {{"rule", "left+bottom"}, {"matches_reference", true}}},
         {"depth_rounding", {{"rule", "truncate"}, {"matches_reference", false}}},
+        {"lines",
+         {{"rule", "diamond-exit, own ends; wide: column; points: square"},
+          {"matches_reference", true}}},
         {"findings", {"subpixel: GL_SUBPIXEL_BITS says 4 but the driver rasterizes like 8 bits"}}}},
       {"gl:x:z", {{"error", "subpixel probe: cannot start"}}}};
   writeJson(s.run / "report.json", doc);
@@ -160,9 +163,10 @@ TEST(Accuracy, VariantsAndFindingsOfEachStackAreListed) {
   EXPECT_TRUE(
       hasLine(md,
               "| `gl:x:y` | zink (dev) \\| OpenGL 4.6 \\| Vulkan 1.3 dev | 4 | 8 bits | 8 | "
-              "left+bottom (as ref) | truncate (differs from ref) |"))
+              "left+bottom (as ref) | truncate (differs from ref) | diamond-exit, own ends; wide: "
+              "column; points: square (as ref) |"))
       << md;
-  EXPECT_TRUE(hasLine(md, "| `gl:x:z` | error: subpixel probe: cannot start | | | | | |")) << md;
+  EXPECT_TRUE(hasLine(md, "| `gl:x:z` | error: subpixel probe: cannot start | | | | | | |")) << md;
   EXPECT_TRUE(hasLine(
       md, "- `gl:x:y`: subpixel: GL_SUBPIXEL_BITS says 4 but the driver rasterizes like 8 bits"))
       << md;

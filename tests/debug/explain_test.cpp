@@ -244,6 +244,30 @@ TEST(Explain, ABufferListIsSortedAndEndsInTheExactColour) {
   EXPECT_FALSE(json::parse(plain.out).contains("abuffer"));
 }
 
+TEST(Explain, ALinePixelTellsItsSegmentTheRuleAndTheParameter) {
+  // Pixel (95, 52) of the star: segment 2 (primitive 3) passes through it, inside.
+  const Result r = run("explain " + catalog("lines/star_octants.json") +
+                       " --pixel 95,52 --backends ref --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = json::parse(r.out);
+  ASSERT_FALSE(doc["fragments"].empty());
+  const json& f = doc["fragments"][0];
+  EXPECT_EQ(f["primitive_kind"], "lines");
+  EXPECT_EQ(f["line"]["kind"], "segment");
+  EXPECT_EQ(f["line"]["rule"], "diamond-exit");
+  const double t = f["line"]["t"].get<double>();
+  EXPECT_GT(t, 0.0);
+  EXPECT_LT(t, 1.0);
+  // The barycentrics are the parameter, perspective-free here (orthographic camera).
+  EXPECT_NEAR(f["barycentric"][1].get<double>(), t, 1e-9);
+  EXPECT_GT(f["line"]["margin"].get<double>(), 0.0);
+  EXPECT_LT(f["line"]["margin"].get<double>(), 0.5);
+  const Result text =
+      run("explain " + catalog("lines/star_octants.json") + " --pixel 95,52 --backends ref");
+  EXPECT_NE(text.out.find("segment 2 of 'star'"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("diamond-exit rule"), std::string::npos) << text.out;
+}
+
 TEST(Explain, JsonKeysAreTheDocumentedOnes) {
   const std::set<std::string> documented = documentedKeys();
   ASSERT_GT(documented.size(), 100u) << "docs/explain.md's key table was not found";
@@ -257,7 +281,9 @@ TEST(Explain, JsonKeysAreTheDocumentedOnes) {
       catalog("transparency/oit_cyclic.json") + " --pixel 57,93 --backends ref:abuffer",
       catalog("fragment-ops/stencil_portal.json") + " --pixel 80,60 --backends ref",
       catalog("fragment-ops/decal_offset.json") + " --pixel 90,70 --backends ref",
-      catalog("mipmap/level_colours.json") + " --pixel 80,60 --backends ref"};
+      catalog("mipmap/level_colours.json") + " --pixel 80,60 --backends ref",
+      catalog("lines/star_octants.json") + " --pixel 95,52 --backends ref",
+      catalog("lines/point_sizes.json") + " --pixel 38,101 --backends ref"};
   for (const std::string& call : calls) {
     const Result r = run("explain " + call + " --json");
     ASSERT_EQ(r.code, 0) << call << ": " << r.err;

@@ -29,9 +29,26 @@ TEST(MutationStudy, TheFaultsAndTheirClasses) {
                                                                    {"blend_function", "shading"},
                                                                    {"scissor_shift", "visibility"},
                                                                    {"lod_shift", "shading"},
-                                                                   {"lod_weight", "shading"}}));
+                                                                   {"lod_weight", "shading"},
+                                                                   {"move_line_end", "visibility"},
+                                                                   {"move_point", "visibility"}}));
   EXPECT_EQ(std::string(mutationFault("depth_bias").cls), "depth");
   EXPECT_THROW(mutationFault("shift_x"), InputError);
+}
+
+TEST(MutationStudy, LineAndPointFaultsPickTheirOwnKindOfPrimitive) {
+  MutationScene scene;
+  scene.visible_ids = {3, 9, 12, 20};
+  scene.line_ids = {9, 10};
+  scene.point_ids = {20, 21};
+  for (std::uint64_t index = 0; index < 20; ++index) {
+    EXPECT_EQ(faultSetting(mutationFault("move_line_end"), scene, 1, index), "move_line_end=9");
+    EXPECT_EQ(faultSetting(mutationFault("move_point"), scene, 1, index), "move_point=20");
+    const std::string moved = faultSetting(mutationFault("move_vertex"), scene, 1, index);
+    EXPECT_TRUE(moved == "move_vertex=3" || moved == "move_vertex=12") << moved;
+  }
+  scene.line_ids.clear();
+  EXPECT_EQ(faultSetting(mutationFault("move_line_end"), scene, 1, 0), "");
 }
 
 TEST(MutationStudy, SettingsFollowWhatTheSceneOffers) {
