@@ -238,8 +238,8 @@ int runCli(int argc, char** argv) {
                          "how often it is caught in its class");
   campaign_cmd
       ->add_option("--faults", campaign.faults,
-                   "--mutations: faults to inject, comma separated (default: light_scale, "
-                   "depth_bias, drop_primitive, move_vertex, texel_offset, blend_factor)")
+                   "--mutations: faults to inject, comma separated (default: every fault of "
+                   "docs/campaigns.md)")
       ->delimiter(',');
 
   AccuracyArgs accuracy;

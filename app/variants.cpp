@@ -141,8 +141,7 @@ nlohmann::json analyseVariants(const VariantProbes& probes,
           variants::lineProbe(), got.at("lines")->frame,
           renderReference(loadScene(probes.files.at("lines")), line_options));
       v["lines"] = variants::toJson(lines);
-      if (!lines.matches_reference)
-        v["findings"].push_back(variants::describeLines(lines));
+      if (!lines.matches_reference) v["findings"].push_back(variants::describeLines(lines));
       v["probe_seconds"] = shared_seconds;
     } catch (const InputError& e) {
       v = {{"error", e.what()}};

@@ -152,11 +152,11 @@ std::string variantsTable(const Report& report) {
     out += fmt::format("<td>{} {}</td>",
                        mark(v, "depth_rounding", "matches_reference", "as ref", "differs"),
                        esc(text(v, "depth_rounding")));
-    out += fmt::format("<td>{} {}</td>",
-                       v.contains("lines") ? mark(v, "lines", "matches_reference", "as ref",
-                                                  "differs")
-                                           : std::string(),
-                       esc(text(v, "lines")));
+    out +=
+        fmt::format("<td>{} {}</td>",
+                    v.contains("lines") ? mark(v, "lines", "matches_reference", "as ref", "differs")
+                                        : std::string(),
+                    esc(text(v, "lines")));
     std::string findings;
     if (v.contains("findings") && v["findings"].is_array()) {
       for (const nlohmann::json& f : v["findings"])

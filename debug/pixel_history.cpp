@@ -190,9 +190,9 @@ std::string story(const Json& doc) {
         "\nfragment {}: primitive {}, {} {} of '{}' ({} pass {}), barycentric "
         "{}\n",
         f["index"].get<int>(), f["primitive"].get<int>(), primitiveNoun(f),
-        f["triangle"].get<int>(),
-        f["object"].get<std::string>(), f["draw"]["kind"].get<std::string>(),
-        f["draw"]["pass"].get<int>(), fmtVec(f["barycentric"]));
+        f["triangle"].get<int>(), f["object"].get<std::string>(),
+        f["draw"]["kind"].get<std::string>(), f["draw"]["pass"].get<int>(),
+        fmtVec(f["barycentric"]));
     if (f.contains("line")) s += lineStory(f["line"]);
     const Json& d = f["depth"];
     s += fmt::format(

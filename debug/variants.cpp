@@ -683,13 +683,14 @@ LineRuleResult analyseLines(const LineProbe& probe, const Frame& driver, const F
   // 4 per column for the column rule; 4 / cos(30 deg) = 4.62 for a rectangle.
   r.wide_lines = std::fabs(r.wide_per_column - 4.0) < 0.15   ? "column"
                  : std::fabs(r.wide_per_column - 4.62) < 0.2 ? "rectangle"
-                                                               : "other";
+                                                             : "other";
   r.line_rule = r.thin_interior_off == 0 && r.thin_end_off == 0 ? "diamond-exit"
                 : r.thin_interior_off == 0                      ? "diamond-exit, own ends"
                                                                 : "other";
   r.point_rule = r.point_off == 0 ? "square" : "other";
   // Ends of its own are GL's to allow (the reference's allowance takes them).
-  r.matches_reference = r.line_rule != "other" && r.wide_lines == "column" && r.point_rule == "square";
+  r.matches_reference =
+      r.line_rule != "other" && r.wide_lines == "column" && r.point_rule == "square";
   return r;
 }
 

@@ -185,10 +185,10 @@ struct LineProbe {
 LineProbe lineProbe();
 
 struct LineRuleResult {
-  int thin_pixels = 0;        // the reference's fragments of the one-pixel segments
-  int thin_interior_off = 0;  // pixels (either side) where the driver differs, away from ends
-  int thin_end_off = 0;       // ... within a pixel of an end (GL leaves those open)
-  std::string line_rule;      // "diamond-exit", "diamond-exit, own ends", "other"
+  int thin_pixels = 0;           // the reference's fragments of the one-pixel segments
+  int thin_interior_off = 0;     // pixels (either side) where the driver differs, away from ends
+  int thin_end_off = 0;          // ... within a pixel of an end (GL leaves those open)
+  std::string line_rule;         // "diamond-exit", "diamond-exit, own ends", "other"
   double wide_per_column = 0.0;  // mean fragments per column (row) inside the wide segments
   std::string wide_lines;        // "column", "rectangle", "other"
   int point_pixels = 0;          // the reference's point fragments

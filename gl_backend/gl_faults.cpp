@@ -15,7 +15,8 @@ namespace {
 
 constexpr const char* kValidFaults =
     "drop_primitive=ID, depth_bias=STEPS, light_scale=F, no_inverse_transpose, shift_x=PX, "
-    "shader_compile_error, move_vertex=ID, move_line_end=ID, move_point=ID, texel_offset=N, blend_factor=one|swapped, "
+    "shader_compile_error, move_vertex=ID, move_line_end=ID, move_point=ID, texel_offset=N, "
+    "blend_factor=one|swapped, "
     "depth_func=inverted, stencil_op=shifted, blend_function=shifted, scissor_shift=N, "
     "lod_shift=N, lod_weight=inverted, "
     "hang=FIXTURE|*, crash=FIXTURE|*, flaky=FIXTURE|*, hang_once=FIXTURE|*";
@@ -42,11 +43,10 @@ T number(std::string_view entry, std::string_view value) {
 bool Faults::any() const {
   return drop_primitive != 0 || depth_bias_steps != 0 || light_scale != 1.0 ||
          no_inverse_transpose || shift_x_px != 0.0 || shader_compile_error || move_vertex != 0 ||
-         move_line_end != 0 || move_point != 0 ||
-         texel_offset != 0.0 || blend_factor != Blend::Correct || depth_func_inverted ||
-         stencil_op_shifted || blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 ||
-         lod_weight_inverted || !hang.empty() || !crash.empty() || !flaky.empty() ||
-         !hang_once.empty();
+         move_line_end != 0 || move_point != 0 || texel_offset != 0.0 ||
+         blend_factor != Blend::Correct || depth_func_inverted || stencil_op_shifted ||
+         blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 || lod_weight_inverted ||
+         !hang.empty() || !crash.empty() || !flaky.empty() || !hang_once.empty();
 }
 
 bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }
@@ -97,11 +97,11 @@ Faults parseFaults(std::string_view text) {
     const bool flag = name == "no_inverse_transpose" || name == "shader_compile_error";
     const bool valued = name == "drop_primitive" || name == "depth_bias" || name == "light_scale" ||
                         name == "shift_x" || name == "move_vertex" || name == "texel_offset" ||
-                        name == "move_line_end" || name == "move_point" ||
-                        name == "blend_factor" || name == "hang" || name == "crash" ||
-                        name == "flaky" || name == "hang_once" || name == "depth_func" ||
-                        name == "stencil_op" || name == "blend_function" ||
-                        name == "scissor_shift" || name == "lod_shift" || name == "lod_weight";
+                        name == "move_line_end" || name == "move_point" || name == "blend_factor" ||
+                        name == "hang" || name == "crash" || name == "flaky" ||
+                        name == "hang_once" || name == "depth_func" || name == "stencil_op" ||
+                        name == "blend_function" || name == "scissor_shift" ||
+                        name == "lod_shift" || name == "lod_weight";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
     if (name == "drop_primitive") {

@@ -861,10 +861,10 @@ void setMaterialUniforms(const gl::Functions& gl, const Program& p, const Materi
 void setFixedState(const gl::Functions& gl, const Scene& scene) {
   gl.Viewport(0, 0, scene.width, scene.height);
   gl.DepthRange(0.0, 1.0);
-  for (GLenum cap : {GL_DITHER, GL_MULTISAMPLE, GL_FRAMEBUFFER_SRGB, GL_DEPTH_CLAMP,
-                     GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_POLYGON_OFFSET_FILL,
-                     GL_SAMPLE_ALPHA_TO_COVERAGE, GL_RASTERIZER_DISCARD, GL_PRIMITIVE_RESTART,
-                     GL_LINE_SMOOTH, GL_PROGRAM_POINT_SIZE}) {
+  for (GLenum cap :
+       {GL_DITHER, GL_MULTISAMPLE, GL_FRAMEBUFFER_SRGB, GL_DEPTH_CLAMP, GL_SCISSOR_TEST,
+        GL_STENCIL_TEST, GL_POLYGON_OFFSET_FILL, GL_SAMPLE_ALPHA_TO_COVERAGE, GL_RASTERIZER_DISCARD,
+        GL_PRIMITIVE_RESTART, GL_LINE_SMOOTH, GL_PROGRAM_POINT_SIZE}) {
     gl.Disable(cap);
   }
   gl.PolygonMode(GL_FRONT_AND_BACK, GL_FILL);

@@ -118,8 +118,8 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
         face = flatFace(wm.positions[tri[0]], wm.positions[tri[1]], wm.positions[tri[2]]);
       } else {
         const std::uint32_t last = tri[count - 1];
-        face = flatSegment(wm.positions[tri[0]], wm.positions[last],
-                           glm::dvec3(wm.normals[tri[0]]), glm::dvec3(wm.normals[last]));
+        face = flatSegment(wm.positions[tri[0]], wm.positions[last], glm::dvec3(wm.normals[tri[0]]),
+                           glm::dvec3(wm.normals[last]));
       }
 
       const auto material = static_cast<std::uint32_t>(obj.material);

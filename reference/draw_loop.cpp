@@ -120,9 +120,8 @@ void Renderer::transformVertices() {
     // vertex outside, the pieces so far are transformed again into the array (the same
     // bits) and the rest are written there as before.
     // (Lines and points read their vertices' clip coordinates: line_loop.cpp.)
-    bool records_unread = obj.primitive == PrimitiveKind::Triangles &&
-                          shading == Shading::Flat && trace_ == nullptr &&
-                          scene_.materials[obj.material].texture == nullptr &&
+    bool records_unread = obj.primitive == PrimitiveKind::Triangles && shading == Shading::Flat &&
+                          trace_ == nullptr && scene_.materials[obj.material].texture == nullptr &&
                           prepared.lights.empty();
     // In pieces that stay in the cache from the transform to the window set-up (and
     // Gouraud's lighting): 512 x (128 + 72) bytes.
@@ -278,7 +277,7 @@ void Renderer::prepareTriangle(TriangleContext& t) const {
 // there, or a non-finite window position). reach and depth_reach only with the
 // uncertainty channels.
 bool Renderer::windowVertexSetup(const ClipVertex& c, WindowVertex& wv, FixedVertex& fv,
-                                        double& reach, double& depth_reach) const {
+                                 double& reach, double& depth_reach) const {
   if (!(c.clip.w > 0.0)) return false;
   wv = toWindow(c, scene_.width, scene_.height);
   if (!std::isfinite(wv.x) || !std::isfinite(wv.y) || !std::isfinite(wv.z)) return false;

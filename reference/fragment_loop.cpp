@@ -20,7 +20,6 @@
 namespace rc::ref {
 namespace {
 
-
 struct PhongQuad {
   static constexpr int kMax = 8;
   const FragmentInterpolator* interp = nullptr;
@@ -770,9 +769,9 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       }
       colour_reach = static_cast<float>(255.0 * worst);
       if (shared && !outline_dry_) {
-        const auto it = std::lower_bound(
-            outline_spread_.begin(), outline_spread_.end(), index,
-            [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
+        const auto it =
+            std::lower_bound(outline_spread_.begin(), outline_spread_.end(), index,
+                             [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
         if (it != outline_spread_.end() && it->index == index) {
           const glm::dvec3 d_lo = glm::dvec3(own) - it->c_lo;
           const glm::dvec3 d_hi = it->c_hi - glm::dvec3(own);
@@ -793,12 +792,12 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     }
     double spread_z = slack_px * z_per_px;
     if (shared) {
-      const auto it = std::lower_bound(
-          outline_spread_.begin(), outline_spread_.end(), index,
-          [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
+      const auto it =
+          std::lower_bound(outline_spread_.begin(), outline_spread_.end(), index,
+                           [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
       if (it != outline_spread_.end() && it->index == index)
-        spread_z = std::max(spread_z, std::max(z - it->z_lo, it->z_hi - z) * std::fabs(g.scale) *
-                                          depth_steps_);
+        spread_z = std::max(
+            spread_z, std::max(z - it->z_lo, it->z_hi - z) * std::fabs(g.scale) * depth_steps_);
     }
     const double fragment_reach = depth_reach + spread_z + 1.0;
     // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
@@ -820,8 +819,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
                                1.0 / (256.0 * chain[coarsest]->height));
         range = lodRange(chain, uv, lo, hi, shift, lod_state_);
       } else {
-        range = linearReachRange(*tex, uv, scene_.state.texture_wrap, 0.0, 0.0,
-                                 textureRangeOf(tex));
+        range =
+            linearReachRange(*tex, uv, scene_.state.texture_wrap, 0.0, 0.0, textureRangeOf(tex));
       }
       LitColor lit = t.flat;
       if constexpr (kShading == Shading::Gouraud) {
@@ -829,9 +828,9 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
                               w.y * t.gouraud[1]->ambient_diffuse +
                               w.z * t.gouraud[2]->ambient_diffuse;
       } else if constexpr (kShading == Shading::Phong) {
-        lit = shadePrepared(*t.shading, w.x * t.v[0]->world + w.y * t.v[1]->world + w.z * t.v[2]->world,
-                            safeNormalize(w.x * t.v[0]->normal + w.y * t.v[1]->normal +
-                                          w.z * t.v[2]->normal));
+        lit = shadePrepared(
+            *t.shading, w.x * t.v[0]->world + w.y * t.v[1]->world + w.z * t.v[2]->world,
+            safeNormalize(w.x * t.v[0]->normal + w.y * t.v[1]->normal + w.z * t.v[2]->normal));
       }
       double alt = 0.0;
       double light = 0.0;
@@ -848,29 +847,27 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     t.line_lambda = lambda_at(s, lo, hi);
     if (trace_ != nullptr) {
       trace.t = s;
-      trace.margin = segment ? segmentMargin(a, b, size, half_width, cx, cy)
-                             : pointMargin(a, size, cx, cy);
+      trace.margin =
+          segment ? segmentMargin(a, b, size, half_width, cx, cy) : pointMargin(a, size, cx, cy);
     }
-    generalFragment<kShading>(t, g, p.x, p.y, index, z,
-                              static_cast<float>(uncertainty_ ? fragment_reach : 0.0),
-                              [&] { return bary_at(s); }, nullptr, nullptr, 0.0, extra);
+    generalFragment<kShading>(
+        t, g, p.x, p.y, index, z, static_cast<float>(uncertainty_ ? fragment_reach : 0.0),
+        [&] { return bary_at(s); }, nullptr, nullptr, 0.0, extra);
   }
   t.line_lambda = std::numeric_limits<double>::quiet_NaN();
   trace = LineTrace{};
 }
 
 template void Renderer::shadeLineFragments<Shading::Flat>(const std::vector<LinePixel>&,
-                                                           const WindowVertex&,
-                                                           const WindowVertex&, bool, double,
-                                                           double, bool);
+                                                          const WindowVertex&, const WindowVertex&,
+                                                          bool, double, double, bool);
 template void Renderer::shadeLineFragments<Shading::Gouraud>(const std::vector<LinePixel>&,
-                                                              const WindowVertex&,
-                                                              const WindowVertex&, bool, double,
-                                                              double, bool);
+                                                             const WindowVertex&,
+                                                             const WindowVertex&, bool, double,
+                                                             double, bool);
 template void Renderer::shadeLineFragments<Shading::Phong>(const std::vector<LinePixel>&,
-                                                            const WindowVertex&,
-                                                            const WindowVertex&, bool, double,
-                                                            double, bool);
+                                                           const WindowVertex&, const WindowVertex&,
+                                                           bool, double, double, bool);
 
 void Renderer::shadeFanGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
                                const FragmentInterpolator& interp) {

@@ -9,8 +9,8 @@
 // fragment centre onto the segment while drivers interpolate along the major axis (up to
 // half a pixel, more for wide lines, apart: depth_reach and normal_reach).
 #include <algorithm>
-#include <vector>
 #include <cmath>
+#include <vector>
 
 #include "fixtures/scene_geometry.h"
 #include "reference/renderer_internal.h"
@@ -219,10 +219,11 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
   // border, and edges along it between them (their depth and colour join the dry run).
   std::vector<WindowVertex> crossings;
   std::vector<std::pair<WindowVertex, WindowVertex>> border_edges;
-  const double reach_px = points ? pass.ops.point_size / 2.0 + 1.0
-                                 : roundedWidth(pass.ops.line_width) / 2.0 + 1.0;
+  const double reach_px =
+      points ? pass.ops.point_size / 2.0 + 1.0 : roundedWidth(pass.ops.line_width) / 2.0 + 1.0;
   if (uncertainty_) {
-    const double bounds[2] = {static_cast<double>(scene_.width), static_cast<double>(scene_.height)};
+    const double bounds[2] = {static_cast<double>(scene_.width),
+                              static_cast<double>(scene_.height)};
     double lo[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}};  // [axis][side]
     double hi[2][2] = {{-INFINITY, -INFINITY}, {-INFINITY, -INFINITY}};
     WindowVertex border_lo[2][2]{};
@@ -305,8 +306,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
     }
     std::sort(hits.begin(), hits.end());
     for (std::size_t k = 1; k < hits.size(); ++k)
-      if (hits[k] == hits[k - 1] &&
-          (outline_shared_.empty() || outline_shared_.back() != hits[k]))
+      if (hits[k] == hits[k - 1] && (outline_shared_.empty() || outline_shared_.back() != hits[k]))
         outline_shared_.push_back(hits[k]);
   }
   auto draw = [&] {
@@ -320,8 +320,8 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
     }
     if (points) {
       for (int i = 0; i < count; ++i) {
-        const bool inside = wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 &&
-                            wv[i].y <= scene_.height;
+        const bool inside =
+            wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 && wv[i].y <= scene_.height;
         // (The dry run also records a vertex beyond the viewport: a driver may draw it.)
         if (original(wv[i].bary) && (inside || outline_dry_)) {
           drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
@@ -529,15 +529,15 @@ void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, d
                                  double depth_reach, bool polygon_vertex) {
   const double size = context_.pass->ops.point_size;
   // (A polygon outline's dry run: also the pixels a tie on the square's border may add.)
-  const std::vector<LinePixel> pixels = outline_dry_
-                                            ? pointCandidates(c, size)
-                                            : rasterizePoint(fc, size, options_.subpixel_bits, clip_);
+  const std::vector<LinePixel> pixels =
+      outline_dry_ ? pointCandidates(c, size)
+                   : rasterizePoint(fc, size, options_.subpixel_bits, clip_);
   // edge_dist: a pixel centre's distance to the square's border (inside or out), less the
   // vertex's reach: GL leaves centres on the border to the implementation.
   if (uncertainty_) {
     const double h = size / 2.0;
-    const bool crosses = c.x - h < 0.0 || c.y - h < 0.0 || c.x + h > scene_.width ||
-                         c.y + h > scene_.height;
+    const bool crosses =
+        c.x - h < 0.0 || c.y - h < 0.0 || c.x + h > scene_.width || c.y + h > scene_.height;
     for (int py = std::max(clip_.y0, static_cast<int>(std::floor(c.y - h - 1.5)));
          py < std::min(clip_.y1, static_cast<int>(std::ceil(c.y + h + 1.5))); ++py) {
       for (int px = std::max(clip_.x0, static_cast<int>(std::floor(c.x - h - 1.5)));
@@ -562,16 +562,13 @@ void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, d
   if (!outline_dry_) ++triangles_drawn_;
   switch (scene_.state.shading) {
     case Shading::Flat:
-      shadeLineFragments<Shading::Flat>(pixels, c, c, false, size, depth_reach,
-                                        polygon_vertex);
+      shadeLineFragments<Shading::Flat>(pixels, c, c, false, size, depth_reach, polygon_vertex);
       break;
     case Shading::Gouraud:
-      shadeLineFragments<Shading::Gouraud>(pixels, c, c, false, size, depth_reach,
-                                           polygon_vertex);
+      shadeLineFragments<Shading::Gouraud>(pixels, c, c, false, size, depth_reach, polygon_vertex);
       break;
     case Shading::Phong:
-      shadeLineFragments<Shading::Phong>(pixels, c, c, false, size, depth_reach,
-                                         polygon_vertex);
+      shadeLineFragments<Shading::Phong>(pixels, c, c, false, size, depth_reach, polygon_vertex);
       break;
   }
 }

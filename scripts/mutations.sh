@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The long mutation study of docs/campaigns.md: `rastercheck campaign --mutations` injects
-# each test-only GL fault (move_vertex, depth_bias, light_scale, texel_offset,
+# each test-only GL fault (move_vertex, move_line_end, move_point, depth_bias, light_scale, texel_offset,
 # drop_primitive, blend_factor, depth_func, stencil_op, blend_function, scissor_shift,
 # lod_shift, lod_weight) into
 # every random scene and reports, per fault, the

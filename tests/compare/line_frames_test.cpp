@@ -53,7 +53,8 @@ Scene lineScene(bool reversed, double end_shift_px, double point_shift_px, int s
     // Another grid: the end moved by less than a 256th of a pixel.
     if (subpixel_moved != 0) end += glm::dvec2(0.003, -0.002) * static_cast<double>(subpixel_moved);
     const auto base = static_cast<std::uint32_t>(star.mesh.positions.size());
-    star.mesh.positions.emplace_back(static_cast<float>(c.x), static_cast<float>(c.y), -0.3f * (k % 3));
+    star.mesh.positions.emplace_back(static_cast<float>(c.x), static_cast<float>(c.y),
+                                     -0.3f * (k % 3));
     star.mesh.positions.emplace_back(static_cast<float>(end.x), static_cast<float>(end.y), 0.0f);
     star.mesh.lines.push_back(reversed ? std::array{base + 1, base} : std::array{base, base + 1});
   }
@@ -64,7 +65,8 @@ Scene lineScene(bool reversed, double end_shift_px, double point_shift_px, int s
   dots.name = "dots";
   dots.primitive = PrimitiveKind::Points;
   for (int k = 0; k < 6; ++k) {
-    const float x = 100.3f + static_cast<float>(k % 2) * 14.0f + (k == 3 ? static_cast<float>(point_shift_px) : 0.0f);
+    const float x = 100.3f + static_cast<float>(k % 2) * 14.0f +
+                    (k == 3 ? static_cast<float>(point_shift_px) : 0.0f);
     dots.mesh.positions.emplace_back(x, 12.2f + 14.0f * static_cast<float>(k / 2), 0.0f);
   }
   dots.mesh.normals.assign(dots.mesh.positions.size(), glm::vec3(0, 0, 1));

@@ -81,6 +81,11 @@ TEST(DebugGl, ExplainJsonKeysBothWaysIncludingABackendThatCannotRun) {
                          " --pixel 80,60 --json --backends ref");
   ASSERT_EQ(lod.code, 0) << lod.err;
   collectKeys(json::parse(lod.out), "", seen);
+  // Lines and points (documented keys fragments[].line.*), against llvmpipe.
+  const Result line = run("explain " + catalog("lines/star_octants.json") +
+                          " --pixel 95,52 --json --backends " + kLlvmpipe);
+  ASSERT_EQ(line.code, 0) << line.err;
+  collectKeys(json::parse(line.out), "", seen);
   for (const std::string& k : seen) EXPECT_TRUE(documented.count(k)) << "undocumented key " << k;
   for (const std::string& k : documented) EXPECT_TRUE(seen.count(k)) << "never seen " << k;
 }

@@ -246,8 +246,8 @@ TEST(Explain, ABufferListIsSortedAndEndsInTheExactColour) {
 
 TEST(Explain, ALinePixelTellsItsSegmentTheRuleAndTheParameter) {
   // Pixel (95, 52) of the star: segment 2 (primitive 3) passes through it, inside.
-  const Result r = run("explain " + catalog("lines/star_octants.json") +
-                       " --pixel 95,52 --backends ref --json");
+  const Result r =
+      run("explain " + catalog("lines/star_octants.json") + " --pixel 95,52 --backends ref --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const json doc = json::parse(r.out);
   ASSERT_FALSE(doc["fragments"].empty());

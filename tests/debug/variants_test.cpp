@@ -286,7 +286,8 @@ TEST(Variants, LineProbeTellsTheRulesApart) {
     for (int gy = h - 1; gy > 0; --gy) {
       // Thin segment 0 (x-major or not, its pixels move up one row in its middle third).
       const double mid = (thin.a.x + thin.b.x) / 2.0;
-      if (reference.id[reference.index(x, h - 1 - gy)] == thin.primitive && std::abs(x + 0.5 - mid) < 2.0) {
+      if (reference.id[reference.index(x, h - 1 - gy)] == thin.primitive &&
+          std::abs(x + 0.5 - mid) < 2.0) {
         at(x, gy) = 0;
         at(x, gy + 1) = thin.primitive;
       }
