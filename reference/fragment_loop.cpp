@@ -739,7 +739,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       lambda_at(s, lo, hi);
       // Sampled at kSteps + 1 parameters; untextured, the largest change between neighbouring
       // samples is added (how far the smooth lighting can go past the samples between two).
-      constexpr int kSteps = 24;
+      constexpr int kSteps = 48;
       double worst = 0.0;
       double step = 0.0;
       glm::dvec4 last(0.0);

@@ -21,6 +21,11 @@ namespace {
 // GL rounds a non-antialiased line's width to the nearest integer, 0 counting as 1 (halves
 // up here, as in line_raster.h).
 double roundedWidth(double width) { return std::max(1.0, std::floor(width + 0.5)); }
+// A width of k + 1/2, which may round either way.
+bool halfWidth(const DrawPass& pass) {
+  const double w = pass.ops.line_width;
+  return w > 1.0 && w - std::floor(w) == 0.5;
+}
 
 // Clips the segment c0 -> c1 to the view volume (GL 13.7: |x|, |y|, |z| <= w); false when
 // nothing is left. Against x and y too: a wide line is widened from its clipped centre
@@ -276,14 +281,15 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
     for (int i = 0; i < count; ++i) {
       std::vector<LinePixel> pixels;
       if (points) {
-        if (original(wv[i].bary)) pixels = pointCandidates(wv[i], pass.ops.point_size);
+        // (Every vertex: one made by clipping is a driver's point too, with its depth.)
+        pixels = pointCandidates(wv[i], pass.ops.point_size);
       } else {
         const int j = (i + 1) % count;
         pixels = roundedWidth(pass.ops.line_width) == 1.0
                      ? rasterizeLine(fv[i], fv[j], bits, clip_)
                      : rasterizeWideLine(fv[i], fv[j], pass.ops.line_width, bits, clip_);
         const std::vector<LinePixel> ends =
-            endCandidates(wv[i], wv[j], roundedWidth(pass.ops.line_width));
+            endCandidates(wv[i], wv[j], roundedWidth(pass.ops.line_width), halfWidth(pass));
         pixels.insert(pixels.end(), ends.begin(), ends.end());
       }
       for (const LinePixel& p : pixels)
@@ -301,7 +307,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
       for (const auto& [a, b] : border_edges) {
         add(rasterizeLine(snapVertexScaled(a.x, a.y, snap_scale_),
                           snapVertexScaled(b.x, b.y, snap_scale_), bits, clip_));
-        add(endCandidates(a, b, roundedWidth(pass.ops.line_width)));
+        add(endCandidates(a, b, roundedWidth(pass.ops.line_width), halfWidth(pass)));
       }
     }
     std::sort(hits.begin(), hits.end());
@@ -322,8 +328,9 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
       for (int i = 0; i < count; ++i) {
         const bool inside =
             wv[i].x >= 0.0 && wv[i].x <= scene_.width && wv[i].y >= 0.0 && wv[i].y <= scene_.height;
-        // (The dry run also records a vertex beyond the viewport: a driver may draw it.)
-        if (original(wv[i].bary) && (inside || outline_dry_)) {
+        // (The dry run also records a vertex beyond the viewport or made by clipping: a
+        // driver may draw it.)
+        if ((original(wv[i].bary) && inside) || outline_dry_) {
           drawPointWindowed(wv[i], fv[i], reach[i], depth_reach[i], true);
           if (!inside && uncertainty_) markAmbiguous(wv[i], wv[i], reach_px);
         } else if (uncertainty_) {
@@ -339,6 +346,10 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
         boundary = boundary || (wv[i].bary[k] == 0.0 && wv[j].bary[k] == 0.0);
       if (!boundary) {
         if (uncertainty_) markAmbiguous(wv[i], wv[j], reach_px);
+        // The dry run records the edge clipping made: a driver may draw it, with its depths.
+        if (outline_dry_)
+          drawSegmentWindowed(wv[i], wv[j], fv[i], fv[j], std::max(reach[i], reach[j]),
+                              std::max(depth_reach[i], depth_reach[j]), true);
         continue;
       }
       // Clipped to the viewport, as GL clips the polygon before it draws its edges (a wide
@@ -386,27 +397,31 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
 // (an x-major segment; else rows) within a pixel of an end point, those within w / 2 + 1 px
 // of the segment in the minor direction.
 std::vector<LinePixel> Renderer::endCandidates(const WindowVertex& a, const WindowVertex& b,
-                                               double w) const {
+                                               double w, bool half) const {
+  // Within kTieMarginPx of the rule's other decision: beyond any snapping or float32 error.
+  constexpr double kTieMarginPx = 1.0 / 16.0;
   std::vector<LinePixel> out;
   const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
   const double ma = x_major ? a.x : a.y;
   const double mb = x_major ? b.x : b.y;
   const double na = x_major ? a.y : a.x;
   const double nb = x_major ? b.y : b.x;
-  for (const double end : {ma, mb}) {
-    const double n_end = end == ma ? na : nb;
-    for (int m = static_cast<int>(std::floor(end - 1.5)); m <= static_cast<int>(end + 1.5); ++m) {
-      const double mc = m + 0.5;
-      if (std::fabs(mc - end) >= 1.0) continue;
-      const double n_line = ma != mb ? na + (mc - ma) * (nb - na) / (mb - ma) : n_end;
-      for (int n = static_cast<int>(std::floor(n_line - w / 2 - 1.5));
-           n <= static_cast<int>(std::ceil(n_line + w / 2 + 1.5)); ++n) {
-        if (std::fabs(n + 0.5 - n_line) >= w / 2 + 1.0) continue;
-        const int px = x_major ? m : n;
-        const int py = x_major ? n : m;
-        if (px < clip_.x0 || px >= clip_.x1 || py < clip_.y0 || py >= clip_.y1) continue;
-        out.push_back({px, py});
-      }
+  const double lo = std::min(ma, mb);
+  const double hi = std::max(ma, mb);
+  const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
+  for (int m = static_cast<int>(std::floor(lo - 1.5)); m <= static_cast<int>(std::ceil(hi + 1.5));
+       ++m) {
+    const double mc = m + 0.5;
+    if (mc <= lo - 1.0 || mc >= hi + 1.0) continue;
+    const double n_line = na + (std::clamp(mc, lo, hi) - ma) * slope;
+    for (int n = static_cast<int>(std::floor(n_line - w / 2 - 1.5));
+         n <= static_cast<int>(std::ceil(n_line + w / 2 + 1.5)); ++n) {
+      if (std::fabs(n + 0.5 - n_line) >= w / 2 + 1.0) continue;
+      const int px = x_major ? m : n;
+      const int py = x_major ? n : m;
+      if (px < clip_.x0 || px >= clip_.x1 || py < clip_.y0 || py >= clip_.y1) continue;
+      if (segmentMargin(a, b, w, half, px + 0.5, py + 0.5) >= kTieMarginPx) continue;
+      out.push_back({px, py});
     }
   }
   return out;
@@ -460,13 +475,14 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
                                       ? rasterizeLine(fa, fb, bits, clip_)
                                       : rasterizeWideLine(fa, fb, width, bits, clip_);
   const double w = roundedWidth(width);
+  const bool half = width > 1.0 && width - std::floor(width) == 0.5;
   // The dry run of a polygon outline also records the fragments a driver may add at the
-  // segment's ends (another edge's pixel there may then hold this edge's depth and colour).
+  // segment's ends and ties (another edge's pixel there may then hold this edge's depth and
+  // colour).
   if (outline_dry_) {
-    const std::vector<LinePixel> ends = endCandidates(a, b, w);
+    const std::vector<LinePixel> ends = endCandidates(a, b, w, half);
     pixels.insert(pixels.end(), ends.begin(), ends.end());
   }
-  const bool half = width > 1.0 && width - std::floor(width) == 0.5;
   // edge_dist: how close each pixel near the segment came to the other decision, less the
   // vertices' reach. In the segment's major direction, per column (x-major) or row: the
   // one-pixel rule produces the pixel whose centre is within w/2 of the segment measured
@@ -474,6 +490,14 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
   // wide lines), so a pixel's margin is | |minor offset| - w/2 |. At each end, the columns
   // within a pixel of the end point are the driver's (GL's rules for the initial and
   // final fragments allow another fragment count and fragments one pixel away there).
+  // A segment at 45 degrees to within its vertices' error may be x-major for a driver
+  // and y-major here: a wide line's columns become rows, its ends another shape. Its whole
+  // band is the driver's then.
+  if (uncertainty_ &&
+      std::fabs(std::fabs(b.x - a.x) - std::fabs(b.y - a.y)) <=
+          2.0 * reach + 2.0 * std::ldexp(1.0, -options_.subpixel_bits)) {
+    markAmbiguous(a, b, w / 2.0 + 1.0);
+  }
   if (uncertainty_) {
     const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
     const double ma = x_major ? a.x : a.y;

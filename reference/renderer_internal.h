@@ -349,8 +349,10 @@ class Renderer {
   void drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, double reach,
                          double depth_reach, bool polygon_vertex);
   void markAmbiguous(const WindowVertex& a, const WindowVertex& b, double radius);
-  std::vector<LinePixel> endCandidates(const WindowVertex& a, const WindowVertex& b,
-                                       double w) const;
+  // The pixels GL leaves to the driver near the segment: its end columns, and those within
+  // a 16th of a pixel of the rule's other decision (line_loop.cpp).
+  std::vector<LinePixel> endCandidates(const WindowVertex& a, const WindowVertex& b, double w,
+                                       bool half) const;
   std::vector<LinePixel> pointCandidates(const WindowVertex& c, double size) const;
   template <Shading kShading>
   void shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
