@@ -607,7 +607,8 @@ LineProbe lineProbe() {
   auto dyadic = [](glm::dvec2 v) { return glm::round(v * 64.0) / 64.0; };
   for (int k = 0; k < 16; ++k) {
     const double angle = 2.0 * 3.14159265358979323846 * (k + 0.37) / 16.0;
-    const glm::dvec2 c(10.5 + 21.0 * (k % 4) + 0.3125, 7.5 + 15.0 * (k / 4) + 0.1875);
+    const glm::dvec2 c(10.5 + 21.0 * (k % 4) + 0.3125,
+                       7.5 + 15.0 * static_cast<double>(k / 4) + 0.1875);
     const glm::dvec2 d(std::cos(angle), std::sin(angle));
     add(LineProbeItem::Kind::Thin, dyadic(c - 6.0 * d), dyadic(c + 6.0 * d), 1.0);
   }
@@ -616,7 +617,8 @@ LineProbe lineProbe() {
   add(LineProbeItem::Kind::Wide, dyadic({44.3125, 64.1875}), dyadic({59.3125, 90.1875}), 4.0);
   // Points of size 3.5 and 5 at quarter-pixel positions, right of the segments.
   for (int k = 0; k < 8; ++k) {
-    const glm::dvec2 c(92.0 + 9.0 * (k % 4) + 0.25 * k, 10.0 + 12.0 * (k / 4) + 0.125);
+    const glm::dvec2 c(92.0 + 9.0 * (k % 4) + 0.25 * k,
+                       10.0 + 12.0 * static_cast<double>(k / 4) + 0.125);
     add(LineProbeItem::Kind::Point, c, c, k % 2 == 0 ? 3.5 : 5.0);
   }
   return probe;

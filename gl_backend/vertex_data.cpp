@@ -136,9 +136,9 @@ VertexData buildVertexData(const Scene& scene, const std::vector<DrawPass>& pass
         // centroid stay where they were, so the error is geometry alone. move_line_end and
         // move_point likewise for a segment's second vertex and a point.
         glm::dvec3 position = wm.positions[vi];
-        if (k == 0 && count == 3 && prim.id == faults.move_vertex) {
-          position = onePixelRight(position, view_projection, scene.width);
-        } else if (k == 0 && count == 1 && prim.id == faults.move_point) {
+        const bool moved_right = (k == 0 && count == 3 && prim.id == faults.move_vertex) ||
+                                 (k == 0 && count == 1 && prim.id == faults.move_point);
+        if (moved_right) {
           position = onePixelRight(position, view_projection, scene.width);
         } else if (k == 1 && count == 2 && prim.id == faults.move_line_end) {
           position = onePixelAcross(wm.positions[tri[0]], position, view_projection, scene.width,

@@ -127,4 +127,23 @@ bool clipTriangle(const glm::dvec4& c0, const glm::dvec4& c1, const glm::dvec4& 
   return true;
 }
 
+bool clipSegment(ClipVertex& a, ClipVertex& b, const ClipVolume& volume) {
+  // Plane by plane, each end outside it moved to the crossing (Sutherland-Hodgman for two
+  // vertices), with the intersection's error as for polygons.
+  for (int p = 0; p < kPlaneCount; ++p) {
+    const double da = distance(a.clip, p, volume);
+    const double db = distance(b.clip, p, volume);
+    const bool a_in = da >= 0.0;
+    const bool b_in = db >= 0.0;
+    if (!a_in && !b_in) return false;
+    if (a_in && b_in) continue;
+    if (a_in) {
+      b = lerpFromInside(a, da, b, db, p, volume);
+    } else {
+      a = lerpFromInside(b, db, a, da, p, volume);
+    }
+  }
+  return true;
+}
+
 }  // namespace rc::ref

@@ -94,6 +94,11 @@ inline ClipClass classifyTriangle(const glm::dvec4& c0, const glm::dvec4& c1, co
 // from the inside vertex towards the outside one, so an edge shared by two triangles is
 // cut at bit-identical points in both (no cracks along clipped shared edges).
 // `errors` (optional): the three vertices' clip-space error bounds (ClipVertex::err).
+// The segment a -> b clipped to `volume` in place (each end outside a plane moved to where
+// it crosses it, with that point's float32 error as for polygons); false when nothing is
+// left.
+bool clipSegment(ClipVertex& a, ClipVertex& b, const ClipVolume& volume);
+
 bool clipTriangle(const glm::dvec4& c0, const glm::dvec4& c1, const glm::dvec4& c2,
                   const ClipVolume& volume, ClipPolygon& out, const glm::dvec4* errors = nullptr);
 

@@ -27,40 +27,6 @@ bool halfWidth(const DrawPass& pass) {
   return w > 1.0 && w - std::floor(w) == 0.5;
 }
 
-// Clips the segment c0 -> c1 to the view volume (GL 13.7: |x|, |y|, |z| <= w); false when
-// nothing is left. Against x and y too: a wide line is widened from its clipped centre
-// line, so the part of its width that reaches into the viewport past the segment's exit
-// is not drawn (llvmpipe and zink clip so). A clipped end lies on the viewport's border,
-// where GL's end rules leave the last fragments to the driver.
-bool clipSegment(ClipVertex& c0, ClipVertex& c1) {
-  double t0 = 0.0;
-  double t1 = 1.0;
-  auto plane = [&](double d0, double d1) {
-    if (d0 < 0.0 && d1 < 0.0) return false;
-    if (d0 < 0.0) t0 = std::max(t0, d0 / (d0 - d1));
-    if (d1 < 0.0) t1 = std::min(t1, d0 / (d0 - d1));
-    return t0 <= t1;
-  };
-  const glm::dvec4& a = c0.clip;
-  const glm::dvec4& b = c1.clip;
-  if (!plane(a.w + a.z, b.w + b.z) || !plane(a.w - a.z, b.w - b.z) ||
-      !plane(a.w - a.x, b.w - b.x) || !plane(a.w + a.x, b.w + b.x) ||
-      !plane(a.w - a.y, b.w - b.y) || !plane(a.w + a.y, b.w + b.y))
-    return false;
-  const ClipVertex from = c0;
-  const ClipVertex to = c1;
-  auto at = [&](double t) {
-    ClipVertex v;
-    v.clip = from.clip + t * (to.clip - from.clip);
-    v.bary = from.bary + t * (to.bary - from.bary);
-    v.err = glm::max(from.err, to.err);
-    return v;
-  };
-  if (t0 > 0.0) c0 = at(t0);
-  if (t1 < 1.0) c1 = at(t1);
-  return true;
-}
-
 // The point a fraction f of the way from a to b in window space: x, y, z and 1/w affine, the
 // barycentrics divided by w too.
 WindowVertex lerpWindow(const WindowVertex& a, const WindowVertex& b, double f) {
@@ -163,7 +129,13 @@ void Renderer::drawLineOrPoint(const PrimitiveRef& prim, const DrawPass& pass) {
 void Renderer::drawSegment(const ClipVertex& a, const ClipVertex& b, bool polygon_edge) {
   ClipVertex c0 = a;
   ClipVertex c1 = b;
-  if (!clipSegment(c0, c1)) return;
+  // To the view volume (GL 13.7: |x|, |y|, |z| <= w), not the guard band: a wide line is
+  // widened from its clipped centre line, so the part of its width that reaches into the
+  // viewport past the segment's exit is not drawn (llvmpipe and zink clip so). A clipped
+  // end lies on the border, where GL's end rules leave the last fragments to the driver.
+  ClipVolume view = volume_;
+  view.guard_x = view.guard_y = 1.0;
+  if (!clipSegment(c0, c1, view)) return;
   WindowVertex w0{};
   WindowVertex w1{};
   FixedVertex f0{};
@@ -289,7 +261,8 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
                      ? rasterizeLine(fv[i], fv[j], bits, clip_)
                      : rasterizeWideLine(fv[i], fv[j], pass.ops.line_width, bits, clip_);
         const std::vector<LinePixel> ends =
-            endCandidates(wv[i], wv[j], roundedWidth(pass.ops.line_width), halfWidth(pass));
+            endCandidates(wv[i], wv[j], roundedWidth(pass.ops.line_width), halfWidth(pass),
+                          std::max(reach[i], reach[j]));
         pixels.insert(pixels.end(), ends.begin(), ends.end());
       }
       for (const LinePixel& p : pixels)
@@ -307,7 +280,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
       for (const auto& [a, b] : border_edges) {
         add(rasterizeLine(snapVertexScaled(a.x, a.y, snap_scale_),
                           snapVertexScaled(b.x, b.y, snap_scale_), bits, clip_));
-        add(endCandidates(a, b, roundedWidth(pass.ops.line_width), halfWidth(pass)));
+        add(endCandidates(a, b, roundedWidth(pass.ops.line_width), halfWidth(pass), 0.0));
       }
     }
     std::sort(hits.begin(), hits.end());
@@ -397,7 +370,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
 // (an x-major segment; else rows) within a pixel of an end point, those within w / 2 + 1 px
 // of the segment in the minor direction.
 std::vector<LinePixel> Renderer::endCandidates(const WindowVertex& a, const WindowVertex& b,
-                                               double w, bool half) const {
+                                               double w, bool half, double end_reach) const {
   // Within kTieMarginPx of the rule's other decision: beyond any snapping or float32 error.
   constexpr double kTieMarginPx = 1.0 / 16.0;
   std::vector<LinePixel> out;
@@ -409,18 +382,18 @@ std::vector<LinePixel> Renderer::endCandidates(const WindowVertex& a, const Wind
   const double lo = std::min(ma, mb);
   const double hi = std::max(ma, mb);
   const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
-  for (int m = static_cast<int>(std::floor(lo - 1.5)); m <= static_cast<int>(std::ceil(hi + 1.5));
-       ++m) {
+  for (int m = static_cast<int>(std::floor(lo - 1.5 - end_reach));
+       m <= static_cast<int>(std::ceil(hi + 1.5 + end_reach)); ++m) {
     const double mc = m + 0.5;
-    if (mc <= lo - 1.0 || mc >= hi + 1.0) continue;
-    const double n_line = na + (std::clamp(mc, lo, hi) - ma) * slope;
+    if (mc <= lo - 1.0 - end_reach || mc >= hi + 1.0 + end_reach) continue;
+    const double n_line = na + (mc - ma) * slope;
     for (int n = static_cast<int>(std::floor(n_line - w / 2 - 1.5));
          n <= static_cast<int>(std::ceil(n_line + w / 2 + 1.5)); ++n) {
       if (std::fabs(n + 0.5 - n_line) >= w / 2 + 1.0) continue;
       const int px = x_major ? m : n;
       const int py = x_major ? n : m;
       if (px < clip_.x0 || px >= clip_.x1 || py < clip_.y0 || py >= clip_.y1) continue;
-      if (segmentMargin(a, b, w, half, px + 0.5, py + 0.5) >= kTieMarginPx) continue;
+      if (segmentMargin(a, b, w, half, px + 0.5, py + 0.5, end_reach) >= kTieMarginPx) continue;
       out.push_back({px, py});
     }
   }
@@ -480,7 +453,7 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
   // segment's ends and ties (another edge's pixel there may then hold this edge's depth and
   // colour).
   if (outline_dry_) {
-    const std::vector<LinePixel> ends = endCandidates(a, b, w, half);
+    const std::vector<LinePixel> ends = endCandidates(a, b, w, half, reach);
     pixels.insert(pixels.end(), ends.begin(), ends.end());
   }
   // edge_dist: how close each pixel near the segment came to the other decision, less the
@@ -493,9 +466,8 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
   // A segment at 45 degrees to within its vertices' error may be x-major for a driver
   // and y-major here: a wide line's columns become rows, its ends another shape. Its whole
   // band is the driver's then.
-  if (uncertainty_ &&
-      std::fabs(std::fabs(b.x - a.x) - std::fabs(b.y - a.y)) <=
-          2.0 * reach + 2.0 * std::ldexp(1.0, -options_.subpixel_bits)) {
+  if (uncertainty_ && std::fabs(std::fabs(b.x - a.x) - std::fabs(b.y - a.y)) <=
+                          2.0 * reach + 2.0 * std::ldexp(1.0, -options_.subpixel_bits)) {
     markAmbiguous(a, b, w / 2.0 + 1.0);
   }
   if (uncertainty_) {
@@ -511,12 +483,12 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
     const int major_hi = x_major ? clip_.x1 : clip_.y1;
     const int minor_lo = x_major ? clip_.y0 : clip_.x0;
     const int minor_hi = x_major ? clip_.y1 : clip_.x1;
-    const int first = std::max(major_lo, static_cast<int>(std::floor(lo - 1.5)));
-    const int last = std::min(major_hi - 1, static_cast<int>(std::ceil(hi + 1.5)));
+    const int first = std::max(major_lo, static_cast<int>(std::floor(lo - 1.5 - reach)));
+    const int last = std::min(major_hi - 1, static_cast<int>(std::ceil(hi + 1.5 + reach)));
     for (int m = first; m <= last; ++m) {
       const double mc = m + 0.5;
-      if (mc <= lo - 1.0 || mc >= hi + 1.0) continue;
-      const double n_line = na + (std::clamp(mc, lo, hi) - ma) * slope;
+      if (mc <= lo - 1.0 - reach || mc >= hi + 1.0 + reach) continue;
+      const double n_line = na + (mc - ma) * slope;
       const int n_first = std::max(minor_lo, static_cast<int>(std::floor(n_line - w / 2 - 1.5)));
       const int n_last = std::min(minor_hi - 1, static_cast<int>(std::ceil(n_line + w / 2 + 1.5)));
       for (int n = n_first; n <= n_last; ++n) {
@@ -524,7 +496,7 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
         if (off >= w / 2 + 1.0) continue;
         const double cx = x_major ? mc : n + 0.5;
         const double cy = x_major ? n + 0.5 : mc;
-        const double margin = std::max(0.0, segmentMargin(a, b, w, half, cx, cy) - reach);
+        const double margin = std::max(0.0, segmentMargin(a, b, w, half, cx, cy, reach) - reach);
         const int px = x_major ? m : n;
         const int py = x_major ? n : m;
         const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +

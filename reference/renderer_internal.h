@@ -146,10 +146,11 @@ struct GeneralSetup {
 // How close the pixel centre (cx, cy) comes to the other decision of GL's rule for the
 // segment a -> b of rounded width w (px, measured in the minor direction: | |offset| - w/2 |),
 // 0 in the columns (rows) within a pixel of an end, where GL leaves the fragment to the
-// driver, and for a width of k + 1/2 (either width) between the two bands. The reach of the
-// vertices is not subtracted.
+// driver (and `end_reach` px more: how far float32 may move an end, a clipped one far), and
+// for a width of k + 1/2 (either width) between the two bands. The reach of the vertices is
+// not subtracted.
 inline double segmentMargin(const WindowVertex& a, const WindowVertex& b, double w, bool half,
-                            double cx, double cy) {
+                            double cx, double cy, double end_reach = 0.0) {
   const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
   const double ma = x_major ? a.x : a.y;
   const double mb = x_major ? b.x : b.y;
@@ -161,7 +162,8 @@ inline double segmentMargin(const WindowVertex& a, const WindowVertex& b, double
   const double hi = std::max(ma, mb);
   const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
   const double off = std::fabs(nc - (na + (std::clamp(mc, lo, hi) - ma) * slope));
-  const bool end = std::fabs(mc - ma) < 1.0 || std::fabs(mc - mb) < 1.0 || mc <= lo || mc >= hi;
+  const bool end = std::fabs(mc - ma) < 1.0 + end_reach || std::fabs(mc - mb) < 1.0 + end_reach ||
+                   mc <= lo || mc >= hi;
   if (end) return 0.0;
   if (!half) return std::fabs(off - w / 2);
   // Either width, w or w - 1: the rows between are open, the rest decided by the nearer.
@@ -352,7 +354,7 @@ class Renderer {
   // The pixels GL leaves to the driver near the segment: its end columns, and those within
   // a 16th of a pixel of the rule's other decision (line_loop.cpp).
   std::vector<LinePixel> endCandidates(const WindowVertex& a, const WindowVertex& b, double w,
-                                       bool half) const;
+                                       bool half, double end_reach) const;
   std::vector<LinePixel> pointCandidates(const WindowVertex& c, double size) const;
   template <Shading kShading>
   void shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
