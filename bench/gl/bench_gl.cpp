@@ -187,6 +187,11 @@ void BM_SmallTriangleMesh(benchmark::State& state) {
   renderScene(state, scene);
 }
 
+void BM_Lines(benchmark::State& state) {
+  static const rc::Scene scene = rc::bench::linesAndPoints();
+  renderScene(state, scene);
+}
+
 void BM_Layers(benchmark::State& state) {
   static const rc::Scene scenes[3] = {rc::bench::layers(rc::Shading::Flat),
                                       rc::bench::layers(rc::Shading::Gouraud),
@@ -211,6 +216,7 @@ BENCHMARK(BM_Stages1080p)
 BENCHMARK(BM_HarnessOverhead1080p)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SmallTriangles)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SmallTriangleMesh)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Lines)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Layers)
     ->ArgName("shading")
     ->DenseRange(0, 2)

@@ -56,4 +56,6 @@ Scene smallTriangleMesh() { return test::smallTriangleMeshScene(kRefSize, 100000
 
 Scene layers(Shading shading) { return test::layersScene(shading, kRefSize, 8); }
 
+Scene linesAndPoints() { return test::linesScene(kRefSize, 20000); }
+
 }  // namespace rc::bench

@@ -20,5 +20,8 @@ Scene smallTriangles();
 Scene smallTriangleMesh();
 // 8 full-screen rectangles back to front, one point light, Blinn-Phong, shininess 32.
 Scene layers(Shading shading);
+// 20k segments (random ends, 2 to 60 px long, every third 3 px wide) and 20k points of size
+// 3, Gouraud with one point light, depth tested: lines and points at scale.
+Scene linesAndPoints();
 
 }  // namespace rc::bench

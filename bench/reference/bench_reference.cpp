@@ -75,6 +75,14 @@ BENCHMARK(BM_Layers)
     ->ArgsProduct({{0, 1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 
+// 20k segments (a third 3 px wide) and 20k points of size 3, Gouraud: the line and point
+// path (line_loop.cpp), whose channels also sample each fragment's colour slack.
+void BM_Lines(benchmark::State& state) {
+  static const Scene scene = test::linesScene(kSize, 20000);
+  run(state, scene, state.range(0) != 0);
+}
+BENCHMARK(BM_Lines)->ArgName("uncertainty")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 // The fixed cost of a 1024 x 1024 frame with nothing in it (allocation, clear, output).
 void BM_EmptyFrame(benchmark::State& state) {
   static const Scene scene = test::windowScene(kSize, kSize);

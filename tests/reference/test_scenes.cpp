@@ -310,4 +310,50 @@ Scene layersScene(Shading shading, int size, int layers) {
   return s;
 }
 
+Scene linesScene(int size, int count) {
+  Scene s = windowScene(size, size);
+  s.name = "bench/lines";
+  s.state.shading = Shading::Gouraud;
+  s.ambient_light = glm::dvec3(0.1);
+  const double k = size / 1024.0;
+  s.lights.push_back(
+      Light{LightType::Point, {300.0 * k, 700.0 * k, 400.0 * k}, {}, {1.0, 1.0, 1.0}, 1.0});
+  s.materials[0].diffuse = {0.6, 0.5, 0.4};
+  std::uint32_t seed = 7;
+  auto unit = [&]() {
+    seed = seed * 1664525u + 1013904223u;
+    return static_cast<float>(seed >> 8) / static_cast<float>(1 << 24);
+  };
+  const auto span = static_cast<float>(size - 64);
+  Object thin;
+  thin.name = "thin";
+  thin.primitive = PrimitiveKind::Lines;
+  Object wide = thin;
+  wide.name = "wide";
+  wide.state.line_width = 3.0;
+  Object points;
+  points.name = "points";
+  points.primitive = PrimitiveKind::Points;
+  points.state.point_size = 3.0;
+  for (int i = 0; i < count; ++i) {
+    const float x = 32.0f + unit() * span;
+    const float y = 32.0f + unit() * span;
+    const float z = 0.25f + 0.5f * unit();
+    const float length = 2.0f + 58.0f * unit();
+    const float angle = 6.2831853f * unit();
+    Object& o = i % 3 == 0 ? wide : thin;
+    const auto base = static_cast<std::uint32_t>(o.mesh.positions.size());
+    o.mesh.positions.push_back({x, y, z});
+    o.mesh.positions.push_back(
+        {x + length * std::cos(angle), y + length * std::sin(angle), z + 0.1f * unit()});
+    o.mesh.lines.push_back({base, base + 1});
+    points.mesh.positions.push_back({32.0f + unit() * span, 32.0f + unit() * span, z});
+  }
+  for (Object* o : {&thin, &wide, &points}) {
+    o->mesh.normals.assign(o->mesh.positions.size(), {0.0f, 0.0f, 1.0f});
+    s.objects.push_back(std::move(*o));
+  }
+  return s;
+}
+
 }  // namespace rc::test

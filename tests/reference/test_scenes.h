@@ -74,4 +74,9 @@ Scene smallTriangleMeshScene(int size = 1024, int count = 100000);
 // (layers * size^2 fragments per frame).
 Scene layersScene(Shading shading, int size = 1024, int layers = 8);
 
+// `count` segments with pseudo-random ends 2 to 60 px apart (every third drawn 3 px wide,
+// the rest one pixel) and `count` points of size 3, in a size x size window scene, Gouraud
+// with one point light, depths in [0.25, 0.75): lines and points at scale.
+Scene linesScene(int size = 1024, int count = 20000);
+
 }  // namespace rc::test
