@@ -78,6 +78,42 @@ TEST(Robustness, EmptyMeshesAndEmptyScenes) {
   EXPECT_NO_THROW(renderReference(s));
 }
 
+TEST(Robustness, DegenerateAndNonFiniteLinesAndPoints) {
+  // A zero-length segment draws nothing (its end lies in its start's diamond); a loop of one
+  // position has one zero-length segment; non-finite and enormous ends are dropped or
+  // clipped; a point far outside marks nothing but its own neighbourhood; wide everything.
+  Scene s = test::windowScene(32, 24);
+  s.state.shading = Shading::Phong;
+  s.state.ops.line_width = 7.0;
+  s.state.ops.point_size = 64.0;
+  auto add = [&](PrimitiveKind kind, std::vector<glm::vec3> positions,
+                 std::vector<std::array<std::uint32_t, 2>> lines) {
+    Object o;
+    o.primitive = kind;
+    o.mesh.positions = std::move(positions);
+    o.mesh.normals.assign(o.mesh.positions.size(), glm::vec3(0, 0, 1));
+    o.mesh.lines = std::move(lines);
+    s.objects.push_back(std::move(o));
+  };
+  add(PrimitiveKind::Lines, {{10.3f, 10.2f, 0.5f}}, {{0, 0}});                  // id 1
+  add(PrimitiveKind::Lines, {{kNaN, 1, 0.5f}, {30, 20, 0.5f}}, {{0, 1}});       // id 2
+  add(PrimitiveKind::Lines, {{-3e38f, 1e38f, 0.5f}, {20, 5, 0.5f}}, {{0, 1}});  // id 3
+  add(PrimitiveKind::Points, {{3e38f, 1e38f, 0.5f}, {16, 12, kInf}}, {});       // 4, 5
+  add(PrimitiveKind::Lines, {}, {});                                            // empty
+  const Frame f = renderReference(s);
+  int drawn_segment = 0;
+  for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+    EXPECT_TRUE(f.id[i] == 0u || f.id[i] == 3u) << f.id[i];
+    drawn_segment += f.id[i] == 3u;
+    EXPECT_TRUE(f.depth[i] >= 0.0f && f.depth[i] <= 1.0f);
+    EXPECT_TRUE(std::isfinite(f.color[4 * i]));
+  }
+  EXPECT_GT(drawn_segment, 20) << "the clipped huge segment still crosses the window";
+  // The same, traced at a pixel of it: no crash, the fragments of id 3 only.
+  const std::vector<FragmentTrace> trace = tracePixel(s, ReferenceOptions{}, 16, 16);
+  for (const FragmentTrace& t : trace) EXPECT_EQ(t.primitive, 3u);
+}
+
 TEST(Robustness, OneByOneImage) {
   Scene s = test::windowScene(1, 1);
   test::addTriangle(s, {-1, -1, 0.5f}, {3, -1, 0.5f}, {-1, 3, 0.5f});
