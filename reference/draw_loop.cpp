@@ -429,12 +429,12 @@ void Renderer::drawWindowed(const PrimitiveRef& prim, const DrawPass& pass, cons
                             const FixedVertex* fv, const double* reach, const double* depth_reach,
                             int count, bool clipped) {
   if (pass.ops.polygon_mode != PolygonMode::Fill) {  // its edges or vertices (line_loop.cpp)
+    // (t.constant, the fans' one-colour fast path, is not read on the way: every fragment
+    // goes through generalFragment().)
     TriangleContext& t = context_;
     t.prim = &prim;
     t.pass = &pass;
-    t.constant = false;
     prepareTriangle(t);
-    t.constant = false;
     drawPolygonOutline(wv, fv, reach, depth_reach, count);
     return;
   }

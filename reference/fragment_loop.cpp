@@ -692,15 +692,15 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     hi = std::max(l_spec, l_major) + 0.5;
     return l_spec;
   };
-  auto colour = [&](double s) {
-    double lo = 0.0;
-    double hi = 0.0;
-    t.line_lambda = lambda_at(s, lo, hi);
-    return fragmentColor<kShading>(t, bary_at(s), nullptr);
+  // The polygon's merged record of a shared pixel (outline_spread_), or null.
+  auto spread_at = [&](std::size_t index) -> const OutlineSpread* {
+    const auto it =
+        std::lower_bound(outline_spread_.begin(), outline_spread_.end(), index,
+                         [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
+    return it != outline_spread_.end() && it->index == index ? &*it : nullptr;
   };
-
-  const bool half_width = segment && t.pass->ops.line_width > 1.0 &&
-                          t.pass->ops.line_width - std::floor(t.pass->ops.line_width) == 0.5;
+  const double slack_t = len > 0.0 ? slack_px / len : 0.0;
+  const bool half_width = segment && halfLineWidth(t.pass->ops.line_width);
   LineTrace& trace = t.line_trace;
   trace = LineTrace{};
   if (trace_ != nullptr) {
@@ -714,8 +714,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
   for (const LinePixel& p : pixels) {
     const double cx = p.x + 0.5;
     const double cy = p.y + 0.5;
-    const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
-                              static_cast<std::size_t>(p.x - clip_.x0);
+    const std::size_t index = frameIndex(p.x, p.y);
     const double s = segment ? param(cx, cy) : 0.0;
     const double z = (1.0 - s) * a.z + s * b.z;
     // A pixel another edge (vertex) of the same polygon also produces (outline_shared_): the
@@ -724,7 +723,10 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     const bool shared = !outline_shared_.empty() &&
                         std::binary_search(outline_shared_.begin(), outline_shared_.end(), index);
     if (outline_dry_ && !shared) continue;
-    const double slack_t = len > 0.0 ? slack_px / len : 0.0;
+    // The fragment's level of detail and the interval a driver's may lie in (NaN: none).
+    double lambda_lo = 0.0;
+    double lambda_hi = 0.0;
+    const double lambda = lambda_at(s, lambda_lo, lambda_hi);
     // normal_reach: the colour's range over the parameters and levels of detail a
     // conforming driver may use here, against the reference's own (8-bit units).
     TexelNote extra;
@@ -732,11 +734,11 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     glm::dvec3 c_lo(0.0);
     glm::dvec3 c_hi(0.0);
     if (uncertainty_ && (varies || outline_dry_)) {
-      const glm::dvec4 own = colour(s);
+      t.line_lambda = lambda;
+      const glm::dvec4 own = fragmentColor<kShading>(t, bary_at(s), nullptr);
       c_lo = c_hi = glm::dvec3(own);
-      double lo = 0.0;
-      double hi = 0.0;
-      lambda_at(s, lo, hi);
+      const double lo = lambda_lo;
+      const double hi = lambda_hi;
       // Sampled at kSteps + 1 parameters; untextured, the largest change between neighbouring
       // samples is added (how far the smooth lighting can go past the samples between two).
       constexpr int kSteps = 48;
@@ -769,10 +771,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       }
       colour_reach = static_cast<float>(255.0 * worst);
       if (shared && !outline_dry_) {
-        const auto it =
-            std::lower_bound(outline_spread_.begin(), outline_spread_.end(), index,
-                             [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
-        if (it != outline_spread_.end() && it->index == index) {
+        if (const OutlineSpread* it = spread_at(index)) {
           const glm::dvec3 d_lo = glm::dvec3(own) - it->c_lo;
           const glm::dvec3 d_hi = it->c_hi - glm::dvec3(own);
           const double spread = std::max({d_lo.x, d_lo.y, d_lo.z, d_hi.x, d_hi.y, d_hi.z});
@@ -782,22 +781,18 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     }
     // Depth: the slack's reach, or at a shared pixel the farthest any of the polygon's
     // fragments there may be (each at its own slack).
-    const double z_lo = std::min((1.0 - s + slack_t) * a.z + (s - slack_t) * b.z,
-                                 (1.0 - s - slack_t) * a.z + (s + slack_t) * b.z);
-    const double z_hi = std::max((1.0 - s + slack_t) * a.z + (s - slack_t) * b.z,
-                                 (1.0 - s - slack_t) * a.z + (s + slack_t) * b.z);
+    const double z_before = (1.0 - s + slack_t) * a.z + (s - slack_t) * b.z;
+    const double z_after = (1.0 - s - slack_t) * a.z + (s + slack_t) * b.z;
+    const double z_lo = std::min(z_before, z_after);
+    const double z_hi = std::max(z_before, z_after);
     if (outline_dry_) {
       outline_spread_.push_back({index, z_lo, z_hi, c_lo, c_hi});
       continue;
     }
     double spread_z = slack_px * z_per_px;
-    if (shared) {
-      const auto it =
-          std::lower_bound(outline_spread_.begin(), outline_spread_.end(), index,
-                           [](const OutlineSpread& x, std::size_t i) { return x.index < i; });
-      if (it != outline_spread_.end() && it->index == index)
-        spread_z = std::max(
-            spread_z, std::max(z - it->z_lo, it->z_hi - z) * std::fabs(g.scale) * depth_steps_);
+    if (const OutlineSpread* it = shared ? spread_at(index) : nullptr) {
+      spread_z = std::max(spread_z,
+                          std::max(z - it->z_lo, it->z_hi - z) * std::fabs(g.scale) * depth_steps_);
     }
     const double fragment_reach = depth_reach + spread_z + 1.0;
     // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
@@ -808,9 +803,8 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       const glm::dvec2 uv = w.x * t.v[0]->uv + w.y * t.v[1]->uv + w.z * t.v[2]->uv;
       glm::dvec4 range(0.0);
       if (t.chain != nullptr) {
-        double lo = 0.0;
-        double hi = 0.0;
-        lambda_at(s, lo, hi);
+        const double lo = lambda_lo;
+        const double hi = lambda_hi;
         const auto& chain = *t.chain;
         const int q = static_cast<int>(chain.size()) - 1;
         const auto coarsest =
@@ -842,9 +836,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
       extra.dist = 0.0f;
       extra.alt = static_cast<float>(weight * (255.0 * alt + light));
     }
-    double lo = 0.0;
-    double hi = 0.0;
-    t.line_lambda = lambda_at(s, lo, hi);
+    t.line_lambda = lambda;
     if (trace_ != nullptr) {
       trace.t = s;
       trace.margin =
@@ -858,16 +850,21 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
   trace = LineTrace{};
 }
 
-template void Renderer::shadeLineFragments<Shading::Flat>(const std::vector<LinePixel>&,
-                                                          const WindowVertex&, const WindowVertex&,
-                                                          bool, double, double, bool);
-template void Renderer::shadeLineFragments<Shading::Gouraud>(const std::vector<LinePixel>&,
-                                                             const WindowVertex&,
-                                                             const WindowVertex&, bool, double,
-                                                             double, bool);
-template void Renderer::shadeLineFragments<Shading::Phong>(const std::vector<LinePixel>&,
-                                                           const WindowVertex&, const WindowVertex&,
-                                                           bool, double, double, bool);
+void Renderer::shadeLine(const std::vector<LinePixel>& pixels, const WindowVertex& a,
+                         const WindowVertex& b, bool segment, double size, double depth_reach,
+                         bool polygon_edge) {
+  switch (scene_.state.shading) {
+    case Shading::Flat:
+      shadeLineFragments<Shading::Flat>(pixels, a, b, segment, size, depth_reach, polygon_edge);
+      break;
+    case Shading::Gouraud:
+      shadeLineFragments<Shading::Gouraud>(pixels, a, b, segment, size, depth_reach, polygon_edge);
+      break;
+    case Shading::Phong:
+      shadeLineFragments<Shading::Phong>(pixels, a, b, segment, size, depth_reach, polygon_edge);
+      break;
+  }
+}
 
 void Renderer::shadeFanGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
                                const FragmentInterpolator& interp) {

@@ -18,13 +18,38 @@
 namespace rc::ref {
 namespace {
 
-// GL rounds a non-antialiased line's width to the nearest integer, 0 counting as 1 (halves
-// up here, as in line_raster.h).
-double roundedWidth(double width) { return std::max(1.0, std::floor(width + 0.5)); }
-// A width of k + 1/2, which may round either way.
-bool halfWidth(const DrawPass& pass) {
-  const double w = pass.ops.line_width;
-  return w > 1.0 && w - std::floor(w) == 0.5;
+// Calls f(px, py) for every pixel of `clip` in the columns (an x-major segment; else rows)
+// within 1 + end_reach px of the segment's extent along its major axis whose centre lies
+// within w / 2 + 1 px of the segment's line in the minor direction: every pixel a segment
+// of rounded width w may produce or leave open.
+template <class F>
+void forEachPixelNear(const WindowVertex& a, const WindowVertex& b, double w, double end_reach,
+                      const PixelRect& clip, F&& f) {
+  const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
+  const double ma = x_major ? a.x : a.y;
+  const double mb = x_major ? b.x : b.y;
+  const double na = x_major ? a.y : a.x;
+  const double nb = x_major ? b.y : b.x;
+  const double lo = std::min(ma, mb);
+  const double hi = std::max(ma, mb);
+  const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
+  const int major_lo = x_major ? clip.x0 : clip.y0;
+  const int major_hi = x_major ? clip.x1 : clip.y1;
+  const int minor_lo = x_major ? clip.y0 : clip.x0;
+  const int minor_hi = x_major ? clip.y1 : clip.x1;
+  const int first = std::max(major_lo, static_cast<int>(std::floor(lo - 1.5 - end_reach)));
+  const int last = std::min(major_hi - 1, static_cast<int>(std::ceil(hi + 1.5 + end_reach)));
+  for (int m = first; m <= last; ++m) {
+    const double mc = m + 0.5;
+    if (mc <= lo - 1.0 - end_reach || mc >= hi + 1.0 + end_reach) continue;
+    const double n_line = na + (mc - ma) * slope;  // extrapolated past the ends
+    const int n_first = std::max(minor_lo, static_cast<int>(std::floor(n_line - w / 2 - 1.5)));
+    const int n_last = std::min(minor_hi - 1, static_cast<int>(std::ceil(n_line + w / 2 + 1.5)));
+    for (int n = n_first; n <= n_last; ++n) {
+      if (std::fabs(n + 0.5 - n_line) >= w / 2 + 1.0) continue;
+      f(x_major ? m : n, x_major ? n : m);
+    }
+  }
 }
 
 // The point a fraction f of the way from a to b in window space: x, y, z and 1/w affine, the
@@ -92,7 +117,6 @@ void Renderer::drawLineOrPoint(const PrimitiveRef& prim, const DrawPass& pass) {
   TriangleContext& t = context_;
   t.prim = &prim;
   t.pass = &pass;
-  t.constant = false;
   t.texel_choice = false;
   t.thin = false;
   t.short_normals = false;
@@ -169,7 +193,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
     if (area2 == 0 || cullCouldFlip(wv, count, max_reach)) {
       const double radius = pass.ops.polygon_mode == PolygonMode::Point
                                 ? pass.ops.point_size / 2.0 + 1.0
-                                : roundedWidth(pass.ops.line_width) / 2.0 + 1.0;
+                                : roundedLineWidth(pass.ops.line_width) / 2.0 + 1.0;
       for (int i = 0; i < count; ++i) markAmbiguous(wv[i], wv[(i + 1) % count], radius);
     }
   }
@@ -197,7 +221,7 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
   std::vector<WindowVertex> crossings;
   std::vector<std::pair<WindowVertex, WindowVertex>> border_edges;
   const double reach_px =
-      points ? pass.ops.point_size / 2.0 + 1.0 : roundedWidth(pass.ops.line_width) / 2.0 + 1.0;
+      points ? pass.ops.point_size / 2.0 + 1.0 : roundedLineWidth(pass.ops.line_width) / 2.0 + 1.0;
   if (uncertainty_) {
     const double bounds[2] = {static_cast<double>(scene_.width),
                               static_cast<double>(scene_.height)};
@@ -249,38 +273,28 @@ void Renderer::drawPolygonOutline(const WindowVertex* wv, const FixedVertex* fv,
   outline_shared_.clear();
   if (uncertainty_) {
     std::vector<std::size_t> hits;
+    auto add = [&](const std::vector<LinePixel>& pixels) {
+      for (const LinePixel& p : pixels) hits.push_back(frameIndex(p.x, p.y));
+    };
+    const double width = pass.ops.line_width;
+    const double w = roundedLineWidth(width);
     const int bits = options_.subpixel_bits;
     for (int i = 0; i < count; ++i) {
-      std::vector<LinePixel> pixels;
-      if (points) {
-        // (Every vertex: one made by clipping is a driver's point too, with its depth.)
-        pixels = pointCandidates(wv[i], pass.ops.point_size);
-      } else {
-        const int j = (i + 1) % count;
-        pixels = roundedWidth(pass.ops.line_width) == 1.0
-                     ? rasterizeLine(fv[i], fv[j], bits, clip_)
-                     : rasterizeWideLine(fv[i], fv[j], pass.ops.line_width, bits, clip_);
-        const std::vector<LinePixel> ends =
-            endCandidates(wv[i], wv[j], roundedWidth(pass.ops.line_width), halfWidth(pass),
-                          std::max(reach[i], reach[j]));
-        pixels.insert(pixels.end(), ends.begin(), ends.end());
+      if (points) {  // every vertex: one made by clipping is a driver's point too
+        add(pointCandidates(wv[i], pass.ops.point_size));
+        continue;
       }
-      for (const LinePixel& p : pixels)
-        hits.push_back(static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
-                       static_cast<std::size_t>(p.x - clip_.x0));
+      const int j = (i + 1) % count;
+      add(rasterizeWideLine(fv[i], fv[j], width, bits, clip_));
+      add(endCandidates(wv[i], wv[j], w, halfLineWidth(width), std::max(reach[i], reach[j])));
     }
-    auto add = [&](const std::vector<LinePixel>& pixels) {
-      for (const LinePixel& p : pixels)
-        hits.push_back(static_cast<std::size_t>(clip_.y1 - 1 - p.y) * fb_width_ +
-                       static_cast<std::size_t>(p.x - clip_.x0));
-    };
     if (points) {
       for (const WindowVertex& c : crossings) add(pointCandidates(c, pass.ops.point_size));
     } else {
       for (const auto& [a, b] : border_edges) {
-        add(rasterizeLine(snapVertexScaled(a.x, a.y, snap_scale_),
-                          snapVertexScaled(b.x, b.y, snap_scale_), bits, clip_));
-        add(endCandidates(a, b, roundedWidth(pass.ops.line_width), halfWidth(pass), 0.0));
+        add(rasterizeWideLine(snapVertexScaled(a.x, a.y, snap_scale_),
+                              snapVertexScaled(b.x, b.y, snap_scale_), 1.0, bits, clip_));
+        add(endCandidates(a, b, w, halfLineWidth(width), 0.0));
       }
     }
     std::sort(hits.begin(), hits.end());
@@ -374,29 +388,10 @@ std::vector<LinePixel> Renderer::endCandidates(const WindowVertex& a, const Wind
   // Within kTieMarginPx of the rule's other decision: beyond any snapping or float32 error.
   constexpr double kTieMarginPx = 1.0 / 16.0;
   std::vector<LinePixel> out;
-  const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
-  const double ma = x_major ? a.x : a.y;
-  const double mb = x_major ? b.x : b.y;
-  const double na = x_major ? a.y : a.x;
-  const double nb = x_major ? b.y : b.x;
-  const double lo = std::min(ma, mb);
-  const double hi = std::max(ma, mb);
-  const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
-  for (int m = static_cast<int>(std::floor(lo - 1.5 - end_reach));
-       m <= static_cast<int>(std::ceil(hi + 1.5 + end_reach)); ++m) {
-    const double mc = m + 0.5;
-    if (mc <= lo - 1.0 - end_reach || mc >= hi + 1.0 + end_reach) continue;
-    const double n_line = na + (mc - ma) * slope;
-    for (int n = static_cast<int>(std::floor(n_line - w / 2 - 1.5));
-         n <= static_cast<int>(std::ceil(n_line + w / 2 + 1.5)); ++n) {
-      if (std::fabs(n + 0.5 - n_line) >= w / 2 + 1.0) continue;
-      const int px = x_major ? m : n;
-      const int py = x_major ? n : m;
-      if (px < clip_.x0 || px >= clip_.x1 || py < clip_.y0 || py >= clip_.y1) continue;
-      if (segmentMargin(a, b, w, half, px + 0.5, py + 0.5, end_reach) >= kTieMarginPx) continue;
+  forEachPixelNear(a, b, w, end_reach, clip_, [&](int px, int py) {
+    if (segmentMargin(a, b, w, half, px + 0.5, py + 0.5, end_reach) < kTieMarginPx)
       out.push_back({px, py});
-    }
-  }
+  });
   return out;
 }
 
@@ -432,9 +427,7 @@ void Renderer::markAmbiguous(const WindowVertex& a, const WindowVertex& b, doubl
       const double t = len2 > 0.0 ? std::clamp(glm::dot(c - pa, d) / len2, 0.0, 1.0) : 0.0;
       const glm::dvec2 off = glm::abs(c - (pa + t * d));
       if (std::max(off.x, off.y) > radius) continue;  // squares: a point's shape
-      const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
-                                static_cast<std::size_t>(px - clip_.x0);
-      frame_.edge_dist[index] = 0.0f;
+      frame_.edge_dist[frameIndex(px, py)] = 0.0f;
     }
   }
 }
@@ -443,12 +436,9 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
                                    const FixedVertex& fa, const FixedVertex& fb, double reach,
                                    double depth_reach, bool polygon_edge) {
   const double width = context_.pass->ops.line_width;
-  const int bits = options_.subpixel_bits;
-  std::vector<LinePixel> pixels = roundedWidth(width) == 1.0
-                                      ? rasterizeLine(fa, fb, bits, clip_)
-                                      : rasterizeWideLine(fa, fb, width, bits, clip_);
-  const double w = roundedWidth(width);
-  const bool half = width > 1.0 && width - std::floor(width) == 0.5;
+  std::vector<LinePixel> pixels = rasterizeWideLine(fa, fb, width, options_.subpixel_bits, clip_);
+  const double w = roundedLineWidth(width);
+  const bool half = halfLineWidth(width);
   // The dry run of a polygon outline also records the fragments a driver may add at the
   // segment's ends and ties (another edge's pixel there may then hold this edge's depth and
   // colour).
@@ -471,54 +461,14 @@ void Renderer::drawSegmentWindowed(const WindowVertex& a, const WindowVertex& b,
     markAmbiguous(a, b, w / 2.0 + 1.0);
   }
   if (uncertainty_) {
-    const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
-    const double ma = x_major ? a.x : a.y;
-    const double mb = x_major ? b.x : b.y;
-    const double na = x_major ? a.y : a.x;
-    const double nb = x_major ? b.y : b.x;
-    const double lo = std::min(ma, mb);
-    const double hi = std::max(ma, mb);
-    const double slope = mb != ma ? (nb - na) / (mb - ma) : 0.0;
-    const int major_lo = x_major ? clip_.x0 : clip_.y0;
-    const int major_hi = x_major ? clip_.x1 : clip_.y1;
-    const int minor_lo = x_major ? clip_.y0 : clip_.x0;
-    const int minor_hi = x_major ? clip_.y1 : clip_.x1;
-    const int first = std::max(major_lo, static_cast<int>(std::floor(lo - 1.5 - reach)));
-    const int last = std::min(major_hi - 1, static_cast<int>(std::ceil(hi + 1.5 + reach)));
-    for (int m = first; m <= last; ++m) {
-      const double mc = m + 0.5;
-      if (mc <= lo - 1.0 - reach || mc >= hi + 1.0 + reach) continue;
-      const double n_line = na + (mc - ma) * slope;
-      const int n_first = std::max(minor_lo, static_cast<int>(std::floor(n_line - w / 2 - 1.5)));
-      const int n_last = std::min(minor_hi - 1, static_cast<int>(std::ceil(n_line + w / 2 + 1.5)));
-      for (int n = n_first; n <= n_last; ++n) {
-        const double off = std::fabs(n + 0.5 - n_line);
-        if (off >= w / 2 + 1.0) continue;
-        const double cx = x_major ? mc : n + 0.5;
-        const double cy = x_major ? n + 0.5 : mc;
-        const double margin = std::max(0.0, segmentMargin(a, b, w, half, cx, cy, reach) - reach);
-        const int px = x_major ? m : n;
-        const int py = x_major ? n : m;
-        const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
-                                  static_cast<std::size_t>(px - clip_.x0);
-        float& e = frame_.edge_dist[index];
-        e = std::min(e, static_cast<float>(margin));
-      }
-    }
+    forEachPixelNear(a, b, w, reach, clip_, [&](int px, int py) {
+      lowerEdgeDist(frameIndex(px, py),
+                    segmentMargin(a, b, w, half, px + 0.5, py + 0.5, reach) - reach);
+    });
   }
   if (pixels.empty()) return;
   if (!outline_dry_) ++triangles_drawn_;
-  switch (scene_.state.shading) {
-    case Shading::Flat:
-      shadeLineFragments<Shading::Flat>(pixels, a, b, true, w, depth_reach, polygon_edge);
-      break;
-    case Shading::Gouraud:
-      shadeLineFragments<Shading::Gouraud>(pixels, a, b, true, w, depth_reach, polygon_edge);
-      break;
-    case Shading::Phong:
-      shadeLineFragments<Shading::Phong>(pixels, a, b, true, w, depth_reach, polygon_edge);
-      break;
-  }
+  shadeLine(pixels, a, b, true, w, depth_reach, polygon_edge);
 }
 
 void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, double reach,
@@ -532,41 +482,24 @@ void Renderer::drawPointWindowed(const WindowVertex& c, const FixedVertex& fc, d
   // vertex's reach: GL leaves centres on the border to the implementation.
   if (uncertainty_) {
     const double h = size / 2.0;
+    // A square that crosses the viewport's border, or a polygon's vertex: Mesa's drivers
+    // may draw it through their draw module (its clipper, its unfilled stage), whose
+    // wide-point stage offsets it by (1/8, -1/8) px.
     const bool crosses =
         c.x - h < 0.0 || c.y - h < 0.0 || c.x + h > scene_.width || c.y + h > scene_.height;
+    const double bias = crosses || polygon_vertex ? 0.125 : 0.0;
     for (int py = std::max(clip_.y0, static_cast<int>(std::floor(c.y - h - 1.5)));
          py < std::min(clip_.y1, static_cast<int>(std::ceil(c.y + h + 1.5))); ++py) {
       for (int px = std::max(clip_.x0, static_cast<int>(std::floor(c.x - h - 1.5)));
            px < std::min(clip_.x1, static_cast<int>(std::ceil(c.x + h + 1.5))); ++px) {
-        const double dx = std::fabs(px + 0.5 - c.x) - h;
-        const double dy = std::fabs(py + 0.5 - c.y) - h;
-        // Inside: the nearer border; outside: how far beyond the farther one.
-        const double d = dx <= 0.0 && dy <= 0.0 ? std::min(-dx, -dy) : std::max(dx, dy);
-        if (d >= 1.0) continue;
-        // A square that crosses the viewport's border, or a polygon's vertex: Mesa's drivers
-        // may draw it through their draw module (its clipper, its unfilled stage), whose
-        // wide-point stage offsets it by (1/8, -1/8) px.
-        const double bias = crosses || polygon_vertex ? 0.125 : 0.0;
-        const std::size_t index = static_cast<std::size_t>(clip_.y1 - 1 - py) * fb_width_ +
-                                  static_cast<std::size_t>(px - clip_.x0);
-        float& e = frame_.edge_dist[index];
-        e = std::min(e, static_cast<float>(std::max(0.0, d - reach - bias)));
+        const double d = pointMargin(c, size, px + 0.5, py + 0.5);
+        if (d < 1.0) lowerEdgeDist(frameIndex(px, py), d - reach - bias);
       }
     }
   }
   if (pixels.empty()) return;
   if (!outline_dry_) ++triangles_drawn_;
-  switch (scene_.state.shading) {
-    case Shading::Flat:
-      shadeLineFragments<Shading::Flat>(pixels, c, c, false, size, depth_reach, polygon_vertex);
-      break;
-    case Shading::Gouraud:
-      shadeLineFragments<Shading::Gouraud>(pixels, c, c, false, size, depth_reach, polygon_vertex);
-      break;
-    case Shading::Phong:
-      shadeLineFragments<Shading::Phong>(pixels, c, c, false, size, depth_reach, polygon_vertex);
-      break;
-  }
+  shadeLine(pixels, c, c, false, size, depth_reach, polygon_vertex);
 }
 
 }  // namespace rc::ref

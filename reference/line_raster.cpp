@@ -153,11 +153,13 @@ std::vector<LinePixel> rasterizeLine(const FixedVertex& a, const FixedVertex& b,
   return out;
 }
 
+double roundedLineWidth(double width) { return std::max(1.0, std::floor(width + 0.5)); }
+
+bool halfLineWidth(double width) { return width > 1.0 && width - std::floor(width) == 0.5; }
+
 std::vector<LinePixel> rasterizeWideLine(const FixedVertex& a, const FixedVertex& b, double width,
                                          int subpixel_bits, const PixelRect& clip) {
-  // Halves up (2.5 draws 3), as Mesa's drivers round; GL says only "the nearest integer",
-  // so a half's other width is the driver's choice (line_loop.cpp marks it).
-  const auto w = static_cast<int>(std::max(1.0, std::floor(width + 0.5)));
+  const auto w = static_cast<int>(roundedLineWidth(width));
   if (w == 1) return rasterizeLine(a, b, subpixel_bits, clip);
   const bool x_major = std::llabs(b.x - a.x) >= std::llabs(b.y - a.y);
   // (w - 1) / 2 px in snapped units: exact, also for an even w (half a pixel) unless the

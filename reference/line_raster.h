@@ -40,6 +40,13 @@ bool lineProducesFragment(const FixedVertex& a, const FixedVertex& b, std::int64
 std::vector<LinePixel> rasterizeLine(const FixedVertex& a, const FixedVertex& b, int subpixel_bits,
                                      const PixelRect& clip);
 
+// GL's width of a non-antialiased line: the nearest integer, halves up (2.5 draws 3, as
+// Mesa's drivers round), 0 counting as 1.
+double roundedLineWidth(double width);
+// A width of k + 1/2 above 1: GL says only "the nearest integer", so the other width is the
+// driver's choice (reference/line_loop.cpp marks the rows between).
+bool halfLineWidth(double width);
+
 // A non-antialiased wide line by GL's column rule (14.5.2.1): w = the width rounded to the
 // nearest integer, halves up (0 counts as 1); the segment moved by -(w - 1) / 2 px in its minor
 // direction (y for an x-major segment, |dx| >= |dy|; else x) is rasterized by the one-pixel

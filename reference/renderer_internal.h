@@ -356,10 +356,25 @@ class Renderer {
   std::vector<LinePixel> endCandidates(const WindowVertex& a, const WindowVertex& b, double w,
                                        bool half, double end_reach) const;
   std::vector<LinePixel> pointCandidates(const WindowVertex& c, double size) const;
+  // The fragments of a segment (or point, a == b, segment false) of rasterized `size`
+  // (fragment_loop.cpp): shadeLineFragments() for the scene's shading mode.
+  void shadeLine(const std::vector<LinePixel>& pixels, const WindowVertex& a, const WindowVertex& b,
+                 bool segment, double size, double depth_reach, bool polygon_edge);
   template <Shading kShading>
   void shadeLineFragments(const std::vector<LinePixel>& pixels, const WindowVertex& a,
                           const WindowVertex& b, bool segment, double size, double depth_reach,
                           bool polygon_edge);
+  // The framebuffer index of pixel (px, py) of clip_ (GL window coordinates; rows stored
+  // top down).
+  std::size_t frameIndex(int px, int py) const {
+    return static_cast<std::size_t>(clip_.y1 - 1 - py) * static_cast<std::size_t>(fb_width_) +
+           static_cast<std::size_t>(px - clip_.x0);
+  }
+  // edge_dist at `index` lowered to max(0, d) (the channel keeps the least over all edges).
+  void lowerEdgeDist(std::size_t index, double d) {
+    float& e = frame_.edge_dist[index];
+    e = std::min(e, static_cast<float>(std::max(0.0, d)));
+  }
   void prepareLine(TriangleContext& t, const std::uint32_t* vertices, int count) const;
   // Per fan triangle: facing, polygon offset, the depth plane's key and what range and
   // offset add to its depth reach (draw_loop.cpp).
