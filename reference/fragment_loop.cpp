@@ -488,6 +488,15 @@ GeneralSetup Renderer::generalSetup(const TriangleContext& t) const {
   return g;
 }
 
+namespace {
+// True when the pass's scissor box rejects pixel (px, py).
+bool scissored(const FragmentOps& ops, int px, int py) {
+  if (!ops.scissor) return false;
+  const Scissor& box = *ops.scissor;
+  return px < box.x || py < box.y || px - box.x >= box.width || py - box.y >= box.height;
+}
+}  // namespace
+
 // GL's per-fragment operations in order (glspec 4.6 chapter 14.9 and 17.3) for one fragment
 // at pixel (px, py), framebuffer index `index`, window z `z_window` (before the depth range
 // and offset): scissor, stencil test, depth test (window z mapped by the depth range,
@@ -497,12 +506,12 @@ GeneralSetup Renderer::generalSetup(const TriangleContext& t) const {
 // uncertainty channels count every depth comparison (UncertaintyTracker::compared()).
 // `interp`, `row`, `dx`: the fan's interpolator at the fragment (null for lines and
 // points); `colour_reach` (8-bit units) joins the fragment's normal_reach.
-template <Shading kShading, class Bary>
+template <Shading kShading, class Bary, class Extra>
 void Renderer::generalFragment(const TriangleContext& t, const GeneralSetup& g, int px, int py,
                                std::size_t index, double z_window, float reach, Bary&& bary,
                                const FragmentInterpolator* interp,
                                const FragmentInterpolator::Row* row, double dx,
-                               const TexelNote& extra) {
+                               Extra&& extra_note) {
   const DrawPass& pass = *t.pass;
   const FragmentOps& ops = pass.ops;
   const std::uint32_t id = t.prim->id;
@@ -520,13 +529,10 @@ void Renderer::generalFragment(const TriangleContext& t, const GeneralSetup& g, 
     f.color_written = storedColor(index);
     trace_->push_back(std::move(f));
   };
-  if (ops.scissor) {
-    const Scissor& box = *ops.scissor;
-    if (px < box.x || py < box.y || px - box.x >= box.width || py - box.y >= box.height) {
-      f.scissor_pass = false;
-      traced();
-      return;
-    }
+  if (scissored(ops, px, py)) {
+    f.scissor_pass = false;
+    traced();
+    return;
   }
   double z = z_window;
   if (g.mapped) z = g.near + g.scale * z;
@@ -588,11 +594,13 @@ void Renderer::generalFragment(const TriangleContext& t, const GeneralSetup& g, 
   float* c = &frame_.color[4 * index];
   for (int k = 0; k < 4; ++k)
     if (ops.color_mask[static_cast<std::size_t>(k)]) c[k] = storeColor(out[k], color_format_);
-  if (uncertainty_)
+  if (uncertainty_) {
+    const TexelNote extra = extra_note();
     gaps_.colourWritten(index, g.composited, g.alpha, std::min(note.dist, extra.dist),
                         std::max(note.alt, extra.alt), std::max(note.gain, extra.gain),
                         std::max(note.reach, extra.reach), std::max(note.shade, extra.shade),
                         std::max(note.normal, extra.normal));
+  }
   traced();
 }
 
@@ -614,7 +622,7 @@ void Renderer::fillSpansGeneral(const TriangleContext& t, const TriangleCoverage
         return trace_ != nullptr ? interp.barycentric(px + 0.5, cy) : interp.barycentricAt(row, dx);
       };
       generalFragment<kShading>(t, g, px, py, index, interp.depthAt(row, dx), reach, bary, &interp,
-                                &row, dx, TexelNote{});
+                                &row, dx, [] { return TexelNote{}; });
     }
   });
 }
@@ -722,70 +730,124 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     // widens its reaches to the range of all of them there (outline_spread_).
     const bool shared = !outline_shared_.empty() &&
                         std::binary_search(outline_shared_.begin(), outline_shared_.end(), index);
-    if (outline_dry_ && !shared) continue;
+    // A record of a pixel outside the scissor box is never read (its fragments stop there).
+    if (outline_dry_ && (!shared || scissored(t.pass->ops, p.x, p.y))) continue;
     // The fragment's level of detail and the interval a driver's may lie in (NaN: none).
     double lambda_lo = 0.0;
     double lambda_hi = 0.0;
     const double lambda = lambda_at(s, lambda_lo, lambda_hi);
-    // normal_reach: the colour's range over the parameters and levels of detail a
-    // conforming driver may use here, against the reference's own (8-bit units).
-    TexelNote extra;
-    float& colour_reach = extra.normal;
-    glm::dvec3 c_lo(0.0);
-    glm::dvec3 c_hi(0.0);
-    if (uncertainty_ && (varies || outline_dry_)) {
-      t.line_lambda = lambda;
-      const glm::dvec4 own = fragmentColor<kShading>(t, bary_at(s), nullptr);
-      c_lo = c_hi = glm::dvec3(own);
-      const double lo = lambda_lo;
-      const double hi = lambda_hi;
-      // Sampled at kSteps + 1 parameters; untextured, the largest change between neighbouring
-      // samples is added (how far the smooth lighting can go past the samples between two).
-      constexpr int kSteps = 48;
-      double worst = 0.0;
-      double step = 0.0;
-      glm::dvec4 last(0.0);
-      for (int k = 0; k <= kSteps; ++k) {
-        const double q =
-            std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, -overshoot, 1.0 + overshoot);
-        const glm::dvec3 w = bary_at(q);
-        for (int l = 0; l < (std::isnan(lo) ? 1 : 3); ++l) {
-          double ignore_lo = 0.0;
-          double ignore_hi = 0.0;
-          t.line_lambda = std::isnan(lo) ? lambda_at(q, ignore_lo, ignore_hi)
-                                         : (l == 0 ? lo : (l == 1 ? hi : 0.5 * (lo + hi)));
-          const glm::dvec4 c = fragmentColor<kShading>(t, w, nullptr);
-          c_lo = glm::min(c_lo, glm::dvec3(c));
-          c_hi = glm::max(c_hi, glm::dvec3(c));
-          for (int ch = 0; ch < 3; ++ch) {
-            worst = std::max(worst, std::fabs(c[ch] - own[ch]));
-            if (l == 0 && k > 0) step = std::max(step, std::fabs(c[ch] - last[ch]));
-          }
-          if (l == 0) last = c;
-        }
-      }
-      if (tex == nullptr) {
-        worst += step;
-        c_lo -= step;
-        c_hi += step;
-      }
-      colour_reach = static_cast<float>(255.0 * worst);
-      if (shared && !outline_dry_) {
-        if (const OutlineSpread* it = spread_at(index)) {
-          const glm::dvec3 d_lo = glm::dvec3(own) - it->c_lo;
-          const glm::dvec3 d_hi = it->c_hi - glm::dvec3(own);
-          const double spread = std::max({d_lo.x, d_lo.y, d_lo.z, d_hi.x, d_hi.y, d_hi.z});
-          colour_reach = std::max(colour_reach, static_cast<float>(255.0 * spread));
-        }
-      }
-    }
     // Depth: the slack's reach, or at a shared pixel the farthest any of the polygon's
     // fragments there may be (each at its own slack).
     const double z_before = (1.0 - s + slack_t) * a.z + (s - slack_t) * b.z;
     const double z_after = (1.0 - s - slack_t) * a.z + (s + slack_t) * b.z;
     const double z_lo = std::min(z_before, z_after);
     const double z_hi = std::max(z_before, z_after);
+    // The fragment's colour slack and texel channels: computed only where they are used (the
+    // dry run's record of a shared pixel, a fragment that writes its colour), since they
+    // cost up to 147 colour evaluations; c_lo, c_hi receive the colour's range.
+    glm::dvec3 c_lo(0.0);
+    glm::dvec3 c_hi(0.0);
+    auto slack = [&]() -> TexelNote {
+      // normal_reach: the colour's range over the parameters and levels of detail a
+      // conforming driver may use here, against the reference's own (8-bit units).
+      TexelNote extra;
+      float& colour_reach = extra.normal;
+      if (uncertainty_ && (varies || outline_dry_)) {
+        t.line_lambda = lambda;
+        const glm::dvec4 own = fragmentColor<kShading>(t, bary_at(s), nullptr);
+        c_lo = c_hi = glm::dvec3(own);
+        const double lo = lambda_lo;
+        const double hi = lambda_hi;
+        // Sampled at kSteps + 1 parameters; untextured, the largest change between neighbouring
+        // samples is added (how far the smooth lighting can go past the samples between two).
+        // A point (no slack) and a level of detail without an interval (lo == hi) give the
+        // same sample every time: taken once (the same bits, a point's fragment 147x cheaper).
+        constexpr int kSteps = 48;
+        const int steps = slack_t > 0.0 ? kSteps : 0;
+        const int levels = std::isnan(lo) || lo == hi ? 1 : 3;
+        double worst = 0.0;
+        double step = 0.0;
+        glm::dvec4 last(0.0);
+        for (int k = 0; k <= steps; ++k) {
+          const double q =
+              std::clamp(s - slack_t + 2.0 * slack_t * k / kSteps, -overshoot, 1.0 + overshoot);
+          const glm::dvec3 w = bary_at(q);
+          for (int l = 0; l < levels; ++l) {
+            double ignore_lo = 0.0;
+            double ignore_hi = 0.0;
+            t.line_lambda = std::isnan(lo) ? lambda_at(q, ignore_lo, ignore_hi)
+                                           : (l == 0 ? lo : (l == 1 ? hi : 0.5 * (lo + hi)));
+            const glm::dvec4 c = fragmentColor<kShading>(t, w, nullptr);
+            c_lo = glm::min(c_lo, glm::dvec3(c));
+            c_hi = glm::max(c_hi, glm::dvec3(c));
+            for (int ch = 0; ch < 3; ++ch) {
+              worst = std::max(worst, std::fabs(c[ch] - own[ch]));
+              if (l == 0 && k > 0) step = std::max(step, std::fabs(c[ch] - last[ch]));
+            }
+            if (l == 0) last = c;
+          }
+        }
+        if (tex == nullptr) {
+          worst += step;
+          c_lo -= step;
+          c_hi += step;
+        }
+        colour_reach = static_cast<float>(255.0 * worst);
+        if (shared && !outline_dry_) {
+          if (const OutlineSpread* it = spread_at(index)) {
+            const glm::dvec3 d_lo = glm::dvec3(own) - it->c_lo;
+            const glm::dvec3 d_hi = it->c_hi - glm::dvec3(own);
+            const double spread = std::max({d_lo.x, d_lo.y, d_lo.z, d_hi.x, d_hi.y, d_hi.z});
+            colour_reach = std::max(colour_reach, static_cast<float>(255.0 * spread));
+          }
+        }
+      }
+      // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
+      // level of the lambda interval), as triangles' level-of-detail fragments record them
+      // (texel_dist 0: always within; texel_alt the range times the light, plus a unit).
+      if (uncertainty_ && tex != nullptr && !outline_dry_) {
+        const glm::dvec3 w = bary_at(s);
+        const glm::dvec2 uv = w.x * t.v[0]->uv + w.y * t.v[1]->uv + w.z * t.v[2]->uv;
+        glm::dvec4 range(0.0);
+        if (t.chain != nullptr) {
+          const double lo = lambda_lo;
+          const double hi = lambda_hi;
+          const auto& chain = *t.chain;
+          const int q = static_cast<int>(chain.size()) - 1;
+          const auto coarsest =
+              static_cast<std::size_t>(std::clamp(static_cast<int>(std::ceil(hi)), 0, q));
+          const glm::dvec2 shift(1.0 / (256.0 * chain[coarsest]->width),
+                                 1.0 / (256.0 * chain[coarsest]->height));
+          range = lodRange(chain, uv, lo, hi, shift, lod_state_);
+        } else {
+          range =
+              linearReachRange(*tex, uv, scene_.state.texture_wrap, 0.0, 0.0, textureRangeOf(tex));
+        }
+        LitColor lit = t.flat;
+        if constexpr (kShading == Shading::Gouraud) {
+          lit.ambient_diffuse = w.x * t.gouraud[0]->ambient_diffuse +
+                                w.y * t.gouraud[1]->ambient_diffuse +
+                                w.z * t.gouraud[2]->ambient_diffuse;
+        } else if constexpr (kShading == Shading::Phong) {
+          lit = shadePrepared(
+              *t.shading, w.x * t.v[0]->world + w.y * t.v[1]->world + w.z * t.v[2]->world,
+              safeNormalize(w.x * t.v[0]->normal + w.y * t.v[1]->normal + w.z * t.v[2]->normal));
+        }
+        double alt = 0.0;
+        double light = 0.0;
+        for (int c = 0; c < 3; ++c) {
+          alt = std::max(alt, std::fabs(lit.ambient_diffuse[c] * range[c]));
+          light = std::max(light, lit.ambient_diffuse[c]);
+        }
+        const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
+        extra.dist = 0.0f;
+        extra.alt = static_cast<float>(weight * (255.0 * alt + light));
+      }
+      t.line_lambda = lambda;
+      return extra;
+    };
     if (outline_dry_) {
+      slack();
       outline_spread_.push_back({index, z_lo, z_hi, c_lo, c_hi});
       continue;
     }
@@ -795,47 +857,6 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
                           std::max(z - it->z_lo, it->z_hi - z) * std::fabs(g.scale) * depth_steps_);
     }
     const double fragment_reach = depth_reach + spread_z + 1.0;
-    // The texel channels: the texels the filter may read there (a 2x2 footprint, at every
-    // level of the lambda interval), as triangles' level-of-detail fragments record them
-    // (texel_dist 0: always within; texel_alt the range times the light, plus a unit).
-    if (uncertainty_ && tex != nullptr) {
-      const glm::dvec3 w = bary_at(s);
-      const glm::dvec2 uv = w.x * t.v[0]->uv + w.y * t.v[1]->uv + w.z * t.v[2]->uv;
-      glm::dvec4 range(0.0);
-      if (t.chain != nullptr) {
-        const double lo = lambda_lo;
-        const double hi = lambda_hi;
-        const auto& chain = *t.chain;
-        const int q = static_cast<int>(chain.size()) - 1;
-        const auto coarsest =
-            static_cast<std::size_t>(std::clamp(static_cast<int>(std::ceil(hi)), 0, q));
-        const glm::dvec2 shift(1.0 / (256.0 * chain[coarsest]->width),
-                               1.0 / (256.0 * chain[coarsest]->height));
-        range = lodRange(chain, uv, lo, hi, shift, lod_state_);
-      } else {
-        range =
-            linearReachRange(*tex, uv, scene_.state.texture_wrap, 0.0, 0.0, textureRangeOf(tex));
-      }
-      LitColor lit = t.flat;
-      if constexpr (kShading == Shading::Gouraud) {
-        lit.ambient_diffuse = w.x * t.gouraud[0]->ambient_diffuse +
-                              w.y * t.gouraud[1]->ambient_diffuse +
-                              w.z * t.gouraud[2]->ambient_diffuse;
-      } else if constexpr (kShading == Shading::Phong) {
-        lit = shadePrepared(
-            *t.shading, w.x * t.v[0]->world + w.y * t.v[1]->world + w.z * t.v[2]->world,
-            safeNormalize(w.x * t.v[0]->normal + w.y * t.v[1]->normal + w.z * t.v[2]->normal));
-      }
-      double alt = 0.0;
-      double light = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        alt = std::max(alt, std::fabs(lit.ambient_diffuse[c] * range[c]));
-        light = std::max(light, lit.ambient_diffuse[c]);
-      }
-      const double weight = t.pass->blend ? std::clamp(t.material->opacity, 0.0, 1.0) : 1.0;
-      extra.dist = 0.0f;
-      extra.alt = static_cast<float>(weight * (255.0 * alt + light));
-    }
     t.line_lambda = lambda;
     if (trace_ != nullptr) {
       trace.t = s;
@@ -844,7 +865,7 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
     }
     generalFragment<kShading>(
         t, g, p.x, p.y, index, z, static_cast<float>(uncertainty_ ? fragment_reach : 0.0),
-        [&] { return bary_at(s); }, nullptr, nullptr, 0.0, extra);
+        [&] { return bary_at(s); }, nullptr, nullptr, 0.0, slack);
   }
   t.line_lambda = std::numeric_limits<double>::quiet_NaN();
   trace = LineTrace{};

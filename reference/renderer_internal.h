@@ -332,11 +332,13 @@ class Renderer {
   void shadeFanGeneral(const TriangleContext& t, const TriangleCoverage& coverage,
                        const FragmentInterpolator& interp);
   GeneralSetup generalSetup(const TriangleContext& t) const;
-  template <Shading kShading, class Bary>
+  // `extra_note()`: the fragment's own texel and colour notes (lines' slack), asked for only
+  // when the fragment writes its colour.
+  template <Shading kShading, class Bary, class Extra>
   void generalFragment(const TriangleContext& t, const GeneralSetup& g, int px, int py,
                        std::size_t index, double z_window, float reach, Bary&& bary,
                        const FragmentInterpolator* interp, const FragmentInterpolator::Row* row,
-                       double dx, const TexelNote& extra);
+                       double dx, Extra&& extra_note);
   // Lines and points (line_loop.cpp): a line or point primitive of `pass`; the edges or
   // vertices of a triangle's (clipped) polygon in polygon mode line or point; one segment
   // or point in clip space (barycentrics w.r.t. the primitive's original vertices in

@@ -25,12 +25,30 @@ const std::array<double, 256>& unorm8Table() {
 int wrapIndex(double floored, int size, TextureWrap wrap) {
   if (!std::isfinite(floored)) return 0;
   if (wrap == TextureWrap::Clamp) return static_cast<int>(std::clamp(floored, 0.0, size - 1.0));
+  // Integer floor-mod where the coordinate fits: the same index as the double formula
+  // below (its quotient cannot round onto an integer below 2^31), at a fraction of the cost
+  // (the double path is a division and a libm floor; lines sample textures 147 times a
+  // fragment for their colour slack).
+  const bool small = std::fabs(floored) < 2147483648.0;
   if (wrap == TextureWrap::MirroredRepeat) {
+    if (small) {
+      const long long period = 2LL * size;
+      long long k = static_cast<long long>(floored) % period;
+      if (k < 0) k += period;
+      return static_cast<int>(k < size ? k : period - 1 - k);
+    }
     // Period 2 size: indices size .. 2 size - 1 mirror back onto size - 1 .. 0.
     const double period = 2.0 * size;
     const double m = floored - period * std::floor(floored / period);
     const int k = std::clamp(static_cast<int>(m), 0, 2 * size - 1);
     return k < size ? k : 2 * size - 1 - k;
+  }
+  if (small) {
+    // Powers of two (most textures): two's complement masking is the floor-mod.
+    if ((size & (size - 1)) == 0)
+      return static_cast<int>(static_cast<long long>(floored) & (size - 1));
+    const long long k = static_cast<long long>(floored) % size;
+    return static_cast<int>(k < 0 ? k + size : k);
   }
   const double m = floored - size * std::floor(floored / size);  // floor-mod, in [0, size]
   return std::clamp(static_cast<int>(m), 0, size - 1);           // m == size only by rounding
