@@ -200,6 +200,8 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
       const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
       note->normal = normalReach(t, b, p, *interp, *row, dx);
     }
+    if (note && t.shading->shadowed)
+      note->normal = std::max(note->normal, shadowReach(t, b, tex, interp, row, dx));
   }
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
@@ -394,7 +396,7 @@ __attribute__((flatten)) void Renderer::shadeFanFormat(const TriangleContext& t,
   // (ambient + diffuse) * 1 + specular, and x * 1 == x exactly).
   // (Phong fans that record shade_reach take the general path.)
   if (t.texture == nullptr && !blend && scene_.state.shading != Shading::Flat &&
-      !options_.fragment_definition_only &&
+      !options_.fragment_definition_only && !t.shading->shadowed &&
       !(uncertainty_ && (t.thin || t.short_normals) && scene_.state.shading == Shading::Phong)) {
     const bool rgba8 = color_format_ == ColorFormat::RGBA8;
     const float alpha = storeColor(t.material->opacity, color_format_);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "fixtures/errors.h"
+#include "reference/multipass.h"
 #include "reference/renderer_internal.h"
 
 namespace rc {
@@ -39,6 +40,12 @@ void validate(const Scene& scene, const ReferenceOptions& options) {
 
 Frame renderReference(const Scene& scene, const ReferenceOptions& options) {
   validate(scene, options);
+  if (!scene.passes.empty()) {
+    PassOutputs passes = renderPasses(scene, options);
+    Frame frame = renderReference(passes.frame_scene, options);
+    frame.passes = std::move(passes.frames);
+    return frame;
+  }
   Frame frame =
       scene.state.samples > 1
           ? renderMultisample(scene, options)
@@ -56,6 +63,12 @@ std::vector<FragmentTrace> tracePixel(const Scene& scene, const ReferenceOptions
                      "x" + std::to_string(scene.height) + " image");
   const int y = scene.height - 1 - y_image;  // GL window row
   std::vector<FragmentTrace> trace;
+  if (!scene.passes.empty()) {  // the frame pass, its targets drawn first
+    const PassOutputs passes = renderPasses(scene, options);
+    Renderer renderer(passes.frame_scene, options, PixelRect{x, y, x + 1, y + 1}, &trace);
+    renderer.run();
+    return trace;
+  }
   Renderer renderer(scene, options, PixelRect{x, y, x + 1, y + 1}, &trace);
   renderer.run();
   return trace;

@@ -298,6 +298,11 @@ class Renderer {
   float normalReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& p,
                     const FragmentInterpolator& interp, const FragmentInterpolator::Row& row,
                     double dx) const;
+  // normal_reach of a shadowed Phong fragment: how far the lookups of its shadowed lights
+  // may legally go (reference/shadow.h shadowRange()) times each light's unshadowed terms.
+  float shadowReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
+                    const FragmentInterpolator* interp, const FragmentInterpolator::Row* row,
+                    double dx) const;
   float phongReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
                    const LitColor& lit, const FragmentInterpolator& interp,
                    const FragmentInterpolator::Row& row, double dx) const;

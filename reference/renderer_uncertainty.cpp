@@ -187,6 +187,64 @@ float Renderer::normalReach(const TriangleContext& t, const glm::dvec3& b, const
   return reachChannel(reach);
 }
 
+// The shadow lookup's freedoms (docs/tolerances.md "Shadow maps"): the driver's fragment
+// sees the surface kMapBandPx away at most (its snapped vertices move the attribute planes),
+// its float32 matrix product moves (s, t, r) by kShadowCoordUlps units of 2^-24 of the
+// magnitudes summed, and its stored map may differ within ShadowMapData::lo, hi.
+namespace {
+constexpr double kShadowBandPx = 0.1;
+constexpr double kShadowCoordUlps = 16.0;
+}  // namespace
+
+float Renderer::shadowReach(const TriangleContext& t, const glm::dvec3& b, const glm::dvec3& tex,
+                            const FragmentInterpolator* interp,
+                            const FragmentInterpolator::Row* row, double dx) const {
+  const PreparedShading& s = *t.shading;
+  const glm::dvec3 p = b.x * t.v[0]->world + b.y * t.v[1]->world + b.z * t.v[2]->world;
+  const glm::dvec3 n =
+      safeNormalize(b.x * t.v[0]->normal + b.y * t.v[1]->normal + b.z * t.v[2]->normal);
+  glm::dvec3 dp[2] = {glm::dvec3(0.0), glm::dvec3(0.0)};
+  if (interp != nullptr && row != nullptr) {
+    glm::dvec3 db[2];
+    interp->barycentricGradient(*row, dx, b, db);
+    for (int a = 0; a < 2; ++a)
+      dp[a] = db[a].x * t.v[0]->world + db[a].y * t.v[1]->world + db[a].z * t.v[2]->world;
+  }
+  ShadingTerms terms;
+  shadePrepared(s, p, n, &terms, false);  // each light's terms before its lookup
+  double reach = 0.0;
+  for (std::size_t i = 0; i < s.lights.size(); ++i) {
+    const ShadowLookup* lookup = s.lights[i].shadow;
+    if (lookup == nullptr) continue;
+    const ShadowMapData& map = *lookup->data;
+    const ShadowCoord c = shadowCoord(*lookup, p);
+    if (!c.in_front) continue;
+    // Per px of the fragment's position, and the float32 error of the product.
+    glm::dvec3 move(0.0);
+    for (const glm::dvec3& d : dp) {
+      const ShadowCoord q = shadowCoord(*lookup, p + d);
+      if (!q.in_front) continue;
+      move += glm::abs(glm::dvec3(q.s - c.s, q.t - c.t, q.r - c.r)) * kShadowBandPx;
+    }
+    const glm::dvec4 h(p, 1.0);
+    const glm::dvec4 m = glm::abs(map.matrix[0] * h.x) + glm::abs(map.matrix[1] * h.y) +
+                         glm::abs(map.matrix[2] * h.z) + glm::abs(map.matrix[3]);
+    const double w = std::fabs((map.matrix * h).w);
+    const double ulp = kShadowCoordUlps * std::ldexp(1.0, -24);
+    const double es = ulp * (m.x + std::fabs(c.s) * m.w) / w;
+    const double et = ulp * (m.y + std::fabs(c.t) * m.w) / w;
+    const double er = ulp * (m.z + std::fabs(c.r + lookup->bias) * m.w) / w;
+    const ShadowRange range = shadowRange(*lookup, p, (move.x + es) * map.width,
+                                          (move.y + et) * map.height, move.z + er);
+    const double f = shadowFactor(*lookup, p);
+    const double spread = std::max(range.hi - f, f - range.lo);
+    if (!(spread > 0.0)) continue;
+    const glm::dvec3 light = terms.lights[i].diffuse * tex + terms.lights[i].specular;
+    reach += spread * std::max({light.x, light.y, light.z});
+  }
+  return reachChannel(255.0 * reach * blendWeight(t));
+}
+
 // shade_reach of a Phong fragment of a fan triangle thinner than kThinAltitudePx
 // (TriangleContext::thin):
 // the same first-order bound as gouraudReach(), sum |b_k| * |grad C|, with C = T * AD + S

@@ -48,6 +48,11 @@ PreparedShading prepareShading(const Lighting& lighting, const Material& materia
       p.radiance = light.color * light.intensity;
       p.kd_radiance = material.diffuse * p.radiance;
       p.ks_radiance = material.specular * p.radiance;
+      if (material.shadow && material.shadow->data && !light.shadow_map.empty() &&
+          light.shadow_map == material.shadow->map) {
+        p.shadow = &*material.shadow;
+        s.shadowed = true;
+      }
       s.lights.push_back(p);
     }
   }

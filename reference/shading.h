@@ -23,6 +23,7 @@
 
 #include "fixtures/scene.h"
 #include "fixtures/scene_geometry.h"
+#include "reference/shadow.h"
 
 namespace rc {
 
@@ -43,6 +44,7 @@ struct LightFactors {
   double n_dot_h = std::numeric_limits<double>::quiet_NaN();  // Blinn-Phong
   double r_dot_v = std::numeric_limits<double>::quiet_NaN();  // Phong
   double specular_power = 0.0;                                // max(0, n.h or r.v)^shininess
+  double shadow = 1.0;  // the shadow lookup's result multiplying diffuse and specular
   bool contributes = false;
 };
 
@@ -152,6 +154,8 @@ struct PreparedLight {
   glm::dvec3 radiance{0.0};     // color * intensity
   glm::dvec3 kd_radiance{0.0};  // material.diffuse * radiance (unattenuated lights)
   glm::dvec3 ks_radiance{0.0};  // material.specular * radiance (unattenuated lights)
+  // The material's shadow lookup when it reads this light's map (bound), else null.
+  const ShadowLookup* shadow = nullptr;
 };
 
 struct PreparedShading {
@@ -164,6 +168,7 @@ struct PreparedShading {
   bool blinn = true;
   Attenuation attenuation = Attenuation::None;
   std::vector<PreparedLight> lights;
+  bool shadowed = false;  // some light has a shadow lookup
 };
 PreparedShading prepareShading(const Lighting& lighting, const Material& material);
 
@@ -173,9 +178,11 @@ PreparedShading prepareShading(const Lighting& lighting, const Material& materia
 // `explain`: the factors it prints are the very values computed here). Tracing changes no
 // result: a light that contributes nothing is still evaluated for its factors, then
 // skipped, as it is without tracing.
+// `shadows` false: every light unshadowed (the terms a shadow lookup would scale).
 [[gnu::always_inline]] inline LitColor shadePrepared(const PreparedShading& s, const glm::dvec3& p,
                                                      const glm::dvec3& n,
-                                                     ShadingTerms* terms = nullptr) {
+                                                     ShadingTerms* terms = nullptr,
+                                                     bool shadows = true) {
   LitColor out;
   out.ambient_diffuse = s.ambient;
   ShadedPoint* point = nullptr;
@@ -241,6 +248,12 @@ PreparedShading prepareShading(const Lighting& lighting, const Material& materia
     } else {
       diffuse = light.kd_radiance * std::max(0.0, n_dot_l);
       specular = light.ks_radiance * power;
+    }
+    if (shadows && light.shadow != nullptr) {  // GL: the lookup scales the light's terms
+      const double f = shadowFactor(*light.shadow, p);
+      if (point) point->lights[i].shadow = f;
+      diffuse *= f;
+      specular *= f;
     }
     out.ambient_diffuse += diffuse;
     out.specular += specular;

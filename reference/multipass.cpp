@@ -1,0 +1,161 @@
+// Multi-pass scenes in the reference: see multipass.h.
+#include "reference/multipass.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "fixtures/scene_logic.h"
+
+namespace rc::ref {
+namespace {
+
+// Steps of the format: one unit in the last place of d16/d24, 2^-24 for d32f (the
+// comparator's depth steps, docs/tolerances.md section 2).
+double depthStep(DepthFormat f) {
+  const int bits = depthBits(f);
+  return bits > 0 ? 1.0 / (std::ldexp(1.0, bits) - 1.0) : std::ldexp(1.0, -24);
+}
+
+// The comparator's fail threshold for the format's depth (compare/tolerances.cpp): what a
+// stored depth may be off by before a depth error fails.
+double depthFailSteps(DepthFormat f) { return f == DepthFormat::D16 ? 2.0 : 16.0; }
+
+// px: how far a driver's vertices and attribute planes may sit from the reference's (the
+// snap band of a 4-bit-subpixel rasterizer, sqrt(1/2) / 16 each side, rounded up).
+constexpr double kMapBandPx = 0.1;
+
+// The colour target `frame` (rows top-down) as a texture (rows bottom-up, 8-bit).
+std::shared_ptr<Texture> targetTexture(const Frame& frame, const std::string& name) {
+  auto t = std::make_shared<Texture>();
+  t->path = "target:" + name;
+  t->width = frame.width;
+  t->height = frame.height;
+  t->rgba.resize(static_cast<std::size_t>(frame.width) * frame.height * 4);
+  for (int j = 0; j < frame.height; ++j) {
+    const std::size_t row = frame.index(0, frame.height - 1 - j);
+    for (int i = 0; i < frame.width * 4; ++i) {
+      const float v = frame.color[row * 4 + static_cast<std::size_t>(i)];
+      t->rgba[(static_cast<std::size_t>(j) * frame.width) * 4 + static_cast<std::size_t>(i)] =
+          static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+    }
+  }
+  return t;
+}
+
+struct Bound {
+  std::map<std::string, std::shared_ptr<const Texture>> textures;
+  std::map<std::string, std::shared_ptr<const ShadowMapData>> maps;
+};
+
+void bindInputs(Scene& pass_scene, const Bound& bound) {
+  for (Material& m : pass_scene.materials) {
+    if (!m.texture_target.empty()) {
+      const auto it = bound.textures.find(m.texture_target);
+      if (it != bound.textures.end()) m.texture = it->second;
+    }
+    if (m.shadow) {
+      const auto it = bound.maps.find(m.shadow->map);
+      if (it != bound.maps.end()) m.shadow->data = it->second;
+    }
+  }
+}
+
+}  // namespace
+
+void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map) {
+  const std::size_t n = frame.pixelCount();
+  map.lo.assign(n, 0.0);
+  map.hi.assign(n, 0.0);
+  const double step = depthStep(map.format);
+  const bool channels = frame.hasUncertainty();
+  // Steps a texel's own surface may be off by: the fail threshold, its plane moved by the
+  // band, its vertices' float32 reach, another r of its polygon offset's units.
+  auto allowance = [&](std::size_t i) {
+    double a = depthFailSteps(map.format);
+    if (!channels) return a;
+    auto finite = [](float v) { return std::isfinite(v) ? static_cast<double>(v) : 0.0; };
+    a += kMapBandPx * finite(frame.depth_slope[i]) + finite(frame.depth_reach[i]) +
+         finite(frame.offset_steps[i]);
+    return a;
+  };
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      const std::size_t i = frame.index(x, y);
+      const std::size_t k = static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x;
+      const double d = frame.depth[i];
+      const double a = allowance(i) * step;
+      double lo = d - a;
+      double hi = d + a;
+      if (channels) {
+        // Two fragments within their tolerances of a tie: the other may be stored.
+        const double gap = frame.depth_gap[i];
+        if (std::isfinite(gap) && gap <= 2.0 * allowance(i)) {
+          lo = std::min(lo, d - gap * step - a);
+          hi = std::max(hi, d + gap * step + a);
+        }
+        // Within the band of an edge another surface (or the clear depth) may cover the
+        // texel: those of its neighbours, each carried over one texel along its slope.
+        if (frame.edge_dist[i] <= kMapBandPx || frame.clear_gap[i] <= allowance(i)) {
+          for (int dy = -1; dy <= 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int nx = x + dx;
+              const int ny = y + dy;
+              if (nx < 0 || ny < 0 || nx >= frame.width || ny >= frame.height) continue;
+              const std::size_t j = frame.index(nx, ny);
+              const double slope = std::isfinite(frame.depth_slope[j]) ? frame.depth_slope[j] : 0.0;
+              const double reach = (allowance(j) + 1.5 * slope) * step;
+              lo = std::min(lo, frame.depth[j] - reach);
+              hi = std::max(hi, frame.depth[j] + reach);
+            }
+          }
+          lo = std::min(lo, clear_depth);
+          hi = std::max(hi, clear_depth);
+        }
+      }
+      map.lo[k] = lo;
+      map.hi[k] = hi;
+    }
+  }
+}
+
+PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options) {
+  PassOutputs out;
+  Bound bound;
+  for (std::size_t k = 0; k + 1 < scene.passes.size(); ++k) {
+    Scene ps = passScene(scene, k);
+    bindInputs(ps, bound);
+    ReferenceOptions o = options;
+    o.uncertainty = true;  // the map's range comes from its channels
+    Frame f = renderReference(ps, o);
+    const std::string& name = scene.passes[k].target;
+    const RenderTarget* target = findTarget(scene, name);
+    f.meta["pass"] = {{"index", k},
+                      {"target", name},
+                      {"format", target != nullptr ? toString(target->format) : "frame"}};
+    if (target != nullptr && target->depth()) {
+      auto map = std::make_shared<ShadowMapData>();
+      map->width = f.width;
+      map->height = f.height;
+      map->format = ps.state.depth_format;
+      map->matrix = shadowMatrix(scene, name);
+      map->depth.resize(f.pixelCount());
+      for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x)
+          map->depth[static_cast<std::size_t>(f.height - 1 - y) * f.width + x] =
+              f.depth[f.index(x, y)];
+      if (options.uncertainty) shadowMapRange(f, ps.clear_depth, *map);
+      bound.maps[name] = std::move(map);
+    } else if (target != nullptr) {
+      bound.textures[name] = targetTexture(f, name);
+    }
+    out.frames.push_back(std::move(f));
+  }
+  out.frame_scene = passScene(scene, scene.passes.size() - 1);
+  bindInputs(out.frame_scene, bound);
+  return out;
+}
+
+}  // namespace rc::ref
