@@ -18,8 +18,8 @@ constexpr const char* kValidFaults =
     "shader_compile_error, move_vertex=ID, move_line_end=ID, move_point=ID, texel_offset=N, "
     "blend_factor=one|swapped, "
     "depth_func=inverted, stencil_op=shifted, blend_function=shifted, scissor_shift=N, "
-    "lod_shift=N, lod_weight=inverted, "
-    "hang=FIXTURE|*, crash=FIXTURE|*, flaky=FIXTURE|*, hang_once=FIXTURE|*";
+    "lod_shift=N, lod_weight=inverted, shadow_shift=N, shadow_compare=inverted, "
+    "shadow_bias=dropped, hang=FIXTURE|*, crash=FIXTURE|*, flaky=FIXTURE|*, hang_once=FIXTURE|*";
 
 [[noreturn]] void badFault(std::string_view entry, std::string_view why) {
   throw InputError(
@@ -46,7 +46,7 @@ bool Faults::any() const {
          move_line_end != 0 || move_point != 0 || texel_offset != 0.0 ||
          blend_factor != Blend::Correct || depth_func_inverted || stencil_op_shifted ||
          blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 || lod_weight_inverted ||
-         !hang.empty() || !crash.empty() || !flaky.empty() || !hang_once.empty();
+         shadow_shift != 0.0 || shadow_compare_inverted || shadow_bias_dropped || !hang.empty() || !crash.empty() || !flaky.empty() || !hang_once.empty();
 }
 
 bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }
@@ -76,6 +76,9 @@ std::string Faults::describe() const {
   if (scissor_shift != 0) parts.push_back(fmt::format("scissor_shift={}", scissor_shift));
   if (lod_shift != 0.0) parts.push_back(fmt::format("lod_shift={}", lod_shift));
   if (lod_weight_inverted) parts.emplace_back("lod_weight=inverted");
+  if (shadow_shift != 0.0) parts.push_back(fmt::format("shadow_shift={}", shadow_shift));
+  if (shadow_compare_inverted) parts.emplace_back("shadow_compare=inverted");
+  if (shadow_bias_dropped) parts.emplace_back("shadow_bias=dropped");
   if (!hang.empty()) parts.push_back("hang=" + hang);
   if (!crash.empty()) parts.push_back("crash=" + crash);
   if (!flaky.empty()) parts.push_back("flaky=" + flaky);
@@ -101,7 +104,8 @@ Faults parseFaults(std::string_view text) {
                         name == "hang" || name == "crash" || name == "flaky" ||
                         name == "hang_once" || name == "depth_func" || name == "stencil_op" ||
                         name == "blend_function" || name == "scissor_shift" ||
-                        name == "lod_shift" || name == "lod_weight";
+                        name == "lod_shift" || name == "lod_weight" || name == "shadow_shift" ||
+                        name == "shadow_compare" || name == "shadow_bias";
     if (!flag && !valued) badFault(entry, "unknown fault");
     if (flag == has_value) badFault(entry, flag ? "takes no value" : "needs a value (NAME=VALUE)");
     if (name == "drop_primitive") {
@@ -148,6 +152,14 @@ Faults parseFaults(std::string_view text) {
     } else if (name == "lod_weight") {
       if (value != "inverted") badFault(entry, "must be inverted");
       f.lod_weight_inverted = true;
+    } else if (name == "shadow_shift") {
+      f.shadow_shift = number<double>(entry, value);
+    } else if (name == "shadow_compare") {
+      if (value != "inverted") badFault(entry, "must be inverted");
+      f.shadow_compare_inverted = true;
+    } else if (name == "shadow_bias") {
+      if (value != "dropped") badFault(entry, "must be dropped");
+      f.shadow_bias_dropped = true;
     } else if (name == "hang" || name == "crash" || name == "flaky" || name == "hang_once") {
       if (value.empty()) badFault(entry, "needs a fixture name or *");
       (name == "hang"    ? f.hang

@@ -136,7 +136,9 @@ struct Program {
   GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
   GLint opacity = -1, has_texture = -1, texture = -1;
   GLint fault_depth_bias = -1, fault_shift_ndc = -1, fault_texel_offset = -1,
-        fault_lod_bias = -1;  // -1 unless compiled with the fault
+        fault_lod_bias = -1, fault_shadow_shift = -1;  // -1 unless compiled with the fault
+  // Shadow lookups (-1 in programs without them).
+  GLint shadow_map = -1, shadow_matrix = -1, shadow_bias = -1, light_shadowed = -1;
 };
 
 // The FBO of the last render, kept for the next one of the same size and formats:
@@ -477,14 +479,16 @@ GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& s
                                  stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log));
 }
 
-const Program& programFor(Session& s, int max_lights, const gl::testing::Faults& faults) {
+const Program& programFor(Session& s, int max_lights, const gl::testing::Faults& faults,
+                          bool shadows) {
   gl::ShaderFaults shader_faults;
   shader_faults.depth_bias = faults.depth_bias_steps != 0;
   shader_faults.shift_x = faults.shift_x_px != 0.0;
   shader_faults.compile_error = faults.shader_compile_error;
   shader_faults.texel_offset = faults.texel_offset != 0.0;
   shader_faults.lod_weight = faults.lod_weight_inverted;
-  gl::ProgramSource source = gl::programSource(max_lights, shader_faults);
+  shader_faults.shadow_shift = faults.shadow_shift != 0.0;
+  gl::ProgramSource source = gl::programSource(max_lights, shader_faults, shadows);
   const gl::testing::Hooks& hooks = gl::testing::hooks();
   if (!hooks.vertex_shader.empty()) source.vertex = hooks.vertex_shader;
   if (!hooks.fragment_shader.empty()) source.fragment = hooks.fragment_shader;
@@ -549,6 +553,11 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   p.fault_shift_ndc = loc("u_fault_shift_ndc");
   p.fault_texel_offset = loc("u_fault_texel_offset");
   p.fault_lod_bias = loc("u_fault_lod_bias");
+  p.fault_shadow_shift = loc("u_fault_shadow_shift");
+  p.shadow_map = loc("u_shadow_map");
+  p.shadow_matrix = loc("u_shadow_matrix");
+  p.shadow_bias = loc("u_shadow_bias");
+  p.light_shadowed = loc("u_light_shadowed");
   return s.programs.emplace(key, p).first->second;
 }
 
@@ -731,7 +740,8 @@ void uploadVertices(RenderObjects& o, const gl::VertexData& data) {
 
 // One GL texture per distinct rc::Texture; returns the name for each material (0: none).
 std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max_texture_size,
-                                   const gl::testing::Faults& faults) {
+                                   const gl::testing::Faults& faults,
+                                   const std::map<std::string, GLuint>& target_textures) {
   const gl::Functions& gl = o.gl;
   std::map<const Texture*, GLuint> by_texture;
   std::vector<GLuint> per_material(scene.materials.size(), 0);
@@ -753,6 +763,20 @@ std::vector<GLuint> uploadTextures(RenderObjects& o, const Scene& scene, int max
   gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
   gl.ActiveTexture(GL_TEXTURE0);
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    // A colour target an earlier pass drew: its own texture, one level, sampled with the
+    // scene's filters and wrap.
+    if (const std::string& name = scene.materials[m].texture_target; !name.empty()) {
+      const auto it = target_textures.find(name);
+      if (it == target_textures.end()) continue;
+      gl.BindTexture(GL_TEXTURE_2D, it->second);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                       minFilter(st) == MinFilter::Linear ? GL_LINEAR : GL_NEAREST);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, mag_filter);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
+      per_material[m] = it->second;
+      continue;
+    }
     const Texture* t = scene.materials[m].texture.get();
     if (t == nullptr) continue;
     const bool explicit_levels = !scene.materials[m].texture_levels.empty();
@@ -814,6 +838,9 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
   const auto count = static_cast<GLsizei>(scene.lights.size());
   gl.Uniform1i(p.light_count, count);
   gl.Uniform1i(p.texture, 0);
+  if (p.shadow_map >= 0) gl.Uniform1i(p.shadow_map, 1);
+  if (p.fault_shadow_shift >= 0)
+    gl.Uniform1f(p.fault_shadow_shift, static_cast<GLfloat>(faults.shadow_shift));
   if (p.fault_shift_ndc >= 0) {
     gl.Uniform1f(p.fault_shift_ndc, static_cast<GLfloat>(2.0 * faults.shift_x_px / scene.width));
   }
@@ -846,8 +873,37 @@ void setSceneUniforms(const gl::Functions& gl, const Program& p, const Scene& sc
   gl.Uniform1fv(p.light_intensity, count, intensity.data());
 }
 
+// A material's shadow lookup as GL draws it: the map's depth texture with its compare
+// state, the matrix into it, the bias and which lights it darkens.
+struct MaterialShadow {
+  GLuint texture = 0;  // 0: no lookup
+  glm::mat4 matrix{1.0f};
+  GLint compare = GL_LEQUAL;
+  GLint filter = GL_NEAREST;
+  GLfloat bias = 0.0f;
+  std::vector<GLint> shadowed;  // per light: 1 where lights[i].shadow_map is the map
+};
+
 void setMaterialUniforms(const gl::Functions& gl, const Program& p, const Material& m,
-                         GLuint texture) {
+                         GLuint texture, const MaterialShadow* shadow) {
+  if (p.light_shadowed >= 0) {
+    const MaterialShadow none;
+    const MaterialShadow& sh = shadow != nullptr && shadow->texture != 0 ? *shadow : none;
+    std::vector<GLint> flags = sh.shadowed;
+    flags.resize(static_cast<std::size_t>(std::max(p.max_lights, 1)), 0);
+    gl.Uniform1iv(p.light_shadowed, p.max_lights, flags.data());
+    if (sh.texture != 0) {
+      gl.ActiveTexture(GL_TEXTURE1);
+      gl.BindTexture(GL_TEXTURE_2D, sh.texture);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, sh.compare);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, sh.filter);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, sh.filter);
+      gl.ActiveTexture(GL_TEXTURE0);
+      gl.UniformMatrix4fv(p.shadow_matrix, 1, GL_FALSE, glm::value_ptr(sh.matrix));
+      gl.Uniform1f(p.shadow_bias, sh.bias);
+    }
+  }
   gl.Uniform3fv(p.material_ambient, 1, glm::value_ptr(toFloat(m.ambient)));
   gl.Uniform3fv(p.material_diffuse, 1, glm::value_ptr(toFloat(m.diffuse)));
   gl.Uniform3fv(p.material_specular, 1, glm::value_ptr(toFloat(m.specular)));
@@ -1083,13 +1139,14 @@ double measureOffsetR(const gl::Functions& gl, const Program& p, const Scene& sc
 
 void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
                   const gl::VertexData& data, const std::vector<GLuint>& textures,
-                  const gl::testing::Faults& faults) {
+                  const std::vector<MaterialShadow>& shadows, const gl::testing::Faults& faults) {
   std::uint32_t bound_material = UINT32_MAX;
   for (const gl::PassRuns& pass : data.passes) {
     setPassState(gl, pass.state, faults);
     for (const gl::DrawRun& run : pass.runs) {
       if (run.material != bound_material) {
-        setMaterialUniforms(gl, p, scene.materials[run.material], textures[run.material]);
+        setMaterialUniforms(gl, p, scene.materials[run.material], textures[run.material],
+                            shadows.empty() ? nullptr : &shadows[run.material]);
         bound_material = run.material;
       }
       constexpr std::array<GLenum, 3> kPrimitives{GL_TRIANGLES, GL_LINES, GL_POINTS};
@@ -1475,8 +1532,159 @@ void injectFlake(const gl::testing::Faults& faults, const std::string& fixture, 
   red = red > 0.5f ? red - units / 255.0f : red + units / 255.0f;
 }
 
-Frame renderLocked(const Scene& scene, const GlSpec& spec) {
-  validateForRendering(scene);  // bad input is exit 2 before any driver starts
+// ---- multi-pass scenes ---------------------------------------------------------------
+// The passes before the frame pass draw into framebuffers of their own, each target's
+// contents in a texture (colour, or depth with its compare state set per lookup) that the
+// later passes sample; their frames are read back for `render --all-passes`.
+struct PassTargets {
+  const gl::Functions& gl;
+  std::map<std::string, GLuint> color;  // colour targets' textures, by name
+  std::map<std::string, GLuint> depth;  // depth targets' textures, by name
+  std::vector<GLuint> textures;
+  std::vector<GLuint> renderbuffers;
+  std::vector<GLuint> framebuffers;
+
+  explicit PassTargets(const gl::Functions& functions) : gl(functions) {}
+  PassTargets(const PassTargets&) = delete;
+  PassTargets& operator=(const PassTargets&) = delete;
+  ~PassTargets() {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!framebuffers.empty())
+      gl.DeleteFramebuffers(static_cast<GLsizei>(framebuffers.size()), framebuffers.data());
+    if (!renderbuffers.empty())
+      gl.DeleteRenderbuffers(static_cast<GLsizei>(renderbuffers.size()), renderbuffers.data());
+    if (!textures.empty()) gl.DeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+    gl.GetError();
+  }
+
+  GLuint texture(GLenum internal, GLenum format, GLenum type, int w, int h) {
+    GLuint t = 0;
+    gl.GenTextures(1, &t);
+    textures.push_back(t);
+    gl.BindTexture(GL_TEXTURE_2D, t);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), w, h, 0, format, type, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    return t;
+  }
+  GLuint renderbuffer(GLenum internal, int w, int h) {
+    GLuint r = 0;
+    gl.GenRenderbuffers(1, &r);
+    renderbuffers.push_back(r);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, r);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, internal, w, h);
+    return r;
+  }
+};
+
+bool hasShadowLookups(const Scene& scene) {
+  return std::any_of(scene.materials.begin(), scene.materials.end(),
+                     [](const Material& m) { return m.shadow.has_value(); });
+}
+
+// The shadow lookups of `pass_scene`'s materials (multi-pass `scene`): empty when none.
+std::vector<MaterialShadow> materialShadows(const Scene& scene, const Scene& pass_scene,
+                                            const PassTargets& targets,
+                                            const gl::testing::Faults& faults) {
+  std::vector<MaterialShadow> out;
+  if (!hasShadowLookups(pass_scene)) return out;
+  out.resize(pass_scene.materials.size());
+  for (std::size_t m = 0; m < pass_scene.materials.size(); ++m) {
+    const std::optional<ShadowLookup>& lookup = pass_scene.materials[m].shadow;
+    if (!lookup) continue;
+    const auto it = targets.depth.find(lookup->map);
+    if (it == targets.depth.end()) continue;
+    MaterialShadow& sh = out[m];
+    sh.texture = it->second;
+    sh.matrix = glm::mat4(shadowMatrix(scene, lookup->map));
+    sh.compare = static_cast<GLint>(
+        glCompare(faults.shadow_compare_inverted ? invertedFunc(lookup->compare) : lookup->compare));
+    sh.filter = lookup->filter == TextureFilter::Linear ? GL_LINEAR : GL_NEAREST;
+    sh.bias = faults.shadow_bias_dropped ? 0.0f : static_cast<GLfloat>(lookup->bias);
+    for (const Light& l : pass_scene.lights) sh.shadowed.push_back(l.shadow_map == lookup->map);
+  }
+  return out;
+}
+
+// Draws pass k (before the frame pass) of `scene` into its target and reads it back. The
+// test-only faults are the frame pass's: these passes draw without them.
+Frame drawTargetPass(Session& s, const Program& program, const Scene& scene, std::size_t k,
+                     PassTargets& targets, int max_texture_size) {
+  const gl::Functions& gl = s.gl;
+  const Scene ps = passScene(scene, k);
+  const RenderTarget& target = *findTarget(scene, scene.passes[k].target);
+  if (target.width > max_texture_size || target.height > max_texture_size)
+    throw BackendError(fmt::format("target {} is {}x{}, GL_MAX_TEXTURE_SIZE is {}", target.name,
+                                   target.width, target.height, max_texture_size));
+  const int w = ps.width;
+  const int h = ps.height;
+  GLuint fb = 0;
+  gl.GenFramebuffers(1, &fb);
+  targets.framebuffers.push_back(fb);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fb);
+  const AttachmentFormat color = colorFormat(ps.state.color_format);
+  const AttachmentFormat depth = depthFormat(ps.state.depth_format);
+  if (target.depth()) {
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                               targets.renderbuffer(color.internal, w, h));
+    const GLuint t = targets.texture(depth.internal, GL_DEPTH_COMPONENT, GL_FLOAT, w, h);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, t, 0);
+    targets.depth[target.name] = t;
+  } else {
+    const bool rgba8 = ps.state.color_format == ColorFormat::RGBA8;
+    const GLuint t =
+        targets.texture(color.internal, GL_RGBA, rgba8 ? GL_UNSIGNED_BYTE : GL_FLOAT, w, h);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t, 0);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                               targets.renderbuffer(depth.internal, w, h));
+    targets.color[target.name] = t;
+  }
+  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER,
+                             targets.renderbuffer(GL_R32UI, w, h));
+  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    const std::string what =
+        fmt::format("target {} ({} {}x{}): framebuffer incomplete: {}", target.name,
+                    toString(target.format), w, h, framebufferStatusName(status));
+    if (status == GL_FRAMEBUFFER_UNSUPPORTED) throw NotSupportedError(what);
+    throw BackendError(what);
+  }
+  const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl.DrawBuffers(2, draw_buffers);
+  checkGl(s, "target framebuffer setup");
+
+  const gl::testing::Faults none;
+  const std::vector<DrawPass> passes = drawPasses(ps);
+  const gl::VertexData data = gl::buildVertexData(ps, passes, none);
+  RenderObjects objects(gl);
+  uploadVertices(objects, data);
+  const std::vector<GLuint> textures =
+      uploadTextures(objects, ps, max_texture_size, none, targets.color);
+  setSceneUniforms(gl, program, ps, none);
+  setFixedState(gl, ps);
+  clearFramebuffer(gl, ps);
+  drawPassesGl(gl, program, ps, data, textures, materialShadows(scene, ps, targets, none), none);
+  resetPassState(gl);
+  checkGl(s, fmt::format("pass {} (target {})", k, target.name).c_str());
+  Frame frame;
+  readBack(s, ps, frame);
+  checkGl(s, "target readback");
+  frame.meta["pass"] = {{"index", k}, {"target", target.name}, {"format", toString(target.format)}};
+  frame.drawn = drawFacts(ps);
+  return frame;
+}
+
+Frame renderLocked(const Scene& multi, const GlSpec& spec) {
+  // A multi-pass scene draws its targets first, then its frame pass (`scene` below).
+  validateForRendering(multi);
+  const bool multipass = !multi.passes.empty();
+  const Scene frame_scene = multipass ? passScene(multi, multi.passes.size() - 1) : Scene{};
+  const Scene& scene = multipass ? frame_scene : multi;
+
   const gl::testing::Faults faults = activeFaults();  // bad RASTERCHECK_GL_FAULT: exit 2
   const std::vector<DrawPass> passes = drawPasses(scene);
   auto start = Clock::now();
@@ -1496,7 +1704,8 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   // Compiling is the driver's work and happens once per process and program; it is
   // timed apart from the upload (the harness's own work).
   start = Clock::now();
-  const Program& program = programFor(s, lightArraySize(gl, scene.lights.size()), faults);
+  const Program& program =
+      programFor(s, lightArraySize(gl, scene.lights.size()), faults, hasShadowLookups(scene));
   checkGl(s, "shader compilation");
   const double compile_ms = msSince(start);
 
@@ -1525,6 +1734,16 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
           samples, usable, max_samples));
   }
   s.render_unfinished = true;  // until the frame is read back
+  PassTargets targets(gl);
+  std::vector<Frame> pass_frames;
+  double passes_ms = 0.0;
+  if (multipass) {
+    const auto passes_start = Clock::now();
+    for (std::size_t k = 0; k + 1 < multi.passes.size(); ++k)
+      pass_frames.push_back(
+          drawTargetPass(s, program, multi, k, targets, glInteger(gl, GL_MAX_TEXTURE_SIZE)));
+    passes_ms = msSince(passes_start);
+  }
   bindFramebuffer(s, scene);
   checkGl(s, "framebuffer setup");
   MultisampleTargets ms(gl);
@@ -1568,7 +1787,8 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   RenderObjects objects(gl);
   uploadVertices(objects, data);
   const std::vector<GLuint> textures =
-      uploadTextures(objects, scene, glInteger(gl, GL_MAX_TEXTURE_SIZE), faults);
+      uploadTextures(objects, scene, glInteger(gl, GL_MAX_TEXTURE_SIZE), faults, targets.color);
+  const std::vector<MaterialShadow> shadows = materialShadows(multi, scene, targets, faults);
   setSceneUniforms(gl, program, scene, faults);
   if (gl::testing::hooks().gl_error_after_upload) gl.Enable(0xFFFFu);  // not a capability
   checkGl(s, "upload");
@@ -1584,7 +1804,7 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
     offset_r = measureOffsetR(gl, program, scene, probe_first);
   }
   clearFramebuffer(gl, scene);
-  drawPassesGl(gl, program, scene, data, textures, faults);
+  drawPassesGl(gl, program, scene, data, textures, shadows, faults);
   resetPassState(gl);
   gl.Finish();
   injectStall(faults, scene.name);
@@ -1635,6 +1855,8 @@ Frame renderLocked(const Scene& scene, const GlSpec& spec) {
   m["timing_cpu_ms"] = {{"framebuffer", framebuffer_cpu_ms},
                         {"upload", upload_cpu_ms},
                         {"readback", readback_cpu_ms}};
+  if (multipass) m["timing_ms"]["passes"] = passes_ms;
+  frame.passes = std::move(pass_frames);
   frame.drawn = drawFacts(scene);  // what a comparison of this frame needs
   return frame;
 }

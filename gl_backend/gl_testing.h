@@ -58,6 +58,13 @@ struct Faults {
   // it uses 1 - f (textureQueryLOD, then two textureLod): the levels right, their weights
   // wrong.
   bool lod_weight_inverted = false;
+  // Shadow lookups (materials' shadow): shadow_shift=N: every lookup N map texels to the
+  // right (the map offset by N texels); shadow_compare=inverted: the comparison inverted
+  // as depth_func=inverted does (LEQUAL -> GEQUAL ...); shadow_bias=dropped: the bias
+  // left out of the reference value.
+  double shadow_shift = 0.0;
+  bool shadow_compare_inverted = false;
+  bool shadow_bias_dropped = false;
   // hang=NAME / crash=NAME: the render of the fixture named NAME ("*": every fixture) never
   // returns (blocks after the draw, as a driver stuck in a fence would) or dies with
   // SIGSEGV there, for the watchdog and crash tests of `run`'s workers.

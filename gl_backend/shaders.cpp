@@ -59,6 +59,29 @@ uniform vec3 u_material_diffuse;
 uniform vec3 u_material_specular;
 uniform float u_shininess;
 
+#ifdef RC_SHADOW_LOOKUP
+// Shadow lookups (fragment stage): the material's map through a sampler2DShadow (compare
+// mode, function and filter set on the texture), u_light_shadowed[i] for the lights whose
+// map it is; behind the map's camera (w <= 0) the light is not shadowed.
+uniform sampler2DShadow u_shadow_map;
+uniform mat4 u_shadow_matrix;  // world -> the map's (s, t, r, w), composed in double
+uniform float u_shadow_bias;
+uniform int u_light_shadowed[RC_MAX_LIGHTS];
+#ifdef RC_FAULT_SHADOW_SHIFT
+uniform float u_fault_shadow_shift;  // test-only: map texels to the right
+#endif
+float shadowFactor(int i, vec3 p) {
+  if (u_light_shadowed[i] == 0) return 1.0;
+  vec4 c = u_shadow_matrix * vec4(p, 1.0);
+  if (!(c.w > 0.0)) return 1.0;
+  vec3 q = c.xyz / c.w;
+#ifdef RC_FAULT_SHADOW_SHIFT
+  q.x += u_fault_shadow_shift / float(textureSize(u_shadow_map, 0).x);
+#endif
+  return texture(u_shadow_map, vec3(q.xy, q.z - u_shadow_bias));
+}
+#endif
+
 // normalize() with zero (or a non-finite length) staying zero: a zero normal lights nothing.
 vec3 safeNormalize(vec3 v) {
   float len = length(v);
@@ -93,7 +116,9 @@ void shadePoint(vec3 p, vec3 n, out vec3 ambient_diffuse, out vec3 specular) {
     }
     vec3 L = u_light_color[i] * u_light_intensity[i] * att;
     float n_dot_l = dot(n, l);
+#ifndef RC_SHADOW_LOOKUP
     ambient_diffuse += u_material_diffuse * L * max(0.0, n_dot_l);
+#endif
     float base;
     if (u_specular_model == RC_SPECULAR_BLINN_PHONG) {
       vec3 h = safeNormalize(l + v);
@@ -102,7 +127,15 @@ void shadePoint(vec3 p, vec3 n, out vec3 ambient_diffuse, out vec3 specular) {
       vec3 r = 2.0 * n_dot_l * n - l;
       base = max(0.0, dot(r, v));
     }
+#ifdef RC_SHADOW_LOOKUP
+    // The lookup's result scales this light's terms (1 for lights the material's map does
+    // not belong to): reference/shading.h shadePrepared().
+    float f = shadowFactor(i, p);
+    ambient_diffuse += (u_material_diffuse * L * max(0.0, n_dot_l)) * f;
+    specular += (u_material_specular * L * specularPower(base, u_shininess)) * f;
+#else
     specular += u_material_specular * L * specularPower(base, u_shininess);
+#endif
   }
 }
 )";
@@ -226,7 +259,7 @@ void main() {
 
 }  // namespace
 
-ProgramSource programSource(int max_lights, const ShaderFaults& faults) {
+ProgramSource programSource(int max_lights, const ShaderFaults& faults, bool shadows) {
   std::string header = fmt::format(kHeader, max_lights);
   for (const GlslEnumDefine& d : glslEnumDefines())
     header += fmt::format("#define {} {}\n", d.name, d.value);
@@ -239,6 +272,8 @@ ProgramSource programSource(int max_lights, const ShaderFaults& faults) {
     fragment_header +=
         "#extension GL_ARB_texture_query_lod : require\n#define RC_FAULT_LOD_WEIGHT\n";
   if (faults.compile_error) fragment_header += "#define RC_FAULT_COMPILE_ERROR\n";
+  if (shadows) fragment_header += "#define RC_SHADOW_LOOKUP\n";
+  if (shadows && faults.shadow_shift) fragment_header += "#define RC_FAULT_SHADOW_SHIFT\n";
   return {header + kLighting + kVertexMain, fragment_header + kLighting + kFragmentMain};
 }
 

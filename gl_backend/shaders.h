@@ -48,10 +48,12 @@ struct ShaderFaults {
   bool compile_error = false;  // the fragment shader calls a function that does not exist
   bool texel_offset = false;   // texture() samples at v_uv + u_fault_texel_offset texels in s
   bool lod_weight = false;     // two mip levels blended with the weight inverted (1 - f)
+  bool shadow_shift = false;   // shadow lookups u_fault_shadow_shift map texels to the right
 };
 
 // The program for scenes with up to max_lights lights (array sizes are compile-time
-// constants in GLSL 330).
-ProgramSource programSource(int max_lights, const ShaderFaults& faults = {});
+// constants in GLSL 330); `shadows`: with the shadow lookup (a fragment-stage sampler2DShadow
+// scaling the shadowed lights' terms), for scenes whose materials have one.
+ProgramSource programSource(int max_lights, const ShaderFaults& faults = {}, bool shadows = false);
 
 }  // namespace rc::gl
