@@ -50,6 +50,9 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   render_cmd->add_option("--out,-o", render.out, "Output folder (frame.exr, color.png, frame.json)")
       ->required();
+  render_cmd->add_flag("--all-passes", render.all_passes,
+                       "Multi-pass fixtures: also write what each pass before the frame pass drew "
+                       "into its target, as OUT/passes/K-TARGET/ (a frame folder each)");
 
   ListArgs list;
   CLI::App* list_cmd = app.add_subcommand("list", "List fixtures: name, tags, description");

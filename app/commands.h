@@ -14,6 +14,7 @@ struct RenderArgs {
   std::filesystem::path scene;
   std::string backend = "ref";
   std::filesystem::path out;
+  bool all_passes = false;  // multi-pass scenes: every pass's target in OUT/passes/K-NAME/
 };
 int renderCommand(const RenderArgs& args);
 

@@ -3,6 +3,7 @@
 // the process once with that folder first in LD_LIBRARY_PATH.
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -40,6 +41,7 @@ void restartWithStartupEnvironment(const RenderArgs& args, const BackendSpec& ba
   const std::string exe = "/proc/self/exe";
   std::vector<std::string> argv = {exe,          "render", args.scene.string(), "--backend",
                                    args.backend, "--out",  args.out.string()};
+  if (args.all_passes) argv.emplace_back("--all-passes");
   std::vector<char*> raw;
   raw.reserve(argv.size() + 1);
   for (std::string& a : argv) raw.push_back(a.data());
@@ -61,6 +63,20 @@ int renderCommand(const RenderArgs& args) {
   const Frame frame = renderWith(backend, scene);
   writeFrameDir(frame, args.out);
   std::cout << fmt::format("{}: {} -> {}\n", scene.name, backend.text, args.out.string());
+  if (args.all_passes) {
+    for (const Frame& pass : frame.passes) {
+      const nlohmann::json& p = pass.meta.at("pass");
+      std::string name = p.at("target").get<std::string>();
+      for (char& c : name)  // a folder name whatever the target is called
+        if (std::isalnum(static_cast<unsigned char>(c)) == 0 && c != '-' && c != '_') c = '_';
+      const std::filesystem::path dir =
+          args.out / "passes" / fmt::format("{}-{}", p.at("index").get<int>(), name);
+      writeFrameDir(pass, dir);
+      std::cout << fmt::format("  pass {} ({} {}x{}) -> {}\n", p.at("index").get<int>(),
+                               p.at("target").get<std::string>(), pass.width, pass.height,
+                               dir.string());
+    }
+  }
   return kExitPass;
 }
 
