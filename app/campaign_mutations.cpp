@@ -50,7 +50,10 @@ std::set<std::string> failingClasses(const PairResult& r) {
 
 // What the scene offers the faults: its state and materials (the clean frame adds the
 // visible primitives).
-MutationScene sceneFacts(const Scene& scene) {
+MutationScene sceneFacts(const Scene& multi) {
+  // A multi-pass scene's frame pass: what the compared frame draws, with its ids.
+  const Scene frame_pass = multi.passes.empty() ? Scene{} : passScene(multi, multi.passes.size() - 1);
+  const Scene& scene = multi.passes.empty() ? multi : frame_pass;
   MutationScene m;
   m.depth_format = toString(scene.state.depth_format);
   for (const Object& o : scene.objects) {
@@ -63,6 +66,13 @@ MutationScene sceneFacts(const Scene& scene) {
     m.lod_blend = m.lod_blend ||
                   (mat.texture != nullptr &&
                    (min == MinFilter::NearestMipmapLinear || min == MinFilter::LinearMipmapLinear));
+    if (mat.shadow) {
+      const bool lit = std::any_of(scene.lights.begin(), scene.lights.end(), [&](const Light& l) {
+        return l.shadow_map == mat.shadow->map;
+      });
+      m.shadowed = m.shadowed || lit;
+      m.shadow_bias = m.shadow_bias || (lit && mat.shadow->bias != 0.0);
+    }
   }
   for (const PrimitiveRef& p : flattenPrimitives(scene)) {
     const PrimitiveKind kind = scene.objects[p.object].primitive;

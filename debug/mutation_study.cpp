@@ -16,7 +16,7 @@ using nlohmann::json;
 
 namespace {
 
-constexpr std::array<MutationFault, 14> kFaults = {{
+constexpr std::array<MutationFault, 17> kFaults = {{
     {"light_scale", "shading", "every light 1% brighter"},
     {"depth_bias", "depth", "stored depth 4 x the fail threshold further (8 d16 / 64 d24 steps)"},
     {"drop_primitive", "visibility", "one visible triangle not drawn"},
@@ -33,6 +33,10 @@ constexpr std::array<MutationFault, 14> kFaults = {{
     {"move_line_end", "visibility",
      "one end of one visible line segment one pixel off, across the segment"},
     {"move_point", "visibility", "one visible point one pixel right"},
+    {"shadow_shift", "shading", "shadow lookups one map texel to the right (the map offset)"},
+    {"shadow_compare", "shading",
+     "shadow comparison inverted (LEQUAL and GEQUAL, LESS and GREATER swapped)"},
+    {"shadow_bias", "shading", "shadow lookups without their bias"},
 }};
 
 constexpr std::array<MutationVerdict, 6> kVerdicts = {
@@ -92,6 +96,9 @@ std::string faultSetting(const MutationFault& fault, const MutationScene& scene,
   if (name == "scissor_shift") return scene.scissor ? "scissor_shift=1" : "";
   if (name == "lod_shift") return scene.lod ? "lod_shift=1" : "";
   if (name == "lod_weight") return scene.lod_blend ? "lod_weight=inverted" : "";
+  if (name == "shadow_shift") return scene.shadowed ? "shadow_shift=1" : "";
+  if (name == "shadow_compare") return scene.shadowed ? "shadow_compare=inverted" : "";
+  if (name == "shadow_bias") return scene.shadow_bias ? "shadow_bias=dropped" : "";
   // The candidates: visible segments, points, or (move_vertex) the other visible ids.
   std::vector<std::uint32_t> ids;
   auto in = [](const std::vector<std::uint32_t>& sorted, std::uint32_t id) {

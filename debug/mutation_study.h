@@ -44,7 +44,9 @@ struct MutationFault {
 // stencil_op (depth: the stencil buffer is compared in that class), blend_function
 // (shading) and scissor_shift (visibility); lod_shift (shading) for textures sampled with a
 // level of detail, lod_weight (shading) for textures blended between two mip levels;
-// move_line_end and move_point (visibility) for line and point primitives.
+// move_line_end and move_point (visibility) for line and point primitives; shadow_shift,
+// shadow_compare and shadow_bias (shading) for shadow lookups (shadow_bias where one has a
+// bias).
 std::span<const MutationFault> mutationFaults();
 // Throws InputError naming the valid names.
 const MutationFault& mutationFault(const std::string& name);
@@ -61,6 +63,8 @@ struct MutationScene {
   bool scissor = false;                    // some pass has a scissor box
   bool lod = false;  // textured, sampled with a level of detail (fixtures/scene.h lodSampling())
   bool lod_blend = false;  // textured with a *_mipmap_linear min filter (two levels blended)
+  bool shadowed = false;     // a drawn material's shadow lookup darkens some light
+  bool shadow_bias = false;  // and one of those lookups has a bias
   // Primitive ids of line segments and of points (line and point primitives; triangles in
   // polygon mode line or point are triangles), ascending: move_line_end and move_point pick
   // from the visible ones, move_vertex from the visible others.

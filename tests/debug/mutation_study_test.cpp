@@ -69,6 +69,14 @@ TEST(MutationStudy, SettingsFollowWhatTheSceneOffers) {
   EXPECT_EQ(faultSetting(mutationFault("lod_weight"), scene, 1, 0), "") << "one level at a time";
   scene.lod_blend = true;
   EXPECT_EQ(faultSetting(mutationFault("lod_weight"), scene, 1, 0), "lod_weight=inverted");
+  EXPECT_EQ(faultSetting(mutationFault("shadow_shift"), scene, 1, 0), "") << "no shadow lookup";
+  EXPECT_EQ(faultSetting(mutationFault("shadow_compare"), scene, 1, 0), "");
+  scene.shadowed = true;
+  EXPECT_EQ(faultSetting(mutationFault("shadow_shift"), scene, 1, 0), "shadow_shift=1");
+  EXPECT_EQ(faultSetting(mutationFault("shadow_compare"), scene, 1, 0), "shadow_compare=inverted");
+  EXPECT_EQ(faultSetting(mutationFault("shadow_bias"), scene, 1, 0), "") << "no bias to drop";
+  scene.shadow_bias = true;
+  EXPECT_EQ(faultSetting(mutationFault("shadow_bias"), scene, 1, 0), "shadow_bias=dropped");
 }
 
 TEST(MutationStudy, PrimitivesAreDrawnFromTheVisibleOnesReproducibly) {

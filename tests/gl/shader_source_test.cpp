@@ -73,7 +73,8 @@ std::string code(const std::string& source) {
 TEST(ShaderSource, EnumUniformsAreComparedOnlyWithGeneratedNames) {
   ShaderFaults all;
   all.depth_bias = all.shift_x = all.texel_offset = true;
-  for (const ProgramSource& p : {programSource(1), programSource(8, all)}) {
+  for (const ProgramSource& p :
+       {programSource(1), programSource(8, all), programSource(2, {}, true)}) {
     for (const std::string* stage : {&p.vertex, &p.fragment}) {
       const std::string body = code(*stage);
       // No literal on either side of ==/!= with an enum-carrying uniform.
@@ -82,7 +83,7 @@ TEST(ShaderSource, EnumUniformsAreComparedOnlyWithGeneratedNames) {
           R"(|-?[0-9]+\s*[=!]=\s*(u_shading|u_specular_model|u_attenuation|u_light_type))");
       EXPECT_FALSE(std::regex_search(body, literal)) << body;
       // Every RC_ name the code uses is generated (or one of the program's own defines).
-      std::set<std::string> known = {"RC_MAX_LIGHTS"};
+      std::set<std::string> known = {"RC_MAX_LIGHTS", "RC_SHADOW_LOOKUP"};
       for (const GlslEnumDefine& d : glslEnumDefines()) known.insert(d.name);
       const std::regex name(R"(\bRC_[A-Z_]+\b)");
       for (auto it = std::sregex_iterator(body.begin(), body.end(), name);
