@@ -90,6 +90,8 @@ int explainCommand(const ExplainArgs& args) {
         checkSameSize(frame, other, args.scene, backends[b].text);
         out_backends[backends[b].text] = backendPixel(
             backends[b].text, frame, other, pairTolerances(frame, other, scene.tolerance, cli), i);
+        if (!scene.passes.empty())
+          out_backends[backends[b].text]["shadow_texels"] = backendShadowTexels(doc, other);
       } catch (const BackendError& e) {
         backend_failed = true;
         out_backends[backends[b].text] = {{"backend", backends[b].text}, {"error", e.what()}};

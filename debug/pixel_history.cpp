@@ -1,6 +1,9 @@
 // Pixel history and its story: see pixel_history.h.
 #include "debug/pixel_history.h"
 
+#include "reference/multipass.h"
+#include "reference/shadow.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -36,6 +39,49 @@ Json factorsJson(const LightFactors& f, double weight) {
           {"r_dot_v", num(f.r_dot_v)},
           {"specular_power", num(f.specular_power)},
           {"contributes", f.contributes}};
+}
+
+// The shadow lookup of a light at a Phong fragment (null when the material's lookup does
+// not read the light's map): where it lands in the map pass's target, the depth stored
+// there and the range another driver's may take, the comparison and its result.
+Json shadowJson(const Material& material, const Light& light, const ShadingTerms& terms) {
+  if (!material.shadow || material.shadow->data == nullptr || terms.points.size() != 1 ||
+      light.shadow_map.empty() || light.shadow_map != material.shadow->map)
+    return nullptr;
+  const ShadowLookup& lookup = *material.shadow;
+  const ShadowMapData& map = *lookup.data;
+  const glm::dvec3 p = terms.points.front().position;
+  const ref::ShadowCoord c = ref::shadowCoord(lookup, p);
+  Json j = {{"map", lookup.map},
+            {"filter", toString(lookup.filter)},
+            {"compare", toString(lookup.compare)},
+            {"bias", num(lookup.bias)},
+            {"in_front", c.in_front},
+            {"result", num(ref::shadowFactor(lookup, p))}};
+  if (!c.in_front) return j;
+  const bool linear = lookup.filter == TextureFilter::Linear;
+  const double shift = linear ? 0.5 : 0.0;
+  auto index = [](double v, int size) {
+    return std::clamp(static_cast<int>(std::floor(v)), 0, size - 1);
+  };
+  const int i = index(c.s * map.width - shift, map.width);
+  const int t = index(c.t * map.height - shift, map.height);
+  j["coord"] = {num(c.s), num(c.t), num(c.r)};
+  Json texels = Json::array();
+  for (int dt = 0; dt <= (linear ? 1 : 0); ++dt) {
+    for (int ds = 0; ds <= (linear ? 1 : 0); ++ds) {
+      const int x = std::min(i + ds, map.width - 1);
+      const int y = std::min(t + dt, map.height - 1);
+      const std::size_t k = static_cast<std::size_t>(y) * map.width + x;
+      texels.push_back(
+          {{"texel", {x, y}},
+           {"image", {x, map.height - 1 - y}},  // the map's frame.exr pixel (top-left origin)
+           {"stored", num(map.depth[k])},
+           {"allowed", map.lo.empty() ? Json(nullptr) : Json{num(map.lo[k]), num(map.hi[k])}}});
+    }
+  }
+  j["texels"] = texels;
+  return j;
 }
 
 // The shading block of one fragment, all from the trace: the points the lighting model
@@ -86,7 +132,8 @@ Json shadingJson(const Scene& scene, const FragmentTrace& f) {
                       {"intensity", num(light.intensity)},
                       {"diffuse", vec(t.diffuse)},
                       {"specular", vec(t.specular)},
-                      {"factors", factors}});
+                      {"factors", factors},
+                      {"shadow", shadowJson(material, light, terms)}});
   }
   j["lights"] = lights;
   if (material.texture) {
@@ -264,6 +311,23 @@ std::string story(const Json& doc) {
       s += fmt::format("    light {} ({}): {} -> diffuse {}, specular {}\n", l["index"].get<int>(),
                        l["type"].get<std::string>(), factors, fmtVec(l["diffuse"]),
                        fmtVec(l["specular"]));
+      if (l.contains("shadow") && !l["shadow"].is_null()) {
+        const Json& sh = l["shadow"];
+        if (!sh["in_front"].get<bool>()) {
+          s += fmt::format("      shadow map {}: behind its camera, not shadowed\n",
+                           sh["map"].get<std::string>());
+        } else {
+          s += fmt::format("      shadow map {} ({} {}, bias {}) at (s, t, r) {}: result {}\n",
+                           sh["map"].get<std::string>(), sh["filter"].get<std::string>(),
+                           sh["compare"].get<std::string>(), fmtNum(sh["bias"]),
+                           fmtVec(sh["coord"]), fmtNum(sh["result"]));
+          for (const Json& t : sh["texels"])
+            s +=
+                fmt::format("        texel {} (map pixel {}): stored {}, another driver's in {}\n",
+                            fmtVec(t["texel"]), fmtVec(t["image"]), fmtNum(t["stored"]),
+                            t["allowed"].is_null() ? std::string("(exact)") : fmtVec(t["allowed"]));
+        }
+      }
     }
     if (!sh["texture"].is_null())
       s += fmt::format("    texture {} at uv {} multiplies ambient and diffuse\n",
@@ -372,19 +436,30 @@ std::string story(const Json& doc) {
           "allowance + {}\n",
           fmtVec(c["shading"]["delta_rgba"]), fmtVec(c["shading"]["allowance_rgba"]),
           fmtNum(c["shading"]["base_warn"]), fmtNum(c["shading"]["base_fail"]));
+    if (b.contains("shadow_texels")) {
+      for (const Json& t : b["shadow_texels"])
+        s += fmt::format(
+            "    shadow map {} texel {} (light {}): the driver stored {}, the reference {}\n",
+            t["map"].get<std::string>(), fmtVec(t["texel"]), fmtNum(t["light"]),
+            fmtNum(t["driver"]), fmtNum(t["reference"]));
+    }
   }
   return s;
 }
 
 }  // namespace
 
-Json pixelHistory(const Scene& scene, const PixelQuery& query, const Frame& frame) {
+Json pixelHistory(const Scene& multi, const PixelQuery& query, const Frame& frame) {
+  // A multi-pass fixture: the frame pass, its targets drawn (the history is the frame's).
+  ref::PassOutputs outputs;
+  if (!multi.passes.empty()) outputs = ref::renderPasses(multi, query.options);
+  const Scene& scene = multi.passes.empty() ? multi : outputs.frame_scene;
   const glm::ivec2 pixel(query.x, query.y);
   if (pixel.x < 0 || pixel.y < 0 || pixel.x >= scene.width || pixel.y >= scene.height)
     throw InputError(fmt::format("{}: pixel {},{} is outside the {}x{} image", query.fixture_file,
                                  pixel.x, pixel.y, scene.width, scene.height));
   const ReferenceOptions& options = query.options;
-  const std::vector<FragmentTrace> trace = tracePixel(scene, options, pixel.x, pixel.y);
+  const std::vector<FragmentTrace> trace = tracePixel(multi, options, pixel.x, pixel.y);
   const std::size_t i = frame.index(pixel.x, pixel.y);
   const std::vector<PrimitiveRef> primitives = flattenPrimitives(scene);  // by id - 1
   const std::vector<DrawPass> passes = drawPasses(scene, options.force_painter);
@@ -604,6 +679,36 @@ Json backendPixel(const std::string& spec, const Frame& reference, const Frame& 
   j["class"] = c;
   j["pair_status"] = toString(r.status);
   return j;
+}
+
+Json backendShadowTexels(const Json& doc, const Frame& frame) {
+  Json out = Json::array();
+  const Json& final_fragment = doc.at("final").at("fragment");
+  if (final_fragment.is_null()) return out;
+  const Json& f = doc.at("fragments").at(final_fragment.get<std::size_t>() - 1);
+  for (const Json& light : f.at("shading").at("lights")) {
+    const Json& sh = light.at("shadow");
+    if (sh.is_null() || !sh.contains("texels")) continue;
+    const Frame* map = nullptr;
+    for (const Frame& pass : frame.passes)
+      if (pass.meta.contains("pass") && pass.meta["pass"].value("target", "") == sh["map"])
+        map = &pass;
+    for (const Json& t : sh["texels"]) {
+      Json j = {{"light", light["index"]},
+                {"map", sh["map"]},
+                {"texel", t["texel"]},
+                {"reference", t["stored"]},
+                {"driver", nullptr}};
+      if (map != nullptr) {
+        const int x = t["image"][0].get<int>();
+        const int y = t["image"][1].get<int>();
+        if (x >= 0 && y >= 0 && x < map->width && y < map->height)
+          j["driver"] = num(map->depth[map->index(x, y)]);
+      }
+      out.push_back(j);
+    }
+  }
+  return out;
 }
 
 std::string pixelStory(const Json& doc) { return story(doc); }

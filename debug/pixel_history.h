@@ -48,6 +48,11 @@ nlohmann::ordered_json backendPixel(const std::string& spec, const Frame& refere
                                     std::size_t i);
 
 // The document told as text, for people.
+// A multi-pass fixture: the texels of the driver's shadow maps (its pass frames) that the
+// reference's final fragment at the pixel looked up (pixelHistory()'s shading.lights[i].
+// shadow), beside the reference's stored depth there: [{light, map, texel, reference,
+// driver}], empty where no lookup was made.
+nlohmann::ordered_json backendShadowTexels(const nlohmann::ordered_json& doc, const Frame& frame);
 std::string pixelStory(const nlohmann::ordered_json& doc);
 
 }  // namespace rc

@@ -31,7 +31,10 @@ TEST(MutationStudy, TheFaultsAndTheirClasses) {
                                                                    {"lod_shift", "shading"},
                                                                    {"lod_weight", "shading"},
                                                                    {"move_line_end", "visibility"},
-                                                                   {"move_point", "visibility"}}));
+                                                                   {"move_point", "visibility"},
+                                                                   {"shadow_shift", "shading"},
+                                                                   {"shadow_compare", "shading"},
+                                                                   {"shadow_bias", "shading"}}));
   EXPECT_EQ(std::string(mutationFault("depth_bias").cls), "depth");
   EXPECT_THROW(mutationFault("shift_x"), InputError);
 }
