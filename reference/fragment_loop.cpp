@@ -203,6 +203,18 @@ inline glm::dvec4 Renderer::fragmentColor(const TriangleContext& t, const glm::d
     if (note && t.shading->shadowed)
       note->normal = std::max(note->normal, shadowReach(t, b, tex, interp, row, dx));
   }
+  // A texture another pass drew: its texels may differ by their own uncertainty, times the
+  // light on the texture (normal_reach, 8-bit units; docs/tolerances.md section 11).
+  if (note && t.texture && !t.texture->uncertainty.empty()) {
+    const bool linear = magFilter(scene_.state) == TextureFilter::Linear ||
+                        minFilter(scene_.state) == MinFilter::Linear;
+    const double reach =
+        texelValueReach(*t.texture, uv, linear ? TextureFilter::Linear : TextureFilter::Nearest,
+                        scene_.state.texture_wrap);
+    const double light =
+        std::max({lit.ambient_diffuse.x, lit.ambient_diffuse.y, lit.ambient_diffuse.z});
+    note->normal = std::max(note->normal, static_cast<float>(reach * std::fabs(light)));
+  }
   if (terms) {
     if constexpr (kShading != Shading::Phong) traceTerms(t, b, *terms);
     terms->texture = tex;

@@ -45,6 +45,43 @@ std::shared_ptr<Texture> targetTexture(const Frame& frame, const std::string& na
   return t;
 }
 
+// How far another implementation's drawing of colour target `frame` may differ at each
+// texel (8-bit units, the largest channel; rows bottom-up): the comparator's allowances
+// there (a unit of rounding, the float32 normal and shading reaches, blends' rounding,
+// the texel choice of a texture it sampled), and where an edge or a depth tie may go the
+// other way, any colour of its 3x3 neighbourhood (another surface, or the clear colour).
+std::vector<float> targetUncertainty(const Frame& frame) {
+  std::vector<float> out(frame.pixelCount(), 0.0f);
+  if (!frame.hasUncertainty()) return out;
+  auto finite = [](float v) { return std::isfinite(v) ? static_cast<double>(v) : 0.0; };
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      const std::size_t i = frame.index(x, y);
+      double u = 1.0 + finite(frame.normal_reach[i]) + kMapBandPx * finite(frame.shade_reach[i]) +
+                 finite(frame.blend_count[i]) + finite(frame.texel_alt[i]);
+      const double allowance = depthFailSteps(DepthFormat::D24) + finite(frame.depth_reach[i]);
+      const bool open = frame.edge_dist[i] <= kMapBandPx ||
+                        finite(frame.depth_gap[i]) <= 2.0 * allowance ||
+                        frame.clear_gap[i] <= allowance;
+      if (open) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx;
+            const int ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= frame.width || ny >= frame.height) continue;
+            const std::size_t j = frame.index(nx, ny);
+            for (int c = 0; c < 4; ++c)
+              u = std::max(u, 1.0 + 255.0 * std::fabs(static_cast<double>(frame.color[j * 4 + c]) -
+                                                      frame.color[i * 4 + c]));
+          }
+        }
+      }
+      out[static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x] = static_cast<float>(u);
+    }
+  }
+  return out;
+}
+
 struct Bound {
   std::map<std::string, std::shared_ptr<const Texture>> textures;
   std::map<std::string, std::shared_ptr<const ShadowMapData>> maps;
@@ -149,7 +186,9 @@ PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options) {
       if (options.uncertainty) shadowMapRange(f, ps.clear_depth, *map);
       bound.maps[name] = std::move(map);
     } else if (target != nullptr) {
-      bound.textures[name] = targetTexture(f, name);
+      auto texture = targetTexture(f, name);
+      if (options.uncertainty) texture->uncertainty = targetUncertainty(f);
+      bound.textures[name] = std::move(texture);
     }
     out.frames.push_back(std::move(f));
   }

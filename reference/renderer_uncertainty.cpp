@@ -234,8 +234,8 @@ float Renderer::shadowReach(const TriangleContext& t, const glm::dvec3& b, const
     const double es = ulp * (m.x + std::fabs(c.s) * m.w) / w;
     const double et = ulp * (m.y + std::fabs(c.t) * m.w) / w;
     const double er = ulp * (m.z + std::fabs(c.r + lookup->bias) * m.w) / w;
-    const ShadowRange range = shadowRange(*lookup, p, (move.x + es) * map.width,
-                                          (move.y + et) * map.height, move.z + er);
+    const ShadowRange range =
+        shadowRange(*lookup, p, (move.x + es) * map.width, (move.y + et) * map.height, move.z + er);
     const double f = shadowFactor(*lookup, p);
     const double spread = std::max(range.hi - f, f - range.lo);
     if (!(spread > 0.0)) continue;

@@ -40,8 +40,8 @@ double compareResult(CompareFunc func, double r, double d) {
 // The results r' OP D' can take for r' in [r_lo, r_hi], D' in [d_lo, d_hi]: the monotone
 // functions take their extremes at the corners; EQUAL and NOTEQUAL go either way wherever
 // the intervals meet.
-void compareRange(CompareFunc func, double r_lo, double r_hi, double d_lo, double d_hi,
-                  double& lo, double& hi) {
+void compareRange(CompareFunc func, double r_lo, double r_hi, double d_lo, double d_hi, double& lo,
+                  double& hi) {
   if (func == CompareFunc::Equal || func == CompareFunc::NotEqual) {
     const bool meet = r_lo <= d_hi && d_lo <= r_hi;
     const bool single = r_lo == r_hi && d_lo == d_hi;

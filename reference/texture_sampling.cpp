@@ -63,6 +63,25 @@ glm::dvec4 texel(const Texture& t, int i, int j) {
 
 }  // namespace
 
+double texelValueReach(const Texture& texture, const glm::dvec2& uv, TextureFilter filter,
+                       TextureWrap wrap) {
+  if (texture.uncertainty.empty()) return 0.0;
+  const bool linear = filter == TextureFilter::Linear;
+  const double fs = std::floor(uv.x * texture.width - (linear ? 0.5 : 0.0));
+  const double ft = std::floor(uv.y * texture.height - (linear ? 0.5 : 0.0));
+  double out = 0.0;
+  for (int dj = -1; dj <= (linear ? 2 : 1); ++dj) {
+    for (int di = -1; di <= (linear ? 2 : 1); ++di) {
+      const int i = wrapIndex(fs + di, texture.width, wrap);
+      const int j = wrapIndex(ft + dj, texture.height, wrap);
+      out =
+          std::max(out, static_cast<double>(
+                            texture.uncertainty[static_cast<std::size_t>(j) * texture.width + i]));
+    }
+  }
+  return out;
+}
+
 glm::dvec4 sampleTexture(const Texture& texture, const glm::dvec2& uv, TextureFilter filter,
                          TextureWrap wrap) {
   const double s = uv.x * texture.width;

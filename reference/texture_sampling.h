@@ -15,6 +15,11 @@
 
 namespace rc::ref {
 
+// The largest Texture::uncertainty of the texels a lookup at uv may read (nearest: the
+// texel and its eight neighbours, which a sample near a boundary may take; linear: the 2x2
+// footprint and the ring around it), 0 for textures without one.
+double texelValueReach(const Texture& texture, const glm::dvec2& uv, TextureFilter filter,
+                       TextureWrap wrap);
 glm::dvec4 sampleTexture(const Texture& texture, const glm::dvec2& uv, TextureFilter filter,
                          TextureWrap wrap);
 
