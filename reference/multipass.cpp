@@ -27,6 +27,31 @@ double depthFailSteps(DepthFormat f) { return f == DepthFormat::D16 ? 2.0 : 16.0
 // snap band of a 4-bit-subpixel rasterizer, sqrt(1/2) / 16 each side, rounded up).
 constexpr double kMapBandPx = 0.1;
 
+float finiteOr0(float v) { return std::isfinite(v) ? v : 0.0f; }
+
+// Steps a fragment of depth gradient `slope` (steps/px) at pixel i of a target the
+// reference drew may be off by in another implementation (the comparator's rule of
+// docs/tolerances.md section 2 with the widest driver's band): the fail threshold, its
+// plane moved by the band, its vertices' float32 reach, another r for its offset's units.
+double depthAllowanceSteps(const Frame& frame, DepthFormat format, std::size_t i, double slope) {
+  double a = depthFailSteps(format);
+  if (!frame.hasUncertainty()) return a;
+  return a + kMapBandPx * slope + finiteOr0(frame.depth_reach[i]) +
+         finiteOr0(frame.offset_steps[i]);
+}
+
+// Whether another implementation may show another surface (or the background) at pixel i
+// of a target the reference drew: an edge within the band, a depth test within twice the
+// tolerances of a tie, a fragment within its tolerance of the clear depth.
+bool coverageOpen(const Frame& frame, DepthFormat format, std::size_t i) {
+  if (!frame.hasUncertainty()) return false;
+  return frame.edge_dist[i] <= kMapBandPx ||
+         frame.depth_gap[i] <=
+             2.0 * depthAllowanceSteps(frame, format, i, finiteOr0(frame.gap_slope[i])) ||
+         frame.clear_gap[i] <=
+             depthAllowanceSteps(frame, format, i, finiteOr0(frame.clear_slope[i]));
+}
+
 // The colour target `frame` (rows top-down) as a texture (rows bottom-up, 8-bit).
 std::shared_ptr<Texture> targetTexture(const Frame& frame, const std::string& name) {
   auto t = std::make_shared<Texture>();
@@ -50,20 +75,16 @@ std::shared_ptr<Texture> targetTexture(const Frame& frame, const std::string& na
 // there (a unit of rounding, the float32 normal and shading reaches, blends' rounding,
 // the texel choice of a texture it sampled), and where an edge or a depth tie may go the
 // other way, any colour of its 3x3 neighbourhood (another surface, or the clear colour).
-std::vector<float> targetUncertainty(const Frame& frame) {
+std::vector<float> targetUncertainty(const Frame& frame, DepthFormat format) {
   std::vector<float> out(frame.pixelCount(), 0.0f);
   if (!frame.hasUncertainty()) return out;
-  auto finite = [](float v) { return std::isfinite(v) ? static_cast<double>(v) : 0.0; };
   for (int y = 0; y < frame.height; ++y) {
     for (int x = 0; x < frame.width; ++x) {
       const std::size_t i = frame.index(x, y);
-      double u = 1.0 + finite(frame.normal_reach[i]) + kMapBandPx * finite(frame.shade_reach[i]) +
-                 finite(frame.blend_count[i]) + finite(frame.texel_alt[i]);
-      const double allowance = depthFailSteps(DepthFormat::D24) + finite(frame.depth_reach[i]);
-      const bool open = frame.edge_dist[i] <= kMapBandPx ||
-                        finite(frame.depth_gap[i]) <= 2.0 * allowance ||
-                        frame.clear_gap[i] <= allowance;
-      if (open) {
+      double u = 1.0 + finiteOr0(frame.normal_reach[i]) +
+                 kMapBandPx * finiteOr0(frame.shade_reach[i]) + finiteOr0(frame.blend_count[i]) +
+                 finiteOr0(frame.texel_alt[i]);
+      if (coverageOpen(frame, format, i) || frame.blend_count[i] > 0.0f) {
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dx = -1; dx <= 1; ++dx) {
             const int nx = x + dx;
@@ -108,15 +129,10 @@ void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map) 
   map.hi.assign(n, 0.0);
   const double step = depthStep(map.format);
   const bool channels = frame.hasUncertainty();
-  // Steps a texel's own surface may be off by: the fail threshold, its plane moved by the
-  // band, its vertices' float32 reach, another r of its polygon offset's units.
+  // Steps a texel's own surface may be off by.
   auto allowance = [&](std::size_t i) {
-    double a = depthFailSteps(map.format);
-    if (!channels) return a;
-    auto finite = [](float v) { return std::isfinite(v) ? static_cast<double>(v) : 0.0; };
-    a += kMapBandPx * finite(frame.depth_slope[i]) + finite(frame.depth_reach[i]) +
-         finite(frame.offset_steps[i]);
-    return a;
+    return depthAllowanceSteps(frame, map.format, i,
+                               channels ? finiteOr0(frame.depth_slope[i]) : 0.0);
   };
   for (int y = 0; y < frame.height; ++y) {
     for (int x = 0; x < frame.width; ++x) {
@@ -129,13 +145,14 @@ void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map) 
       if (channels) {
         // Two fragments within their tolerances of a tie: the other may be stored.
         const double gap = frame.depth_gap[i];
-        if (std::isfinite(gap) && gap <= 2.0 * allowance(i)) {
-          lo = std::min(lo, d - gap * step - a);
-          hi = std::max(hi, d + gap * step + a);
+        const double tie = depthAllowanceSteps(frame, map.format, i, finiteOr0(frame.gap_slope[i]));
+        if (std::isfinite(gap) && gap <= 2.0 * tie) {
+          lo = std::min(lo, d - (gap + tie) * step);
+          hi = std::max(hi, d + (gap + tie) * step);
         }
         // Within the band of an edge another surface (or the clear depth) may cover the
         // texel: those of its neighbours, each carried over one texel along its slope.
-        if (frame.edge_dist[i] <= kMapBandPx || frame.clear_gap[i] <= allowance(i)) {
+        if (coverageOpen(frame, map.format, i)) {
           for (int dy = -1; dy <= 1; ++dy) {
             for (int dx = -1; dx <= 1; ++dx) {
               const int nx = x + dx;
@@ -187,7 +204,7 @@ PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options) {
       bound.maps[name] = std::move(map);
     } else if (target != nullptr) {
       auto texture = targetTexture(f, name);
-      if (options.uncertainty) texture->uncertainty = targetUncertainty(f);
+      if (options.uncertainty) texture->uncertainty = targetUncertainty(f, ps.state.depth_format);
       bound.textures[name] = std::move(texture);
     }
     out.frames.push_back(std::move(f));

@@ -14,8 +14,8 @@
 
 namespace rc::test {
 
-// `count` random fixtures of `seed` under each of the profiles all, textures, blend, soups
-// and lines, images up to max_width x max_height, written to dir/<profile>/ (dir emptied
+// `count` random fixtures of `seed` under each of the profiles all, textures, blend, soups,
+// lines and shadow, images up to max_width x max_height, written to dir/<profile>/ (dir emptied
 // first): their files, sorted, without the generate.json records.
 inline std::vector<std::filesystem::path> writeRandomProfiles(const std::filesystem::path& dir,
                                                               std::uint64_t seed, int count,
@@ -26,7 +26,7 @@ inline std::vector<std::filesystem::path> writeRandomProfiles(const std::filesys
   std::vector<fs::path> files;
   for (const RandomProfile profile :
        {RandomProfile::All, RandomProfile::Textures, RandomProfile::Blend, RandomProfile::Soups,
-        RandomProfile::Lines}) {
+        RandomProfile::Lines, RandomProfile::Shadow}) {
     RandomSceneOptions o;
     o.seed = seed;
     o.count = static_cast<std::uint64_t>(count);
