@@ -74,8 +74,11 @@ std::shared_ptr<Texture> targetTexture(const Frame& frame, const std::string& na
 // texel (8-bit units, the largest channel; rows bottom-up): the comparator's allowances
 // there (a unit of rounding, the float32 normal and shading reaches, blends' rounding,
 // the texel choice of a texture it sampled), and where an edge or a depth tie may go the
-// other way, any colour of its 3x3 neighbourhood (another surface, or the clear colour).
-std::vector<float> targetUncertainty(const Frame& frame, DepthFormat format) {
+// other way, any colour of its 3x3 neighbourhood or the clear colour (another surface, or
+// none); where a depth test is within twice its tolerances of a tie, or a blend may go
+// either way, any colour (the other fragment shows nowhere in the target).
+std::vector<float> targetUncertainty(const Frame& frame, DepthFormat format,
+                                     const glm::dvec4& clear) {
   std::vector<float> out(frame.pixelCount(), 0.0f);
   if (!frame.hasUncertainty()) return out;
   for (int y = 0; y < frame.height; ++y) {
@@ -84,7 +87,19 @@ std::vector<float> targetUncertainty(const Frame& frame, DepthFormat format) {
       double u = 1.0 + finiteOr0(frame.normal_reach[i]) +
                  kMapBandPx * finiteOr0(frame.shade_reach[i]) + finiteOr0(frame.blend_count[i]) +
                  finiteOr0(frame.texel_alt[i]);
-      if (coverageOpen(frame, format, i) || frame.blend_count[i] > 0.0f) {
+      // A depth tie (or a blend whose order or coverage is open) may show a fragment whose
+      // colour no pixel of the target shows: anything.
+      const bool tie =
+          frame.depth_gap[i] <=
+              2.0 * depthAllowanceSteps(frame, format, i, finiteOr0(frame.gap_slope[i])) ||
+          (frame.blend_count[i] > 0.0f &&
+           (frame.edge_dist[i] <= kMapBandPx ||
+            frame.blend_gap[i] <=
+                2.0 * depthAllowanceSteps(frame, format, i, finiteOr0(frame.blend_slope[i]))));
+      if (tie) u = 255.0;
+      if (!tie && coverageOpen(frame, format, i)) {
+        for (int c = 0; c < 4; ++c)  // the background
+          u = std::max(u, 1.0 + 255.0 * std::fabs(clear[c] - frame.color[i * 4 + c]));
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dx = -1; dx <= 1; ++dx) {
             const int nx = x + dx;
@@ -204,7 +219,8 @@ PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options) {
       bound.maps[name] = std::move(map);
     } else if (target != nullptr) {
       auto texture = targetTexture(f, name);
-      if (options.uncertainty) texture->uncertainty = targetUncertainty(f, ps.state.depth_format);
+      if (options.uncertainty)
+        texture->uncertainty = targetUncertainty(f, ps.state.depth_format, ps.clear_color);
       bound.textures[name] = std::move(texture);
     }
     out.frames.push_back(std::move(f));

@@ -79,6 +79,27 @@ TEST(Cli, RenderReferenceWritesTheFrameDirectory) {
   EXPECT_TRUE(fs::exists(out / "color.png"));
 }
 
+// A multi-pass fixture with --all-passes: each pass before the frame pass as a frame folder
+// of its own, OUT/passes/K-TARGET, at the target's size (the map a depth frame).
+TEST(Cli, RenderAllPassesWritesEveryTarget) {
+  const fs::path out = scratch("passes") / "frame";
+  Result r = run("render " + catalog("multipass/mirror_quad.json") + " --all-passes --out " +
+                 out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("pass 0 (mirror 128x128)"), std::string::npos) << r.out;
+  const rc::Frame f = rc::readFrameDir(out);
+  EXPECT_EQ(f.width, 200);
+  const rc::Frame mirror = rc::readFrameDir(out / "passes" / "0-mirror");
+  EXPECT_EQ(mirror.width, 128);
+  EXPECT_EQ(mirror.height, 128);
+  EXPECT_EQ(mirror.meta["pass"]["target"], "mirror");
+  // Without the flag only the frame is written.
+  const fs::path plain = scratch("passes_plain") / "frame";
+  ASSERT_EQ(
+      run("render " + catalog("multipass/mirror_quad.json") + " --out " + plain.string()).code, 0);
+  EXPECT_FALSE(fs::exists(plain / "passes"));
+}
+
 TEST(Cli, UnknownBackendExitsTwoBeforeWriting) {
   const fs::path out = scratch("badspec") / "frame";
   Result r = run("render " + catalog("coverage/triangle_fan.json") + " --backend vulkan --out " +

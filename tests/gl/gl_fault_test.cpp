@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -12,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "fixtures/loader.h"
 #include "gl_backend/gl_testing.h"
 #include "tests/gl/gl_test_util.h"
 #include "tests/support/printers.h"
@@ -423,6 +425,40 @@ TEST_F(GlFault, LodWeightInvertsTheBlendBetweenLevelsOnly) {
   EXPECT_EQ(render(one_level).color, renderFaulted(one_level, f).color);
 }
 
+// The shadow faults act on the frame pass's lookups only: ids, depth and the shadow map
+// itself stay the same bits; colours change, and only where light 0 reaches (the ambient
+// term is never shadowed), never below the ambient-only colour of the lit surfaces.
+TEST_F(GlFault, ShadowFaultsChangeOnlyTheLookups) {
+  const Scene s = loadScene(std::filesystem::path(RC_SOURCE_DIR) /
+                            "fixtures/scenes/shadow/teapot_on_plane.json");
+  const Frame clean = render(s);
+  ASSERT_EQ(clean.passes.size(), 1u);
+  EXPECT_EQ(clean.passes[0].meta.at("pass").at("target"), "sun");
+  Faults shift;
+  shift.shadow_shift = 1.0;
+  Faults inverted;
+  inverted.shadow_compare_inverted = true;
+  Faults dropped;
+  dropped.shadow_bias_dropped = true;
+  for (const Faults& f : {shift, inverted, dropped}) {
+    const Frame faulted = renderFaulted(s, f);
+    EXPECT_EQ(faulted.meta.at("fault_injected"), f.describe());
+    EXPECT_EQ(faulted.id, clean.id) << f.describe();
+    EXPECT_EQ(faulted.depth, clean.depth) << f.describe();
+    ASSERT_EQ(faulted.passes.size(), 1u);
+    EXPECT_EQ(faulted.passes[0].depth, clean.passes[0].depth) << f.describe();
+    std::size_t changed = 0;
+    for (std::size_t i = 0; i < clean.pixelCount(); ++i) {
+      if (sameColor(faulted, clean, i, 1e-6)) continue;
+      ++changed;
+      EXPECT_NE(clean.id[i], 0u) << f.describe() << ": background changed at " << i;
+    }
+    // The map moved by a texel, the comparison turned round, acne without the bias: each
+    // changes hundreds of pixels of this scene.
+    EXPECT_GT(changed, 100u) << f.describe();
+  }
+}
+
 class GlFaultBlend : public GlFault, public ::testing::WithParamInterface<Faults::Blend> {};
 
 TEST_P(GlFaultBlend, WrongBlendFactorChangesOnlyBlendedPixels) {
@@ -510,6 +546,14 @@ TEST(GlFaultParse, CanonicalFormRoundTrips) {
   EXPECT_TRUE(lod.lod_weight_inverted);
   EXPECT_EQ(lod.describe(), "lod_shift=1,lod_weight=inverted");
   EXPECT_THROW(gl::testing::parseFaults("lod_weight=swapped"), InputError);
+  const Faults shadow =
+      gl::testing::parseFaults("shadow_bias=dropped,shadow_compare=inverted,shadow_shift=2");
+  EXPECT_EQ(shadow.shadow_shift, 2.0);
+  EXPECT_TRUE(shadow.shadow_compare_inverted);
+  EXPECT_TRUE(shadow.shadow_bias_dropped);
+  EXPECT_EQ(shadow.describe(), "shadow_shift=2,shadow_compare=inverted,shadow_bias=dropped");
+  EXPECT_THROW(gl::testing::parseFaults("shadow_bias=kept"), InputError);
+  EXPECT_THROW(gl::testing::parseFaults("shadow_compare=swapped"), InputError);
   const Faults again = gl::testing::parseFaults(text);
   EXPECT_EQ(again.describe(), text);
   EXPECT_FALSE(gl::testing::parseFaults("").any());
