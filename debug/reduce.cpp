@@ -130,6 +130,19 @@ Scene subsetScene(const Scene& base, const std::vector<PrimitiveRef>& primitives
     if (n == 2) dst.mesh.lines.push_back({kept[0], kept[1]});
     // A point is its position: one was appended above (each point its own vertex).
   }
+  // Multi-pass: the same targets and passes, each pass drawing what is left of its
+  // objects (a pass whose objects are all gone draws nothing).
+  s.targets = base.targets;
+  s.passes = base.passes;
+  for (ScenePass& pass : s.passes) {
+    if (!pass.objects) continue;
+    std::vector<std::size_t> kept;
+    for (std::size_t o : *pass.objects)
+      if (auto it = object_of.find(static_cast<std::uint32_t>(o)); it != object_of.end())
+        kept.push_back(it->second);
+    std::sort(kept.begin(), kept.end());
+    pass.objects = std::move(kept);
+  }
   return s;
 }
 

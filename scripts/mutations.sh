@@ -2,7 +2,7 @@
 # The long mutation study of docs/campaigns.md: `rastercheck campaign --mutations` injects
 # each test-only GL fault (move_vertex, move_line_end, move_point, depth_bias, light_scale, texel_offset,
 # drop_primitive, blend_factor, depth_func, stencil_op, blend_function, scissor_shift,
-# lod_shift, lod_weight) into
+# lod_shift, lod_weight, shadow_shift, shadow_compare, shadow_bias) into
 # every random scene and reports, per fault, the
 # fraction caught in its class among the scenes where it changes a pixel beyond its
 # allowance. The report is copied, with the command and the date, to
