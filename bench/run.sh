@@ -90,11 +90,12 @@ for d, _, _ in gls:
 print("| " + " | ".join(head) + " |")
 print("|" + "---|" * len(head))
 scenes = ["BM_SmallTriangles", "BM_SmallTriangleMesh", "BM_Layers/shading:0", "BM_Layers/shading:1",
-          "BM_Layers/shading:2", "BM_Lines"]
+          "BM_Layers/shading:2", "BM_Lines", "BM_ShadowMap"]
 labels = {"BM_SmallTriangles": "100k 2-px triangles, flat", "BM_SmallTriangleMesh": "the same as one mesh",
           "BM_Layers/shading:0": "8 layers, flat",
           "BM_Layers/shading:1": "8 layers, gouraud", "BM_Layers/shading:2": "8 layers, phong",
-          "BM_Lines": "20k segments and 20k points, gouraud"}
+          "BM_Lines": "20k segments and 20k points, gouraud",
+          "BM_ShadowMap": "teapot on a floor through a 1024^2 shadow map (2 passes), phong"}
 for scene in scenes:
     r0 = ref.get(scene + "/uncertainty:0")
     r1 = ref.get(scene + "/uncertainty:1")

@@ -192,6 +192,11 @@ void BM_Lines(benchmark::State& state) {
   renderScene(state, scene);
 }
 
+void BM_ShadowMap(benchmark::State& state) {
+  static const rc::Scene scene = rc::bench::shadowMap();
+  renderScene(state, scene);
+}
+
 void BM_Layers(benchmark::State& state) {
   static const rc::Scene scenes[3] = {rc::bench::layers(rc::Shading::Flat),
                                       rc::bench::layers(rc::Shading::Gouraud),
@@ -217,6 +222,7 @@ BENCHMARK(BM_HarnessOverhead1080p)->Unit(benchmark::kMillisecond)->UseRealTime()
 BENCHMARK(BM_SmallTriangles)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SmallTriangleMesh)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Lines)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ShadowMap)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Layers)
     ->ArgName("shading")
     ->DenseRange(0, 2)

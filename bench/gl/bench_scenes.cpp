@@ -58,4 +58,6 @@ Scene layers(Shading shading) { return test::layersScene(shading, kRefSize, 8); 
 
 Scene linesAndPoints() { return test::linesScene(kRefSize, 20000); }
 
+Scene shadowMap() { return test::shadowScene(kRefSize); }
+
 }  // namespace rc::bench

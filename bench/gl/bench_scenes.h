@@ -23,5 +23,7 @@ Scene layers(Shading shading);
 // 20k segments (random ends, 2 to 60 px long, every third 3 px wide) and 20k points of size
 // 3, Gouraud with one point light, depth tested: lines and points at scale.
 Scene linesAndPoints();
+// A teapot on a floor through a shadow map (test::shadowScene at the reference's size).
+Scene shadowMap();
 
 }  // namespace rc::bench

@@ -83,6 +83,14 @@ void BM_Lines(benchmark::State& state) {
 }
 BENCHMARK(BM_Lines)->ArgName("uncertainty")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
+// A teapot on a floor through a 1024 x 1024 shadow map: two passes (the map, then the frame
+// at 1024 x 768 with its lookups, the floor's percentage-closer filtered).
+void BM_ShadowMap(benchmark::State& state) {
+  static const Scene scene = test::shadowScene(kSize);
+  run(state, scene, state.range(0) != 0);
+}
+BENCHMARK(BM_ShadowMap)->ArgName("uncertainty")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 // The fixed cost of a 1024 x 1024 frame with nothing in it (allocation, clear, output).
 void BM_EmptyFrame(benchmark::State& state) {
   static const Scene scene = test::windowScene(kSize, kSize);

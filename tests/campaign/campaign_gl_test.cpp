@@ -369,7 +369,9 @@ TEST(CampaignGl, ShortMutationStudyCatchesEveryFaultInItsClass) {
       {"depth_func", "visibility"},     {"stencil_op", "depth"},
       {"blend_function", "shading"},    {"scissor_shift", "visibility"},
       {"lod_shift", "shading"},         {"lod_weight", "shading"},
-      {"move_line_end", "visibility"},  {"move_point", "visibility"}};
+      {"move_line_end", "visibility"},  {"move_point", "visibility"},
+      {"shadow_shift", "shading"},      {"shadow_compare", "shading"},
+      {"shadow_bias", "shading"}};
   for (const json& result : study["results"]) {
     const std::string c = cls.at(result["fault"]);
     const auto has = [&](const char* key) {

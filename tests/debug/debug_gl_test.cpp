@@ -86,6 +86,14 @@ TEST(DebugGl, ExplainJsonKeysBothWaysIncludingABackendThatCannotRun) {
                           " --pixel 95,52 --json --backends " + kLlvmpipe);
   ASSERT_EQ(line.code, 0) << line.err;
   collectKeys(json::parse(line.out), "", seen);
+  // A shadow lookup, PCF (documented keys fragments[].shading.lights[].shadow.* and
+  // backends.SPEC.shadow_texels[].*), against llvmpipe.
+  const Result shadow = run("explain " + catalog("shadow/spot_perspective_pcf.json") +
+                            " --pixel 80,110 --json --backends " + kLlvmpipe);
+  ASSERT_EQ(shadow.code, 0) << shadow.err;
+  const json shadow_doc = json::parse(shadow.out);
+  EXPECT_FALSE(shadow_doc["backends"][kLlvmpipe]["shadow_texels"].empty()) << shadow.out;
+  collectKeys(shadow_doc, "", seen);
   for (const std::string& k : seen) EXPECT_TRUE(documented.count(k)) << "undocumented key " << k;
   for (const std::string& k : documented) EXPECT_TRUE(seen.count(k)) << "never seen " << k;
 }

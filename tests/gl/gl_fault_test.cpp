@@ -453,9 +453,10 @@ TEST_F(GlFault, ShadowFaultsChangeOnlyTheLookups) {
       ++changed;
       EXPECT_NE(clean.id[i], 0u) << f.describe() << ": background changed at " << i;
     }
-    // The map moved by a texel, the comparison turned round, acne without the bias: each
-    // changes hundreds of pixels of this scene.
-    EXPECT_GT(changed, 100u) << f.describe();
+    // The map moved by a texel and the comparison turned round change hundreds of pixels
+    // of this scene; without its bias, acne appears where the floor faces the light most
+    // obliquely (a dozen pixels or more).
+    EXPECT_GT(changed, f.shadow_bias_dropped ? 10u : 100u) << f.describe();
   }
 }
 

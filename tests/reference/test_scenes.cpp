@@ -6,6 +6,10 @@
 #include <cstdint>
 #include <memory>
 
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "fixtures/generators.h"
+
 namespace rc::test {
 
 Scene windowScene(int width, int height) {
@@ -353,6 +357,67 @@ Scene linesScene(int size, int count) {
     o->mesh.normals.assign(o->mesh.positions.size(), {0.0f, 0.0f, 1.0f});
     s.objects.push_back(std::move(*o));
   }
+  return s;
+}
+
+Scene shadowScene(int size) {
+  Scene s;
+  s.name = "bench/shadow";
+  s.width = size;
+  s.height = size * 3 / 4;
+  s.camera.eye = {0.0, 2.0, 3.6};
+  s.camera.target = {0.0, 0.3, 0.0};
+  s.camera.fovy_deg = 40.0;
+  s.camera.near = 1.0;
+  s.camera.far = 12.0;
+  s.clear_color = {0.05, 0.05, 0.08, 1.0};
+  s.ambient_light = glm::dvec3(0.15);
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = {-0.4, -1.0, -0.3};
+  sun.shadow_map = "sun";
+  s.lights.push_back(sun);
+  s.targets.push_back(RenderTarget{"sun", size, size, TargetFormat::D24});
+  Material pot;
+  pot.name = "pot";
+  pot.diffuse = {0.8, 0.5, 0.3};
+  pot.specular = glm::dvec3(0.4);
+  pot.shininess = 24.0;
+  pot.shadow = ShadowLookup{"sun", TextureFilter::Nearest, CompareFunc::LEqual, 0.002, nullptr};
+  Material floor;
+  floor.name = "floor";
+  floor.diffuse = glm::dvec3(0.7);
+  floor.shadow = ShadowLookup{"sun", TextureFilter::Linear, CompareFunc::LEqual, 0.002, nullptr};
+  s.materials = {pot, floor};
+  const glm::dmat4 upright =
+      glm::rotate(glm::dmat4(1.0), glm::radians(-90.0), glm::dvec3(1.0, 0.0, 0.0));
+  Object teapot;
+  teapot.name = "teapot";
+  teapot.mesh = makeTeapot();
+  teapot.model = upright * glm::scale(glm::dmat4(1.0), glm::dvec3(0.4));
+  Object ground;
+  ground.name = "floor";
+  ground.material = 1;
+  ground.mesh = makePlane();
+  ground.model = upright * glm::scale(glm::dmat4(1.0), glm::dvec3(2.5, 2.5, 1.0));
+  s.objects = {teapot, ground};
+  s.state.shading = Shading::Phong;
+  ScenePass map;
+  map.target = "sun";
+  Camera light;
+  light.projection = Projection::Orthographic;
+  light.eye = {1.6, 4.0, 1.2};
+  light.bounds = {-2.2, 2.2, -2.2, 2.2};
+  light.near = 0.5;
+  light.far = 10.0;
+  map.camera = light;
+  map.state = s.state;
+  map.state.cull = Cull::Front;
+  ScenePass frame;
+  frame.target = kFrameTarget;
+  frame.clear_color = s.clear_color;
+  frame.state = s.state;
+  s.passes = {map, frame};
   return s;
 }
 

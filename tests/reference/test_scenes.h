@@ -78,5 +78,9 @@ Scene layersScene(Shading shading, int size = 1024, int layers = 8);
 // the rest one pixel) and `count` points of size 3, in a size x size window scene, Gouraud
 // with one point light, depths in [0.25, 0.75): lines and points at scale.
 Scene linesScene(int size = 1024, int count = 20000);
+// A teapot on a floor lit by a directional light through a size x size d24 shadow map
+// (front faces culled in the map pass), nearest lookups on the teapot and PCF on the floor:
+// the multi-pass path, size x 3/4 size, Phong.
+Scene shadowScene(int size = 1024);
 
 }  // namespace rc::test
