@@ -283,7 +283,8 @@ TEST(Explain, JsonKeysAreTheDocumentedOnes) {
       catalog("fragment-ops/decal_offset.json") + " --pixel 90,70 --backends ref",
       catalog("mipmap/level_colours.json") + " --pixel 80,60 --backends ref",
       catalog("lines/star_octants.json") + " --pixel 95,52 --backends ref",
-      catalog("lines/point_sizes.json") + " --pixel 38,101 --backends ref"};
+      catalog("lines/point_sizes.json") + " --pixel 38,101 --backends ref",
+      catalog("shadow/spot_perspective_pcf.json") + " --pixel 80,110 --backends ref"};
   for (const std::string& call : calls) {
     const Result r = run("explain " + call + " --json");
     ASSERT_EQ(r.code, 0) << call << ": " << r.err;
