@@ -77,7 +77,13 @@ void Renderer::setUpFanChannels(TriangleContext& t, const FragmentInterpolator& 
   // Not for the pieces of a clipped triangle: their clip vertices can lie 10^5 px away
   // (a near-plane cut), where the first-order bound grows to a tenth of the depth range
   // (docs/tolerances.md "Plane set-up": what is left uncovered there).
-  if (!clipped) t.depth_reach.widen(planeSetupError(wv[0], wv[i], wv[i + 1]) * depth_steps_);
+  if (!clipped) {
+    // Its own set-up, or that of a piece a side clip leaves (an implementation's choice).
+    const double setup =
+        std::max(planeSetupError(wv[0], wv[i], wv[i + 1]),
+                 sideClipSetupError(wv[0], wv[i], wv[i + 1], scene_.width, scene_.height));
+    t.depth_reach.widen(setup * depth_steps_);
+  }
   t.texel_choice = t.texture != nullptr;
   t.thin = scene_.state.shading != Shading::Flat &&
            !(minAltitudePx(wv[0], wv[i], wv[i + 1]) >= kThinAltitudePx);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "reference/fragment_ops.h"
 #include "reference/lanes.h"
@@ -656,6 +657,95 @@ double planeSetupError(const WindowVertex& v0, const WindowVertex& v1, const Win
   }
   const double e = worst + slack;
   return std::isfinite(e) ? e : std::numeric_limits<double>::infinity();
+}
+
+namespace {
+
+// Whether triangle (a, b, c) covers a pixel centre, its edges moved out by `margin` px: row by
+// row, the centres between the triangle's crossings of the row's centre line.
+bool coversPixelCentre(const WindowVertex& a, const WindowVertex& b, const WindowVertex& c,
+                       double margin) {
+  const WindowVertex* v[3] = {&a, &b, &c};
+  const double y_lo = std::min({a.y, b.y, c.y}) - margin;
+  const double y_hi = std::max({a.y, b.y, c.y}) + margin;
+  for (double row = std::ceil(y_lo - 0.5); row + 0.5 <= y_hi; row += 1.0) {
+    const double yc = row + 0.5;
+    double x_lo = std::numeric_limits<double>::infinity();
+    double x_hi = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      const WindowVertex& p = *v[k];
+      const WindowVertex& q = *v[(k + 1) % 3];
+      const double lo = std::min(p.y, q.y) - margin;
+      const double hi = std::max(p.y, q.y) + margin;
+      if (yc < lo || yc > hi) continue;
+      const double x = p.y == q.y
+                           ? p.x
+                           : p.x + (std::clamp(yc, std::min(p.y, q.y), std::max(p.y, q.y)) - p.y) *
+                                       (q.x - p.x) / (q.y - p.y);
+      const double other = p.y == q.y ? q.x : x;
+      x_lo = std::min({x_lo, x, other});
+      x_hi = std::max({x_hi, x, other});
+    }
+    if (x_lo > x_hi) continue;
+    if (std::ceil(x_lo - margin - 0.5) <= std::floor(x_hi + margin - 0.5)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+double sideClipSetupError(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                          double width, double height) {
+  auto inside = [&](const WindowVertex& v) {
+    return v.x >= 0.0 && v.x <= width && v.y >= 0.0 && v.y <= height;
+  };
+  if (inside(v0) && inside(v1) && inside(v2)) return 0.0;
+  // Sutherland-Hodgman against the four sides; window z is affine on the screen, so a new
+  // vertex's depth is the edge's, interpolated in window space.
+  std::vector<WindowVertex> poly = {v0, v1, v2};
+  const struct {
+    bool x;
+    double bound;
+    bool keep_above;
+  } sides[4] = {
+      {true, 0.0, true}, {true, width, false}, {false, 0.0, true}, {false, height, false}};
+  for (const auto& side : sides) {
+    std::vector<WindowVertex> out;
+    const std::size_t n = poly.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const WindowVertex& p = poly[k];
+      const WindowVertex& q = poly[(k + 1) % n];
+      const double dp = (side.x ? p.x : p.y) - side.bound;
+      const double dq = (side.x ? q.x : q.y) - side.bound;
+      const bool p_in = side.keep_above ? dp >= 0.0 : dp <= 0.0;
+      const bool q_in = side.keep_above ? dq >= 0.0 : dq <= 0.0;
+      if (p_in) out.push_back(p);
+      if (p_in != q_in) {
+        const double t = dp / (dp - dq);
+        WindowVertex m = p;
+        m.x = p.x + t * (q.x - p.x);
+        m.y = p.y + t * (q.y - p.y);
+        m.z = p.z + t * (q.z - p.z);
+        out.push_back(m);
+      }
+    }
+    poly = std::move(out);
+    if (poly.size() < 3) return 0.0;
+  }
+  const std::size_t n = poly.size();
+  double worst = 0.0;
+  for (std::size_t s = 0; s < n; ++s) {
+    for (std::size_t j = 1; j + 1 < n; ++j) {
+      const WindowVertex& a = poly[s];
+      const WindowVertex& b = poly[(s + j) % n];
+      const WindowVertex& c = poly[(s + j + 1) % n];
+      const double area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+      if (!(std::fabs(area) > 0.0) || !coversPixelCentre(a, b, c, 0.01)) continue;
+      const double e = planeSetupError(a, b, c);
+      if (std::isfinite(e)) worst = std::max(worst, e);
+    }
+  }
+  return worst;
 }
 
 }  // namespace rc::ref

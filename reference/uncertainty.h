@@ -418,6 +418,14 @@ bool cullCouldFlip(const WindowVertex* polygon, int count, double extra_px = 0.0
 // wide seen edge-on put llvmpipe's depth 144 d24 steps from the plane (campaign s20261226).
 // +inf when the unsnapped area is zero or anything is not finite.
 double planeSetupError(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2);
+// The same for the pieces an implementation that clips to the viewport's sides (GL's clip
+// volume; a guard band is its option) may draw instead of the triangle: the triangle clipped
+// to [0, width] x [0, height] in window space, fanned from each of its vertices in turn, the
+// largest planeSetupError() of a piece that covers a pixel centre (within 0.01 px). 0 for a
+// triangle inside the viewport. A side clip can leave a sliver piece along an edge whose set-up
+// is far worse conditioned than the triangle's (docs/tolerances.md section 2, "Side clips").
+double sideClipSetupError(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                          double width, double height);
 
 // Lowers edge_dist (image order, top row first, width * height floats initialised to 1)
 // to the distance from each pixel centre in `clip` to the polygon's boundary segments,

@@ -774,3 +774,45 @@ TEST(DepthReach, PlaneSetUpBoundsAFloat32SetUpFromAnyVertex) {
 
 }  // namespace
 }  // namespace rc
+
+namespace rc {
+namespace {
+
+// sideClipSetupError(): nothing for a triangle inside the viewport; for the triangle of
+// campaign s20261324 scene 00526 (113 px long, its apex 0.455 px below the viewport where it
+// is 0.02 px wide), whose side-clipped piece along the long edge put llvmpipe's depth 329 d24
+// steps from the plane, a bound above that; for a large, well-shaped triangle crossing a side,
+// pieces about as well conditioned as the triangle (a few d24 steps).
+TEST(DepthReach, SideClippedPiecesBoundTheSliverAClipLeaves) {
+  auto wv = [](double x, double y, double z) {
+    ref::WindowVertex v{};
+    v.x = x;
+    v.y = y;
+    v.z = z;
+    v.inv_w = 1.0;
+    return v;
+  };
+  constexpr double kD24 = 16777215.0;
+  const ref::WindowVertex a = wv(29.225206996492517, -0.4549373766449816, 0.7874220122120903);
+  const ref::WindowVertex b = wv(84.71212565114877, 97.57807406802384, 0.8506422508377185);
+  const ref::WindowVertex c = wv(87.6196278832844, 94.33251561948947, 0.8609734928998194);
+  const double own = ref::planeSetupError(a, b, c) * kD24;
+  const double side = ref::sideClipSetupError(a, b, c, 149.0, 100.0) * kD24;
+  EXPECT_LT(own, 60.0);
+  EXPECT_GT(side, 329.0) << "the piece llvmpipe drew";
+  // Moved up by a pixel, the apex is inside: no side clip.
+  auto up = [](ref::WindowVertex v) {
+    v.y += 1.0;
+    return v;
+  };
+  EXPECT_EQ(ref::sideClipSetupError(up(a), up(b), up(c), 149.0, 100.0), 0.0);
+  // A floor-like triangle far larger than the image, cut on all sides.
+  const ref::WindowVertex p = wv(-300.0, -200.0, 0.2);
+  const ref::WindowVertex q = wv(500.0, -150.0, 0.4);
+  const ref::WindowVertex r = wv(60.0, 400.0, 0.9);
+  EXPECT_LT(ref::sideClipSetupError(p, q, r, 149.0, 100.0) * kD24, 5.0);
+  EXPECT_GT(ref::sideClipSetupError(p, q, r, 149.0, 100.0), 0.0);
+}
+
+}  // namespace
+}  // namespace rc
