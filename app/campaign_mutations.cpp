@@ -52,7 +52,8 @@ std::set<std::string> failingClasses(const PairResult& r) {
 // visible primitives).
 MutationScene sceneFacts(const Scene& multi) {
   // A multi-pass scene's frame pass: what the compared frame draws, with its ids.
-  const Scene frame_pass = multi.passes.empty() ? Scene{} : passScene(multi, multi.passes.size() - 1);
+  const Scene frame_pass =
+      multi.passes.empty() ? Scene{} : passScene(multi, multi.passes.size() - 1);
   const Scene& scene = multi.passes.empty() ? multi : frame_pass;
   MutationScene m;
   m.depth_format = toString(scene.state.depth_format);
@@ -67,9 +68,8 @@ MutationScene sceneFacts(const Scene& multi) {
                   (mat.texture != nullptr &&
                    (min == MinFilter::NearestMipmapLinear || min == MinFilter::LinearMipmapLinear));
     if (mat.shadow) {
-      const bool lit = std::any_of(scene.lights.begin(), scene.lights.end(), [&](const Light& l) {
-        return l.shadow_map == mat.shadow->map;
-      });
+      const bool lit = std::any_of(scene.lights.begin(), scene.lights.end(),
+                                   [&](const Light& l) { return l.shadow_map == mat.shadow->map; });
       m.shadowed = m.shadowed || lit;
       m.shadow_bias = m.shadow_bias || (lit && mat.shadow->bias != 0.0);
     }

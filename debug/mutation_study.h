@@ -62,7 +62,7 @@ struct MutationScene {
   bool blend_function = false;             // some pass blends with the object form of blend
   bool scissor = false;                    // some pass has a scissor box
   bool lod = false;  // textured, sampled with a level of detail (fixtures/scene.h lodSampling())
-  bool lod_blend = false;  // textured with a *_mipmap_linear min filter (two levels blended)
+  bool lod_blend = false;    // textured with a *_mipmap_linear min filter (two levels blended)
   bool shadowed = false;     // a drawn material's shadow lookup darkens some light
   bool shadow_bias = false;  // and one of those lookups has a bias
   // Primitive ids of line segments and of points (line and point primitives; triangles in

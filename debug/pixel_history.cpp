@@ -60,12 +60,10 @@ Json shadowJson(const Material& material, const Light& light, const ShadingTerms
             {"result", num(ref::shadowFactor(lookup, p))}};
   if (!c.in_front) return j;
   const bool linear = lookup.filter == TextureFilter::Linear;
-  const double shift = linear ? 0.5 : 0.0;
-  auto index = [](double v, int size) {
-    return std::clamp(static_cast<int>(std::floor(v)), 0, size - 1);
-  };
-  const int i = index(c.s * map.width - shift, map.width);
-  const int t = index(c.t * map.height - shift, map.height);
+  // The texel the lookup reads (linear: its footprint's lower-left), as shadowRange() finds it.
+  const ref::ShadowRange read = ref::shadowRange(lookup, p, 0.0, 0.0, 0.0);
+  const int i = read.i;
+  const int t = read.j;
   j["coord"] = {num(c.s), num(c.t), num(c.r)};
   Json texels = Json::array();
   for (int dt = 0; dt <= (linear ? 1 : 0); ++dt) {
@@ -172,6 +170,23 @@ std::string fmtVec(const Json& v) {
   std::string out = "(";
   for (std::size_t k = 0; k < v.size(); ++k) out += (k ? ", " : "") + fmtNum(v[k]);
   return out + ")";
+}
+
+// A shadowed light's lookup (shading.lights[].shadow), its texels one line each.
+std::string shadowStory(const Json& lookup) {
+  if (!lookup["in_front"].get<bool>())
+    return fmt::format("      shadow map {}: behind its camera, not shadowed\n",
+                       lookup["map"].get<std::string>());
+  std::string s = fmt::format("      shadow map {} ({} {}, bias {}) at (s, t, r) {}: result {}\n",
+                              lookup["map"].get<std::string>(), lookup["filter"].get<std::string>(),
+                              lookup["compare"].get<std::string>(), fmtNum(lookup["bias"]),
+                              fmtVec(lookup["coord"]), fmtNum(lookup["result"]));
+  for (const Json& texel : lookup["texels"])
+    s +=
+        fmt::format("        texel {} (map pixel {}): stored {}, another driver's in {}\n",
+                    fmtVec(texel["texel"]), fmtVec(texel["image"]), fmtNum(texel["stored"]),
+                    texel["allowed"].is_null() ? std::string("(exact)") : fmtVec(texel["allowed"]));
+  return s;
 }
 
 // "triangle", "segment" or "point", by what the fragment's primitive is.
@@ -311,23 +326,7 @@ std::string story(const Json& doc) {
       s += fmt::format("    light {} ({}): {} -> diffuse {}, specular {}\n", l["index"].get<int>(),
                        l["type"].get<std::string>(), factors, fmtVec(l["diffuse"]),
                        fmtVec(l["specular"]));
-      if (l.contains("shadow") && !l["shadow"].is_null()) {
-        const Json& sh = l["shadow"];
-        if (!sh["in_front"].get<bool>()) {
-          s += fmt::format("      shadow map {}: behind its camera, not shadowed\n",
-                           sh["map"].get<std::string>());
-        } else {
-          s += fmt::format("      shadow map {} ({} {}, bias {}) at (s, t, r) {}: result {}\n",
-                           sh["map"].get<std::string>(), sh["filter"].get<std::string>(),
-                           sh["compare"].get<std::string>(), fmtNum(sh["bias"]),
-                           fmtVec(sh["coord"]), fmtNum(sh["result"]));
-          for (const Json& t : sh["texels"])
-            s +=
-                fmt::format("        texel {} (map pixel {}): stored {}, another driver's in {}\n",
-                            fmtVec(t["texel"]), fmtVec(t["image"]), fmtNum(t["stored"]),
-                            t["allowed"].is_null() ? std::string("(exact)") : fmtVec(t["allowed"]));
-        }
-      }
+      if (l.contains("shadow") && !l["shadow"].is_null()) s += shadowStory(l["shadow"]);
     }
     if (!sh["texture"].is_null())
       s += fmt::format("    texture {} at uv {} multiplies ambient and diffuse\n",
@@ -459,7 +458,8 @@ Json pixelHistory(const Scene& multi, const PixelQuery& query, const Frame& fram
     throw InputError(fmt::format("{}: pixel {},{} is outside the {}x{} image", query.fixture_file,
                                  pixel.x, pixel.y, scene.width, scene.height));
   const ReferenceOptions& options = query.options;
-  const std::vector<FragmentTrace> trace = tracePixel(multi, options, pixel.x, pixel.y);
+  // The frame pass with its targets bound above: its passes are not drawn again.
+  const std::vector<FragmentTrace> trace = tracePixel(scene, options, pixel.x, pixel.y);
   const std::size_t i = frame.index(pixel.x, pixel.y);
   const std::vector<PrimitiveRef> primitives = flattenPrimitives(scene);  // by id - 1
   const std::vector<DrawPass> passes = drawPasses(scene, options.force_painter);

@@ -46,7 +46,8 @@ bool Faults::any() const {
          move_line_end != 0 || move_point != 0 || texel_offset != 0.0 ||
          blend_factor != Blend::Correct || depth_func_inverted || stencil_op_shifted ||
          blend_function_shifted || scissor_shift != 0 || lod_shift != 0.0 || lod_weight_inverted ||
-         shadow_shift != 0.0 || shadow_compare_inverted || shadow_bias_dropped || !hang.empty() || !crash.empty() || !flaky.empty() || !hang_once.empty();
+         shadow_shift != 0.0 || shadow_compare_inverted || shadow_bias_dropped || !hang.empty() ||
+         !crash.empty() || !flaky.empty() || !hang_once.empty();
 }
 
 bool Faults::hangs(const std::string& fixture) const { return hang == "*" || hang == fixture; }

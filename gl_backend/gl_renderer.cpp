@@ -135,8 +135,8 @@ struct Program {
   GLint light_intensity = -1, specular_model = -1, attenuation = -1;
   GLint material_ambient = -1, material_diffuse = -1, material_specular = -1, shininess = -1;
   GLint opacity = -1, has_texture = -1, texture = -1;
-  GLint fault_depth_bias = -1, fault_shift_ndc = -1, fault_texel_offset = -1,
-        fault_lod_bias = -1, fault_shadow_shift = -1;  // -1 unless compiled with the fault
+  GLint fault_depth_bias = -1, fault_shift_ndc = -1, fault_texel_offset = -1, fault_lod_bias = -1,
+        fault_shadow_shift = -1;  // -1 unless compiled with the fault
   // Shadow lookups (-1 in programs without them).
   GLint shadow_map = -1, shadow_matrix = -1, shadow_bias = -1, light_shadowed = -1;
 };
@@ -1553,7 +1553,8 @@ struct PassTargets {
       gl.DeleteFramebuffers(static_cast<GLsizei>(framebuffers.size()), framebuffers.data());
     if (!renderbuffers.empty())
       gl.DeleteRenderbuffers(static_cast<GLsizei>(renderbuffers.size()), renderbuffers.data());
-    if (!textures.empty()) gl.DeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+    if (!textures.empty())
+      gl.DeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     gl.GetError();
   }
 
@@ -1601,8 +1602,8 @@ std::vector<MaterialShadow> materialShadows(const Scene& scene, const Scene& pas
     MaterialShadow& sh = out[m];
     sh.texture = it->second;
     sh.matrix = glm::mat4(shadowMatrix(scene, lookup->map));
-    sh.compare = static_cast<GLint>(
-        glCompare(faults.shadow_compare_inverted ? invertedFunc(lookup->compare) : lookup->compare));
+    sh.compare = static_cast<GLint>(glCompare(
+        faults.shadow_compare_inverted ? invertedFunc(lookup->compare) : lookup->compare));
     sh.filter = lookup->filter == TextureFilter::Linear ? GL_LINEAR : GL_NEAREST;
     sh.bias = faults.shadow_bias_dropped ? 0.0f : static_cast<GLfloat>(lookup->bias);
     for (const Light& l : pass_scene.lights) sh.shadowed.push_back(l.shadow_map == lookup->map);

@@ -29,6 +29,19 @@ constexpr double kMapBandPx = 0.1;
 
 float finiteOr0(float v) { return std::isfinite(v) ? v : 0.0f; }
 
+// A target frame's pixel (x, y) (rows top-down) as its texel index (rows bottom-up, GL's).
+std::size_t texelIndex(const Frame& frame, int x, int y) {
+  return static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x;
+}
+
+// fn(j) for pixel (x, y) and its eight neighbours inside the frame (frame indices).
+template <class Fn>
+void forEach3x3(const Frame& frame, int x, int y, Fn&& fn) {
+  for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, frame.height - 1); ++ny)
+    for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, frame.width - 1); ++nx)
+      fn(frame.index(nx, ny));
+}
+
 // Steps a fragment of depth gradient `slope` (steps/px) at pixel i of a target the
 // reference drew may be off by in another implementation (the comparator's rule of
 // docs/tolerances.md section 2 with the widest driver's band): the fail threshold, its
@@ -100,19 +113,13 @@ std::vector<float> targetUncertainty(const Frame& frame, DepthFormat format,
       if (!tie && coverageOpen(frame, format, i)) {
         for (int c = 0; c < 4; ++c)  // the background
           u = std::max(u, 1.0 + 255.0 * std::fabs(clear[c] - frame.color[i * 4 + c]));
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = x + dx;
-            const int ny = y + dy;
-            if (nx < 0 || ny < 0 || nx >= frame.width || ny >= frame.height) continue;
-            const std::size_t j = frame.index(nx, ny);
-            for (int c = 0; c < 4; ++c)
-              u = std::max(u, 1.0 + 255.0 * std::fabs(static_cast<double>(frame.color[j * 4 + c]) -
-                                                      frame.color[i * 4 + c]));
-          }
-        }
+        forEach3x3(frame, x, y, [&](std::size_t j) {
+          for (int c = 0; c < 4; ++c)
+            u = std::max(u, 1.0 + 255.0 * std::fabs(static_cast<double>(frame.color[j * 4 + c]) -
+                                                    frame.color[i * 4 + c]));
+        });
       }
-      out[static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x] = static_cast<float>(u);
+      out[texelIndex(frame, x, y)] = static_cast<float>(u);
     }
   }
   return out;
@@ -152,7 +159,7 @@ void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map) 
   for (int y = 0; y < frame.height; ++y) {
     for (int x = 0; x < frame.width; ++x) {
       const std::size_t i = frame.index(x, y);
-      const std::size_t k = static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x;
+      const std::size_t k = texelIndex(frame, x, y);
       const double d = frame.depth[i];
       const double a = allowance(i) * step;
       double lo = d - a;
@@ -168,18 +175,11 @@ void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map) 
         // Within the band of an edge another surface (or the clear depth) may cover the
         // texel: those of its neighbours, each carried over one texel along its slope.
         if (coverageOpen(frame, map.format, i)) {
-          for (int dy = -1; dy <= 1; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int nx = x + dx;
-              const int ny = y + dy;
-              if (nx < 0 || ny < 0 || nx >= frame.width || ny >= frame.height) continue;
-              const std::size_t j = frame.index(nx, ny);
-              const double slope = std::isfinite(frame.depth_slope[j]) ? frame.depth_slope[j] : 0.0;
-              const double reach = (allowance(j) + 1.5 * slope) * step;
-              lo = std::min(lo, frame.depth[j] - reach);
-              hi = std::max(hi, frame.depth[j] + reach);
-            }
-          }
+          forEach3x3(frame, x, y, [&](std::size_t j) {
+            const double reach = (allowance(j) + 1.5 * finiteOr0(frame.depth_slope[j])) * step;
+            lo = std::min(lo, frame.depth[j] - reach);
+            hi = std::max(hi, frame.depth[j] + reach);
+          });
           lo = std::min(lo, clear_depth);
           hi = std::max(hi, clear_depth);
         }
@@ -212,9 +212,7 @@ PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options) {
       map->matrix = shadowMatrix(scene, name);
       map->depth.resize(f.pixelCount());
       for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x)
-          map->depth[static_cast<std::size_t>(f.height - 1 - y) * f.width + x] =
-              f.depth[f.index(x, y)];
+        for (int x = 0; x < f.width; ++x) map->depth[texelIndex(f, x, y)] = f.depth[f.index(x, y)];
       if (options.uncertainty) shadowMapRange(f, ps.clear_depth, *map);
       bound.maps[name] = std::move(map);
     } else if (target != nullptr) {

@@ -40,21 +40,22 @@ json blockerScene(const std::string& compare = "lequal", const std::string& filt
                      {"near", 1},
                      {"far", 10}};
   const json lookup = {{"map", "sun"}, {"compare", compare}, {"filter", filter}, {"bias", 0.001}};
-  return {{"format", kSceneFormat},
-          {"name", "shadow/blocker"},
-          {"image", {{"width", 64}, {"height", 64}}},
-          {"camera", down},
-          {"ambient_light", {1, 1, 1}},
-          {"lights", {{{"type", "directional"}, {"direction", {0, -1, 0}}, {"shadow_map", "sun"}}}},
-          {"targets", {{"sun", {{"width", 64}, {"height", 64}, {"format", "d24"}}}}},
-          {"materials",
-           {{"floor", {{"ambient", {0.1, 0.1, 0.1}}, {"diffuse", {0.5, 0.5, 0.5}}, {"shadow", lookup}}},
-            {"lid", {{"ambient", {0.1, 0.1, 0.1}}, {"diffuse", {0.2, 0.2, 0.2}}}}}},
-          {"objects",
-           {{{"name", "floor"}, {"material", "floor"}, {"mesh", floor_quad}},
-            {{"name", "blocker"}, {"material", "lid"}, {"mesh", blocker}}}},
-          {"passes", {{{"target", "sun"}, {"camera", down}}, {{"target", "frame"}}}},
-          {"state", {{"shading", "phong"}}}};
+  return {
+      {"format", kSceneFormat},
+      {"name", "shadow/blocker"},
+      {"image", {{"width", 64}, {"height", 64}}},
+      {"camera", down},
+      {"ambient_light", {1, 1, 1}},
+      {"lights", {{{"type", "directional"}, {"direction", {0, -1, 0}}, {"shadow_map", "sun"}}}},
+      {"targets", {{"sun", {{"width", 64}, {"height", 64}, {"format", "d24"}}}}},
+      {"materials",
+       {{"floor", {{"ambient", {0.1, 0.1, 0.1}}, {"diffuse", {0.5, 0.5, 0.5}}, {"shadow", lookup}}},
+        {"lid", {{"ambient", {0.1, 0.1, 0.1}}, {"diffuse", {0.2, 0.2, 0.2}}}}}},
+      {"objects",
+       {{{"name", "floor"}, {"material", "floor"}, {"mesh", floor_quad}},
+        {{"name", "blocker"}, {"material", "lid"}, {"mesh", blocker}}}},
+      {"passes", {{{"target", "sun"}, {"camera", down}}, {{"target", "frame"}}}},
+      {"state", {{"shading", "phong"}}}};
 }
 
 Scene load(const json& doc) { return loadScene(doc, "blocker.json"); }
@@ -209,8 +210,8 @@ TEST(MultiPassReference, ColourTargetIsSampledAsDrawn) {
   const json quad = {{"positions", {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}},
                      {"uvs", {{0, 0}, {1, 0}, {1, 1}, {0, 1}}},
                      {"triangles", {{0, 1, 2}, {0, 2, 3}}}};
-  const json ortho = {{"projection", "orthographic"}, {"eye", {0, 0, 5}},
-                      {"bounds", {-1, 1, -1, 1}}};
+  const json ortho = {
+      {"projection", "orthographic"}, {"eye", {0, 0, 5}}, {"bounds", {-1, 1, -1, 1}}};
   const json doc = {
       {"format", kSceneFormat},
       {"image", {{"width", 16}, {"height", 16}}},
@@ -223,8 +224,8 @@ TEST(MultiPassReference, ColourTargetIsSampledAsDrawn) {
       {"objects",
        {{{"name", "tri"},
          {"material", "paint"},
-         {"mesh", {{"positions", {{-1, -1, 0}, {1, -1, 0}, {-1, 1, 0}}},
-                   {"triangles", {{0, 1, 2}}}}}},
+         {"mesh",
+          {{"positions", {{-1, -1, 0}, {1, -1, 0}, {-1, 1, 0}}}, {"triangles", {{0, 1, 2}}}}}},
         {{"name", "quad"}, {"material", "show"}, {"mesh", quad}}}},
       {"passes",
        {{{"target", "t"}, {"objects", {"tri"}}, {"state", {{"color_format", "rgba8"}}}},
