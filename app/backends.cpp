@@ -87,6 +87,9 @@ Frame renderWith(const BackendSpec& backend, const Scene& scene) {
   // (The formats and texture facts are frame.drawn, set by the renderer.)
   m["state"] = stateJson(scene.state);     // what expected failures are scoped by
   m["color_digest"] = colorDigest(frame);  // tells `compare` color.png shows this frame
+  // Every plane's bits (colour, depth, ids, stencil, samples): what `scripts/same-bits.sh`
+  // compares between two runs (the isolation check: one fixture, two orders).
+  m["frame_digest"] = frameDigest(frame);
   if (!m.contains("subpixel_bits")) m["subpixel_bits"] = backend.reference.subpixel_bits;
   m["time_ms"] = ms;
   return frame;

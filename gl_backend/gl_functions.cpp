@@ -24,13 +24,29 @@ void Functions::load(ProcLoader loader) {
   GLint count = 0;
   GetIntegerv(GL_NUM_EXTENSIONS, &count);
   bool khr_debug = false;
+  bool program_binary = false;
   pack_invert = false;
   for (GLint i = 0; i < count; ++i) {
     const auto* ext = reinterpret_cast<const char*>(GetStringi(GL_EXTENSIONS, i));
     if (ext == nullptr) continue;
     khr_debug = khr_debug || std::strcmp(ext, "GL_KHR_debug") == 0;
     pack_invert = pack_invert || std::strcmp(ext, "GL_MESA_pack_invert") == 0;
+    program_binary = program_binary || std::strcmp(ext, "GL_ARB_get_program_binary") == 0;
   }
+  GLint major = 0;
+  GLint minor = 0;
+  GetIntegerv(GL_MAJOR_VERSION, &major);
+  GetIntegerv(GL_MINOR_VERSION, &minor);
+  GLint formats = 0;
+  if (program_binary || major * 10 + minor >= 41)
+    GetIntegerv(GL_NUM_PROGRAM_BINARY_FORMATS, &formats);
+  GetError();  // GL_NUM_PROGRAM_BINARY_FORMATS is unknown to a context without the extension
+  GetProgramBinary = formats > 0
+                         ? reinterpret_cast<PFNGLGETPROGRAMBINARYPROC>(loader("glGetProgramBinary"))
+                         : nullptr;
+  ProgramBinary =
+      formats > 0 ? reinterpret_cast<PFNGLPROGRAMBINARYPROC>(loader("glProgramBinary")) : nullptr;
+  if (GetProgramBinary == nullptr || ProgramBinary == nullptr) GetProgramBinary = nullptr;
   DebugMessageCallback =
       khr_debug ? reinterpret_cast<PFNGLDEBUGMESSAGECALLBACKPROC>(loader("glDebugMessageCallback"))
                 : nullptr;

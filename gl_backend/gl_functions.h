@@ -114,6 +114,10 @@ struct Functions {
   RC_GL_CORE_FUNCTIONS(RC_GL_DECLARE)
 #undef RC_GL_DECLARE
   PFNGLDEBUGMESSAGECALLBACKPROC DebugMessageCallback = nullptr;  // null without KHR_debug
+  // ARB_get_program_binary (core in 4.1): null without it, or when the driver offers no
+  // binary format (GL_NUM_PROGRAM_BINARY_FORMATS 0, e.g. Mesa without its shader cache).
+  PFNGLGETPROGRAMBINARYPROC GetProgramBinary = nullptr;
+  PFNGLPROGRAMBINARYPROC ProgramBinary = nullptr;
   // GL_MESA_pack_invert: glReadPixels can return rows top first (GL_PACK_INVERT_MESA).
   bool pack_invert = false;
 

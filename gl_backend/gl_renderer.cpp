@@ -129,6 +129,7 @@ std::string driverFromRenderer(const std::string& renderer) {
 // Uniform locations of the one program, looked up once per program.
 struct Program {
   GLuint id = 0;
+  bool from_binary = false;  // made from its glGetProgramBinary bytes (throughBinary)
   int max_lights = 0;
   GLint view_projection = -1, shading = -1, eye = -1, ambient_light = -1, light_count = -1;
   GLint light_type = -1, light_position = -1, light_direction = -1, light_color = -1;
@@ -190,6 +191,7 @@ struct Session {
   bool drew_lines = false;
   const char* context_use = "new";       // frame.json "context": new, reused or replaced
   const char* program_use = "compiled";  // frame.json "program": compiled or reused
+  bool program_binary = false;           // frame.json "program_binary"
 };
 
 std::mutex g_mutex;
@@ -479,6 +481,37 @@ GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& s
                                  stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log));
 }
 
+// The program `id` as its binary gives it back: a new program object made from
+// glGetProgramBinary's bytes; `id` is deleted. The same program when there is no binary or
+// it does not load. Why: Mesa's on-disk shader cache keys llvmpipe's JIT-compiled state
+// variants by the program's NIR, and a program linked from source and the same program
+// found in Mesa's GLSL cache (every later process) hand the driver different NIR, so the
+// variants a first run compiled were never found again and a second run compiled them all
+// anew (gen200 on a new cache: 22 s, 16.7 s, then 2.1 s). Through its binary, every process
+// draws with the cached form, and the second run finds the first one's variants
+// (docs/performance.md, "Mesa's shader cache").
+GLuint throughBinary(Session& s, GLuint id) {
+  const gl::Functions& gl = s.gl;
+  if (gl.GetProgramBinary == nullptr) return id;
+  GLint length = 0;
+  gl.GetProgramiv(id, GL_PROGRAM_BINARY_LENGTH, &length);
+  if (length <= 0) return id;
+  std::vector<std::byte> bytes(static_cast<std::size_t>(length));
+  GLenum format = 0;
+  gl.GetProgramBinary(id, length, nullptr, &format, bytes.data());
+  const GLuint copy = gl.CreateProgram();
+  gl.ProgramBinary(copy, format, bytes.data(), length);
+  GLint ok = GL_FALSE;
+  gl.GetProgramiv(copy, GL_LINK_STATUS, &ok);
+  if (gl.GetError() != GL_NO_ERROR || ok != GL_TRUE) {
+    gl.DeleteProgram(copy);
+    s.debug_errors.clear();
+    return id;
+  }
+  gl.DeleteProgram(id);
+  return copy;
+}
+
 const Program& programFor(Session& s, int max_lights, const gl::testing::Faults& faults,
                           bool shadows) {
   gl::ShaderFaults shader_faults;
@@ -492,9 +525,11 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   const gl::testing::Hooks& hooks = gl::testing::hooks();
   if (!hooks.vertex_shader.empty()) source.vertex = hooks.vertex_shader;
   if (!hooks.fragment_shader.empty()) source.fragment = hooks.fragment_shader;
-  const std::string key = source.vertex + '\0' + source.fragment;
+  std::string key = source.vertex + '\0' + source.fragment;
+  if (hooks.program_from_source) key += std::string(1, '\0') + "from source";
   if (auto it = s.programs.find(key); it != s.programs.end()) {
     s.program_use = "reused";
+    s.program_binary = it->second.from_binary;
     return it->second;
   }
   s.program_use = "compiled";
@@ -527,9 +562,11 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
     throw BackendError(fmt::format("shader program does not link: {}", log));
   }
   Program p;
-  p.id = id;
+  p.id = hooks.program_from_source ? id : throughBinary(s, id);
+  p.from_binary = p.id != id;
+  s.program_binary = p.from_binary;
   p.max_lights = max_lights;
-  auto loc = [&](const char* name) { return gl.GetUniformLocation(id, name); };
+  auto loc = [&](const char* name) { return gl.GetUniformLocation(p.id, name); };
   p.view_projection = loc("u_view_projection");
   p.shading = loc("u_shading");
   p.eye = loc("u_eye");
@@ -1839,6 +1876,7 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec) {
   m["platform"] = s.context->platform();
   m["context"] = s.context_use;
   m["program"] = s.program_use;
+  m["program_binary"] = s.program_binary;
   m["driver"] = s.driver;
   m["stack"] = s.stack;
   m["mesa"] = gl::toJson(s.mesa, s.spec, s.mesa_version);

@@ -100,6 +100,7 @@ struct Hooks {
   std::string gallium_driver;          // non-empty: GALLIUM_DRIVER is set to this, not the spec's
   Faults faults;                       // any(): used instead of RASTERCHECK_GL_FAULT
   bool ignore_pack_invert = false;     // read back as if GL_MESA_pack_invert were missing
+  bool program_from_source = false;    // draw with the program as linked, not its binary
 };
 
 // The process-wide hooks (all off by default).

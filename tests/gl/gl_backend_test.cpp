@@ -385,6 +385,55 @@ TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
   fs::remove_all(dir);
 }
 
+// Programs are drawn through their binary (glGetProgramBinary, then glProgramBinary: the
+// form every later process finds in Mesa's shader cache, so that a second run finds the
+// first one's JIT-compiled variants; docs/performance.md "Mesa's shader cache"). That form
+// must draw the bits the program linked from source draws: random scenes of every profile
+// and the whole catalog, each both ways, every plane compared.
+TEST_F(GlBackend, ProgramThroughItsBinaryDrawsTheSameBits) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("rc_binary_" + std::to_string(getpid()));
+  std::vector<fs::path> files = test::writeRandomProfiles(dir, 20261332, 4, 96, 72);
+  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
+  for (const auto& e : fs::recursive_directory_iterator(catalog))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 30u);
+  std::string driver;
+  auto frameOf = [&](const Scene& scene, bool from_source, bool* binary) {
+    HookGuard guard;
+    gl::testing::hooks().program_from_source = from_source;
+    try {
+      const Frame f = render(scene);
+      *binary = f.meta.at("program_binary").get<bool>();
+      driver = f.meta.at("driver").get<std::string>();
+      return test::framePlanes(f);
+    } catch (const NotSupportedError&) {
+      return std::string("not supported");
+    }
+  };
+  // Mesa offers a binary format only where the driver has an on-disk shader cache
+  // (llvmpipe, zink; not softpipe), and with that cache on.
+  const char* disabled = std::getenv("MESA_SHADER_CACHE_DISABLE");
+  const bool cache_on =
+      disabled == nullptr || std::string(disabled) == "false" || std::string(disabled) == "0";
+  int through_binary = 0;
+  for (const fs::path& f : files) {
+    const Scene scene = loadScene(f);
+    bool binary = false;
+    bool source_binary = true;
+    const std::string a = frameOf(scene, false, &binary);
+    const std::string b = frameOf(scene, true, &source_binary);
+    if (a == "not supported") continue;
+    EXPECT_FALSE(source_binary) << f.string();
+    through_binary += binary ? 1 : 0;
+    EXPECT_TRUE(a == b) << f.string() << ": the program's binary draws other bits than its source";
+  }
+  if (cache_on && (driver == "llvmpipe" || driver == "zink")) {
+    EXPECT_GT(through_binary, 0) << "no render went through the program binary";
+  }
+  fs::remove_all(dir);
+}
+
 TEST_F(GlBackend, ReadbackWithAndWithoutPackInvertAgree) {
   for (ColorFormat color : {ColorFormat::RGBA32F, ColorFormat::RGBA8}) {
     for (DepthFormat depth : {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F}) {
