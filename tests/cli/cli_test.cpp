@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/report_support.h"
+#include "compare/pair_images.h"
 #include "fixtures/frame_io.h"
 #include "fixtures/loader.h"
 #include "fixtures/multisample.h"
@@ -77,6 +78,13 @@ TEST(Cli, RenderReferenceWritesTheFrameDirectory) {
   EXPECT_EQ(f.meta["fixture"], "coverage/triangle_fan");
   EXPECT_EQ(f.meta["subpixel_bits"], 8);
   EXPECT_TRUE(fs::exists(out / "color.png"));
+  // frame_digest covers every plane (scripts/same-bits.sh compares it between runs): the
+  // digest of the frame read back, and another for a frame one depth value away.
+  ASSERT_TRUE(f.meta.contains("frame_digest"));
+  EXPECT_EQ(f.meta["frame_digest"], rc::frameDigest(f));
+  rc::Frame moved = f;
+  moved.depth[moved.depth.size() / 2] += 1e-3f;
+  EXPECT_NE(rc::frameDigest(moved), rc::frameDigest(f));
 }
 
 // A multi-pass fixture with --all-passes: each pass before the frame pass as a frame folder
