@@ -269,6 +269,25 @@ int runCommand(const RunArgs& args) {
   // catalog's images and meshes are read one after another otherwise); the first fixture in
   // order that fails is the one reported, as when they were loaded one by one.
   const std::vector<fs::path> files = findFixtures(inputs);
+  // The mesh files the fixtures name, imported in one importer process before the check
+  // below asks for them one by one (prefetchMeshImports: an optimisation only).
+  {
+    std::vector<std::pair<fs::path, bool>> meshes;
+    for (const fs::path& f : files) {
+      std::ifstream in(f, std::ios::binary);
+      const nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);
+      if (!doc.is_object() || !doc.contains("objects") || !doc["objects"].is_array()) continue;
+      for (const nlohmann::json& o : doc["objects"]) {
+        if (!o.is_object() || !o.contains("mesh") || !o["mesh"].is_object()) continue;
+        const nlohmann::json& file = o["mesh"].value("file", nlohmann::json());
+        if (!file.is_string()) continue;
+        const fs::path p(file.get<std::string>());
+        // As the loader resolves it; a material of the scene's own means none from the file.
+        meshes.emplace_back(p.is_absolute() ? p : f.parent_path() / p, !o.contains("material"));
+      }
+    }
+    prefetchMeshImports(meshes);
+  }
   struct Checked {
     FixtureEntry entry;
     std::exception_ptr error;
