@@ -274,17 +274,8 @@ int runCommand(const RunArgs& args) {
   {
     std::vector<std::pair<fs::path, bool>> meshes;
     for (const fs::path& f : files) {
-      std::ifstream in(f, std::ios::binary);
-      const nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);
-      if (!doc.is_object() || !doc.contains("objects") || !doc["objects"].is_array()) continue;
-      for (const nlohmann::json& o : doc["objects"]) {
-        if (!o.is_object() || !o.contains("mesh") || !o["mesh"].is_object()) continue;
-        const nlohmann::json& file = o["mesh"].value("file", nlohmann::json());
-        if (!file.is_string()) continue;
-        const fs::path p(file.get<std::string>());
-        // As the loader resolves it; a material of the scene's own means none from the file.
-        meshes.emplace_back(p.is_absolute() ? p : f.parent_path() / p, !o.contains("material"));
-      }
+      auto named = meshFilesNamed(f);
+      meshes.insert(meshes.end(), named.begin(), named.end());
     }
     prefetchMeshImports(meshes);
   }

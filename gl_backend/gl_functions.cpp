@@ -33,6 +33,7 @@ void Functions::load(ProcLoader loader) {
     pack_invert = pack_invert || std::strcmp(ext, "GL_MESA_pack_invert") == 0;
     program_binary = program_binary || std::strcmp(ext, "GL_ARB_get_program_binary") == 0;
   }
+  // Program binaries: core in 4.1, else the extension; usable only with a format to use.
   GLint major = 0;
   GLint minor = 0;
   GetIntegerv(GL_MAJOR_VERSION, &major);
@@ -40,13 +41,11 @@ void Functions::load(ProcLoader loader) {
   GLint formats = 0;
   if (program_binary || major * 10 + minor >= 41)
     GetIntegerv(GL_NUM_PROGRAM_BINARY_FORMATS, &formats);
-  GetError();  // GL_NUM_PROGRAM_BINARY_FORMATS is unknown to a context without the extension
-  GetProgramBinary = formats > 0
-                         ? reinterpret_cast<PFNGLGETPROGRAMBINARYPROC>(loader("glGetProgramBinary"))
-                         : nullptr;
-  ProgramBinary =
-      formats > 0 ? reinterpret_cast<PFNGLPROGRAMBINARYPROC>(loader("glProgramBinary")) : nullptr;
-  if (GetProgramBinary == nullptr || ProgramBinary == nullptr) GetProgramBinary = nullptr;
+  auto get = reinterpret_cast<PFNGLGETPROGRAMBINARYPROC>(loader("glGetProgramBinary"));
+  auto put = reinterpret_cast<PFNGLPROGRAMBINARYPROC>(loader("glProgramBinary"));
+  const bool binaries = formats > 0 && get != nullptr && put != nullptr;
+  GetProgramBinary = binaries ? get : nullptr;
+  ProgramBinary = binaries ? put : nullptr;
   DebugMessageCallback =
       khr_debug ? reinterpret_cast<PFNGLDEBUGMESSAGECALLBACKPROC>(loader("glDebugMessageCallback"))
                 : nullptr;

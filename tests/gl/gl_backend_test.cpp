@@ -329,6 +329,17 @@ TEST_F(GlBackend, ContextIsReusedWhereIsolationIsShown) {
   EXPECT_EQ(render(opaque).meta.at("context"), "reused");
 }
 
+// `count` small random fixtures of every profile (written to `dir`) and the whole catalog,
+// sorted: the scenes the tests below draw twice and compare bit for bit.
+std::vector<fs::path> randomAndCatalog(const fs::path& dir, std::uint64_t seed, int count) {
+  std::vector<fs::path> files = test::writeRandomProfiles(dir, seed, count, 96, 72);
+  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
+  for (const auto& e : fs::recursive_directory_iterator(catalog))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 // Isolation: a fixture's frame does not depend on what this process drew before it. Random
 // scenes (every profile, small) and the whole catalog (textures, blending, MSAA, every
 // format) are rendered each in a new context (RASTERCHECK_GL_CONTEXT=new), then in a
@@ -342,11 +353,7 @@ TEST_F(GlBackend, ContextIsReusedWhereIsolationIsShown) {
 TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
   const fs::path dir =
       fs::path(::testing::TempDir()) / ("rc_isolation_" + std::to_string(getpid()));
-  std::vector<fs::path> files = test::writeRandomProfiles(dir, 20261204, 8, 96, 72);
-  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
-  for (const auto& e : fs::recursive_directory_iterator(catalog))
-    if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = randomAndCatalog(dir, 20261204, 8);
   ASSERT_GE(files.size(), 30u);
 
   std::vector<Scene> scenes;
@@ -392,11 +399,7 @@ TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
 // and the whole catalog, each both ways, every plane compared.
 TEST_F(GlBackend, ProgramThroughItsBinaryDrawsTheSameBits) {
   const fs::path dir = fs::path(::testing::TempDir()) / ("rc_binary_" + std::to_string(getpid()));
-  std::vector<fs::path> files = test::writeRandomProfiles(dir, 20261332, 4, 96, 72);
-  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
-  for (const auto& e : fs::recursive_directory_iterator(catalog))
-    if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = randomAndCatalog(dir, 20261332, 4);
   ASSERT_GE(files.size(), 30u);
   std::string driver;
   auto frameOf = [&](const Scene& scene, bool from_source, bool* binary) {

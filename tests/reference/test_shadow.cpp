@@ -111,8 +111,10 @@ TEST(Shadow, CompareFunctionDecidesWhatIsLit) {
     d["materials"]["floor"]["shadow"]["compare"] = fixed;
     const Frame f = renderReference(load(d));
     const float want = std::string(fixed) == "always" ? 0.6f : 0.1f;
-    for (std::size_t i = 0; i < f.pixelCount(); ++i)
-      if (f.id[i] == 1 || f.id[i] == 2) EXPECT_EQ(f.color[i * 4], want) << fixed << " " << i;
+    for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+      if (f.id[i] != 1 && f.id[i] != 2) continue;
+      EXPECT_EQ(f.color[i * 4], want) << fixed << " " << i;
+    }
   }
 }
 
@@ -140,7 +142,7 @@ TEST(Shadow, UncertaintyIsZeroInsideTheRegionsAndTheWholeLightAtTheBorder) {
       if (f.id[i] != 1 && f.id[i] != 2) continue;
       // Two floor pixels side by side on either side of the shadow's edge: one of them
       // is left to the implementation.
-      for (const auto [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
         const std::size_t j = f.index(x + dx, y + dy);
         if ((f.id[j] != 1 && f.id[j] != 2) || f.color[j * 4] == f.color[i * 4]) continue;
         ++border;
