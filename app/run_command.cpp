@@ -17,6 +17,7 @@
 #include <exception>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -422,6 +423,7 @@ int runCommand(const RunArgs& args) {
     std::size_t probes_left = probe_tickets.size();
     const auto probes_start = std::chrono::steady_clock::now();
     double probe_seconds = 0.0;
+    std::future<nlohmann::json> variants_done;
 
     std::map<std::size_t, std::pair<std::size_t, std::string>> ticket_of;  // -> fixture, spec
     std::vector<std::map<std::string, RenderOutcome>> got(fixtures.size());
@@ -564,10 +566,17 @@ int runCommand(const RunArgs& args) {
         if (const auto it = std::find(probe_tickets.begin(), probe_tickets.end(), ticket);
             it != probe_tickets.end()) {
           probe_outcomes[static_cast<std::size_t>(it - probe_tickets.begin())] = std::move(outcome);
-          if (--probes_left == 0)
+          if (--probes_left == 0) {
             probe_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - probes_start)
                     .count();
+            // Analysed (and their frames written) beside the renders rather than after
+            // them: the reference's subpixel renders and the image library's loading
+            // (~0.2 s, for frame.exr and color.png) would otherwise end every run.
+            variants_done = std::async(std::launch::async, [&, probe_seconds] {
+              return analyseVariants(probes, probe_outcomes, probe_seconds);
+            });
+          }
           continue;
         }
         // A worker that judged the fixture bad input (a file changed since it was checked)
@@ -653,7 +662,10 @@ int runCommand(const RunArgs& args) {
           });
       if (disagree) r->status = Status::Flake;
     }
-    if (args.variants) report.variants = analyseVariants(probes, probe_outcomes, probe_seconds);
+    if (args.variants)
+      report.variants = variants_done.valid()
+                            ? variants_done.get()
+                            : analyseVariants(probes, probe_outcomes, probe_seconds);
   }
   for (std::optional<PairResult>& r : results) report.results.push_back(std::move(*r));
   report.skipped = std::move(skipped);
