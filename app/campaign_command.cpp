@@ -29,6 +29,7 @@
 #include "debug/campaign.h"
 #include "debug/probes.h"
 #include "fixtures/errors.h"
+#include "fixtures/output_folder.h"
 #include "fixtures/scene_writer.h"
 
 namespace rc {
@@ -234,6 +235,9 @@ class Campaign {
       if (jobs[0].cancelled || interrupt_.interrupted()) {
         fs::remove_all(staging, ec);
         fs::remove(job.log, ec);
+        // The run was ended by a signal: its report folder's staging folder is left beside
+        // `staging` (it is made when the run starts), unlocked now that the run is gone.
+        removeDeadStaging(runsDir());
         return;
       }
       const int code = jobs[0].exit_code;

@@ -7,6 +7,7 @@
 // Everything the user gave is checked before the first render (exit 2, nothing written);
 // the outputs replace an earlier run's only once all of them are written. With
 // --shard K/N it runs one deterministic part of the whole run (compare/shards.h).
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -213,6 +214,9 @@ std::vector<FixtureEntry> selectCaselist(const fs::path& caselist,
   return out;
 }
 
+// The niceness of work done beside the renders that only the report needs.
+constexpr int kBackgroundNice = 19;
+
 // A render's time as its frame.json says (time_ms), in seconds; 0 when it does not.
 double renderSeconds(const RenderOutcome& o) {
   if (!o.ok || !o.frame.meta.is_object() || !o.frame.meta.contains("time_ms") ||
@@ -266,26 +270,53 @@ int runCommand(const RunArgs& args) {
   const int parallel = args.jobs > 0
                            ? args.jobs
                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // The reference renders too when --against has no uncertainty channels of its own.
+  const bool needs_ref = against.kind == BackendSpec::Kind::Gl;
+
+  // The report folder and the workers come first: the GL workers start (load their drivers,
+  // make their contexts) and draw the variant probes while the fixtures are checked. A bad
+  // fixture still exits 2 with nothing written (the folder is only staged, and the workers
+  // are ended unheard).
+  ReportFolder folder(args.out);
+  std::optional<WorkerPool> pool;
+  pool.emplace(WorkerPool::Options{parallel, args.timeout_seconds, folder.staging() / "workers"});
+  // Which legal variant each GL backend follows, probed once per backend for the run: every
+  // backend the run names (those left without pairs, by --skips or --shard, are rendered but
+  // not analysed).
+  VariantProbes probes;
+  std::vector<std::size_t> probe_tickets;
+  if (args.variants) {
+    std::vector<std::string> named = {against.text};
+    if (needs_ref && against.text != "ref") named.emplace_back("ref");
+    for (const BackendSpec& b : backends)
+      if (std::find(named.begin(), named.end(), b.text) == named.end()) named.push_back(b.text);
+    probes = prepareVariantProbes(named, folder.staging() / "variants");
+    for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool->submit(r));
+  }
+  const auto probes_start = std::chrono::steady_clock::now();
+
   // Loaded `parallel` at a time (a mesh file's import is a child process of its own, and a
   // catalog's images and meshes are read one after another otherwise); the first fixture in
   // order that fails is the one reported, as when they were loaded one by one.
-  const std::vector<fs::path> files = findFixtures(inputs);
-  // The mesh files the fixtures name, imported in one importer process before the check
-  // below asks for them one by one (prefetchMeshImports: an optimisation only).
-  {
-    std::vector<std::pair<fs::path, bool>> meshes;
-    for (const fs::path& f : files) {
-      auto named = meshFilesNamed(f);
-      meshes.insert(meshes.end(), named.begin(), named.end());
-    }
-    prefetchMeshImports(meshes);
-  }
+  std::vector<fs::path> files;
   struct Checked {
     FixtureEntry entry;
     std::exception_ptr error;
   };
-  std::vector<Checked> checked(files.size());
-  {
+  std::vector<Checked> checked;
+  auto check = [&] {
+    files = findFixtures(inputs);
+    // The mesh files the fixtures name, imported in one importer process before the check
+    // below asks for them one by one (prefetchMeshImports: an optimisation only).
+    {
+      std::vector<std::pair<fs::path, bool>> meshes;
+      for (const fs::path& f : files) {
+        auto named = meshFilesNamed(f);
+        meshes.insert(meshes.end(), named.begin(), named.end());
+      }
+      prefetchMeshImports(meshes);
+    }
+    checked.resize(files.size());
     std::atomic<std::size_t> next{0};
     auto validate = [&] {
       for (std::size_t i = next++; i < files.size(); i = next++) {
@@ -302,10 +333,31 @@ int runCommand(const RunArgs& args) {
       }
     };
     const std::size_t threads = std::min<std::size_t>(files.size(), parallel);
-    std::vector<std::thread> pool;
-    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(validate);
+    std::vector<std::thread> helpers;
+    for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(validate);
     validate();
-    for (std::thread& t : pool) t.join();
+    for (std::thread& t : helpers) t.join();
+  };
+  // The probes' outcomes that come in meanwhile, taken up with the renders' below.
+  std::vector<std::pair<std::size_t, RenderOutcome>> early;
+  if (probe_tickets.empty()) {
+    check();
+  } else {
+    pool->poll(0);  // starts the workers on the probes
+    std::atomic<bool> checked_all{false};
+    std::exception_ptr check_error;
+    std::thread checker([&] {
+      try {
+        check();
+      } catch (...) {
+        check_error = std::current_exception();
+      }
+      checked_all = true;
+    });
+    while (!checked_all)
+      for (auto& outcome : pool->poll(5)) early.push_back(std::move(outcome));
+    checker.join();
+    if (check_error) std::rethrow_exception(check_error);
   }
   for (Checked& c : checked) {
     if (c.error) std::rethrow_exception(c.error);
@@ -349,8 +401,6 @@ int runCommand(const RunArgs& args) {
       pairs.push_back({f, b, pairs.size()});
     }
   const std::size_t total_pairs = pairs.size();
-  // The reference renders too when --against has no uncertainty channels of its own.
-  const bool needs_ref = against.kind == BackendSpec::Kind::Gl;
   nlohmann::json shard_block = nlohmann::json::object();
   if (sharded) {
     std::vector<ShardUnit> units;
@@ -397,7 +447,6 @@ int runCommand(const RunArgs& args) {
     pairs_of[p.fixture].push_back(&p);
   }
 
-  ReportFolder folder(args.out);
   const fs::path frames_dir = folder.staging() / "frames";
   Report report;
   report.tool_version = kVersion;
@@ -405,23 +454,17 @@ int runCommand(const RunArgs& args) {
   report.shard = shard_block;
   std::vector<std::optional<PairResult>> results(pairs.size());
   {
-    WorkerPool pool({parallel, args.timeout_seconds, folder.staging() / "workers"});
-    // Which legal variant each GL backend follows, probed once per backend for the run:
-    // first in the queue, so that the workers start (and load their drivers) on them.
+    // The probes analysed: those of the backends that render.
     std::vector<std::string> render_specs;
     for (const auto& n : needed)
       for (const std::string& s : n)
         if (std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end())
           render_specs.push_back(s);
-    VariantProbes probes;
-    std::vector<std::size_t> probe_tickets;
-    if (args.variants) {
-      probes = prepareVariantProbes(render_specs, folder.staging() / "variants");
-      for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool.submit(r));
-    }
+    std::erase_if(probes.gl_specs, [&](const std::string& s) {
+      return std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end();
+    });
     std::vector<RenderOutcome> probe_outcomes(probe_tickets.size());
     std::size_t probes_left = probe_tickets.size();
-    const auto probes_start = std::chrono::steady_clock::now();
     double probe_seconds = 0.0;
     std::future<nlohmann::json> variants_done;
 
@@ -431,7 +474,7 @@ int runCommand(const RunArgs& args) {
     for (std::size_t f = 0; f < fixtures.size(); ++f) {
       left[f] = needed[f].size();
       for (const std::string& spec : needed[f])
-        ticket_of[pool.submit({fixtures[f].file, spec})] = {f, spec};
+        ticket_of[pool->submit({fixtures[f].file, spec})] = {f, spec};
     }
 
     auto expectedFailure = [&](const PairResult& r) {
@@ -559,36 +602,44 @@ int runCommand(const RunArgs& args) {
     std::string input_failure;
     const auto to_render = static_cast<std::size_t>(
         std::count_if(left.begin(), left.end(), [](std::size_t n) { return n > 0; }));
-    while (pool.outstanding() > 0) {
+    auto take = [&](std::size_t ticket, RenderOutcome& outcome) {
+      if (const auto it = std::find(probe_tickets.begin(), probe_tickets.end(), ticket);
+          it != probe_tickets.end()) {
+        probe_outcomes[static_cast<std::size_t>(it - probe_tickets.begin())] = std::move(outcome);
+        if (--probes_left == 0) {
+          probe_seconds =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - probes_start)
+                  .count();
+          // Analysed (and their frames written) on a thread of its own, in the time the
+          // workers leave, rather than after the renders: the reference's subpixel renders
+          // and the image library's loading (~0.2 s, for frame.exr and color.png) would
+          // otherwise end every run.
+          variants_done = std::async(std::launch::async, [&, probe_seconds] {
+            // At the lowest priority: it is needed only for the report, and at normal
+            // priority it took time from the workers (gen200 x llvmpipe 1.25 -> 1.18 s).
+            ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), kBackgroundNice);
+            return analyseVariants(probes, probe_outcomes, probe_seconds);
+          });
+        }
+        return;
+      }
+      // A worker that judged the fixture bad input (a file changed since it was checked)
+      // ends the run as bad input does before rendering: exit 2, nothing written.
+      if (outcome.input_error && input_failure.empty()) input_failure = outcome.error;
+      const auto [f, spec] = ticket_of.at(ticket);
+      got[f][spec] = std::move(outcome);
+      if (--left[f] == 0) {
+        comparer.push(f);
+        ++done;
+      }
+    };
+    for (auto& [ticket, outcome] : early) take(ticket, outcome);
+    early.clear();
+    while (pool->outstanding() > 0) {
       // Frames wait in memory until compared: do not render far ahead of the comparator.
       const bool start_more = comparer.backlog() < 2 * static_cast<std::size_t>(parallel) + 2;
-      for (auto& [ticket, outcome] : pool.poll(start_more ? 200 : 20, start_more)) {
-        if (const auto it = std::find(probe_tickets.begin(), probe_tickets.end(), ticket);
-            it != probe_tickets.end()) {
-          probe_outcomes[static_cast<std::size_t>(it - probe_tickets.begin())] = std::move(outcome);
-          if (--probes_left == 0) {
-            probe_seconds =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - probes_start)
-                    .count();
-            // Analysed (and their frames written) beside the renders rather than after
-            // them: the reference's subpixel renders and the image library's loading
-            // (~0.2 s, for frame.exr and color.png) would otherwise end every run.
-            variants_done = std::async(std::launch::async, [&, probe_seconds] {
-              return analyseVariants(probes, probe_outcomes, probe_seconds);
-            });
-          }
-          continue;
-        }
-        // A worker that judged the fixture bad input (a file changed since it was checked)
-        // ends the run as bad input does before rendering: exit 2, nothing written.
-        if (outcome.input_error && input_failure.empty()) input_failure = outcome.error;
-        const auto [f, spec] = ticket_of.at(ticket);
-        got[f][spec] = std::move(outcome);
-        if (--left[f] == 0) {
-          comparer.push(f);
-          ++done;
-        }
-      }
+      for (auto& [ticket, outcome] : pool->poll(start_more ? 200 : 20, start_more))
+        take(ticket, outcome);
       if (comparer.failed() || !input_failure.empty()) break;
       while (first_open < fixtures.size() && left[first_open] == 0) ++first_open;
       if (first_open < fixtures.size())
@@ -607,7 +658,7 @@ int runCommand(const RunArgs& args) {
       for (int k = 1; k <= retries; ++k) {
         RenderRequest request{fixtures[pairs[i].fixture].file, backends[pairs[i].backend].text};
         request.fresh = true;
-        retry_of[pool.submit(request)] = {i, k};
+        retry_of[pool->submit(request)] = {i, k};
       }
     }
     auto judgeRetry = [&](std::size_t i, int k, const RenderOutcome& o) {
@@ -646,8 +697,8 @@ int runCommand(const RunArgs& args) {
       }
       r.attempts.push_back(std::move(attempt));
     };
-    while (pool.outstanding() > 0) {
-      for (auto& [ticket, outcome] : pool.poll(200)) {
+    while (pool->outstanding() > 0) {
+      for (auto& [ticket, outcome] : pool->poll(200)) {
         const auto it = retry_of.find(ticket);
         if (it != retry_of.end()) judgeRetry(it->second.first, it->second.second, outcome);
       }
@@ -667,6 +718,7 @@ int runCommand(const RunArgs& args) {
                             ? variants_done.get()
                             : analyseVariants(probes, probe_outcomes, probe_seconds);
   }
+  pool.reset();  // the workers end before the report is put in place
   for (std::optional<PairResult>& r : results) report.results.push_back(std::move(*r));
   report.skipped = std::move(skipped);
   applyExpectations(known, report);

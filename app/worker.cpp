@@ -51,11 +51,22 @@ bool reply(ReplyKind kind, std::uint64_t id, const std::string& payload) {
 
 namespace rc {
 
+namespace {
+constexpr int kReferenceNice = 5;
+}  // namespace
+
 // Serves requests until stdin ends: exit 0, or 3 when the reply pipe broke. A fixture or
 // render that fails is a reply, not an exit.
 int workerCommand(const std::string& spec) {
   using namespace worker;
   const BackendSpec backend = parseBackendSpec(spec);
+  // The reference's worker yields to the GL workers: in every run measured the reference had
+  // the least work (gen200: 6 ms a render against llvmpipe's 7, softpipe's 26 and zink's 28),
+  // so the drivers' workers are the run's critical path and the reference fills the time
+  // they leave. Niceness only orders the workers when the cores are short; nice 5 still gives
+  // it a quarter of a core against a busy one (the watchdog's --timeout stays far off).
+  // gen200 x llvmpipe: 1.19 -> 1.10 s a run (docs/performance.md).
+  if (backend.kind == BackendSpec::Kind::Reference) (void)::nice(kReferenceNice);
   keepFreedMemory();  // one fixture's frames after another (fixtures/big_buffer.h)
   std::string line;
   while (std::getline(std::cin, line)) {

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <random>
 #include <sstream>
@@ -129,6 +130,65 @@ TEST(GlWorkers, ACrashingDriverCostsOneRowAndTheRunGoesOn) {
     }
   }
   EXPECT_EQ(errors, 2);
+  fs::remove_all(dir);
+}
+
+// `run` starts its GL workers on the variant probes while it checks the fixtures; a bad
+// fixture still ends the run with exit 2, one line, no report folder, and no worker left
+// behind, even one stuck in a render (hang_once: the first render of each fixture hangs,
+// after leaving a marker in TMPDIR). The check cannot end before a worker has begun to draw:
+// its mesh importer (RASTERCHECK_MESH_IMPORTER) is a script that waits for that marker,
+// then fails, which refuses the fixture naming the mesh.
+TEST(GlWorkers, ABadFixtureEndsTheRunWhileTheWorkersDrawTheProbes) {
+  const fs::path dir = scratch("bad_beside_probes");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  const fs::path inputs = dir / "inputs";
+  fs::create_directories(inputs);
+  fs::copy_file(catalog("coverage/triangle_fan.json"), inputs / "a.json");
+  std::ofstream(inputs / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(inputs / "b.json") << R"({"format": "rastercheck-scene/1",
+    "image": {"width": 8, "height": 8}, "camera": {"eye": [0, 0, 5]},
+    "objects": [{"mesh": {"file": "tri.obj"}}]})";
+  const fs::path tmp = dir / "tmp";
+  fs::create_directories(tmp);
+  const fs::path importer = dir / "importer.sh";
+  std::ofstream(importer) << "#!/bin/sh\n"
+                             "for i in $(seq 600); do\n"
+                             "  ls \"$TMPDIR\" | grep -q rastercheck-hang-once && exit 1\n"
+                             "  sleep 0.1\n"
+                             "done\n"
+                             "exit 1\n";
+  fs::permissions(importer, fs::perms::owner_all);
+  const auto start = std::chrono::steady_clock::now();
+  const Result r =
+      run("run " + inputs.string() + " --backends gl:egl:llvmpipe,gl:egl:softpipe --out " +
+              (dir / "out").string(),
+          "TMPDIR=" + tmp.string() + " RASTERCHECK_GL_FAULT=hang_once=* " +
+              "RASTERCHECK_MESH_IMPORTER=" + importer.string());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  EXPECT_NE(r.out.find("the mesh importer failed"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir)) left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"importer.sh", "inputs", "probe", "tmp"}));
+  bool drew = false;  // a worker began a render before the check ended
+  for (const auto& e : fs::directory_iterator(tmp))
+    drew = drew || e.path().filename().string().rfind("rastercheck-hang-once-", 0) == 0;
+  EXPECT_TRUE(drew);
+  EXPECT_LT(seconds, 50.0) << "the run waited for a stuck worker";
+  // No process of the run is left: none has this test's TMPDIR in its environment.
+  const std::string mine = "TMPDIR=" + tmp.string();
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    std::ifstream env(e.path() / "environ", std::ios::binary);
+    const std::string text{std::istreambuf_iterator<char>(env), {}};
+    std::size_t at = 0;
+    for (std::size_t end; (end = text.find('\0', at)) != std::string::npos; at = end + 1)
+      EXPECT_NE(text.substr(at, end - at), mine) << e.path();
+  }
   fs::remove_all(dir);
 }
 
