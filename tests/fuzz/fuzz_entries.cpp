@@ -17,6 +17,7 @@
 #include "fixtures/mesh_import.h"
 #include "fixtures/message_text.h"
 #include "fixtures/resource_estimate.h"
+#include "fixtures/shared_cache.h"
 #include "fixtures/texture_io.h"
 
 namespace rc::fuzz {
@@ -32,6 +33,11 @@ const fs::path& scratch() {
   }();
   return dir;
 }
+
+// Every texture decoded for real, every time: the user cache (fixtures/shared_cache.h) would
+// serve the images of tests/fixtures/data after their first decode, and the decoder's
+// coverage with them. Set before any entry runs, in the fuzzers and their regression test.
+const bool kUserCacheOff = ::setenv(kUserCacheDisableEnv, "1", 1) == 0;
 
 }  // namespace
 
