@@ -8,7 +8,9 @@
 #include <exception>
 #include <functional>
 #include <future>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -16,6 +18,7 @@
 #include "fixtures/errors.h"
 #include "fixtures/frame_io.h"
 #include "fixtures/image_io.h"
+#include "fixtures/shared_cache.h"
 
 namespace rc {
 namespace fs = std::filesystem;
@@ -291,7 +294,25 @@ std::vector<Rgb8> colorStops(int count, const char* map) {
   count = std::max(count, 2);
   std::vector<float> ramp(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) ramp[i] = static_cast<float>(i) / static_cast<float>(count - 1);
-  const std::vector<float> rgb = image_io::functions().color_map(ramp, map);
+  // OpenImageIO's map, kept in the user cache (fixtures/shared_cache.h) under the image
+  // module that made it: report.html's legend would otherwise load the image library at the
+  // end of every run.
+  const std::filesystem::path user = userCacheDir();
+  const std::string key =
+      fmt::format("rastercheck color map 1|{}|{}|{}", image_io::moduleIdentity(), map, count);
+  std::vector<float> rgb;
+  if (const std::optional<std::string> bytes =
+          user.empty() ? std::nullopt : readSharedEntry(user, key, "rcmap");
+      bytes && bytes->size() == ramp.size() * 3 * sizeof(float)) {
+    rgb.resize(ramp.size() * 3);
+    std::memcpy(rgb.data(), bytes->data(), bytes->size());
+  } else {
+    rgb = image_io::functions().color_map(ramp, map);
+    if (!user.empty() && rgb.size() == ramp.size() * 3)
+      writeSharedEntry(
+          user, key, "rcmap",
+          std::string_view(reinterpret_cast<const char*>(rgb.data()), rgb.size() * sizeof(float)));
+  }
   std::vector<Rgb8> stops(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i)
     for (int c = 0; c < 3; ++c)

@@ -247,14 +247,23 @@ TEST(CliScale, OnlyCommandsThatTouchImagesLoadOpenImageIO) {
   EXPECT_EQ(list.out.find("libOpenImageIO"), std::string::npos) << "list loaded OpenImageIO";
   EXPECT_EQ(list.out.find("libassimp"), std::string::npos) << "list loaded Assimp";
   const fs::path out = scratch("image_io");
-  const Result render = run("render " + catalog("zbuffer/interpenetrating_ab.json") +
-                                " --backend ref --out " + out.string(),
-                            "LD_DEBUG=libs");
+  const std::string render_args =
+      "render " + catalog("zbuffer/interpenetrating_ab.json") + " --backend ref --out ";
+  // The frame files are encoded here (a private user cache, empty: fixtures/shared_cache.h).
+  const std::string cache = "RASTERCHECK_CACHE_DIR=" + (out / "cache").string();
+  const Result render = run(render_args + (out / "a").string(), cache + " LD_DEBUG=libs");
   EXPECT_EQ(render.code, 0) << render.out;
   EXPECT_NE(render.out.find("rastercheck-image-io.so"), std::string::npos) << render.out;
   EXPECT_NE(render.out.find("libOpenImageIO"), std::string::npos) << render.out;
-  EXPECT_TRUE(fs::is_regular_file(out / "frame.exr"));
-  EXPECT_TRUE(fs::is_regular_file(out / "color.png"));
+  EXPECT_TRUE(fs::is_regular_file(out / "a" / "frame.exr"));
+  EXPECT_TRUE(fs::is_regular_file(out / "a" / "color.png"));
+  // The same frame again: its files come from the user cache, the same bytes, and nothing
+  // loads the image library.
+  const Result again = run(render_args + (out / "b").string(), cache + " LD_DEBUG=libs");
+  EXPECT_EQ(again.code, 0) << again.out;
+  EXPECT_EQ(again.out.find("libOpenImageIO"), std::string::npos) << "loaded OpenImageIO again";
+  for (const char* name : {"frame.exr", "color.png"})
+    EXPECT_EQ(readFile(out / "a" / name), readFile(out / "b" / name)) << name;
   fs::remove_all(out);
 }
 

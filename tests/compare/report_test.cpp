@@ -6,9 +6,12 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
@@ -456,6 +459,41 @@ TEST(ReportText, DescribeNamesTheFailingClassAndItsNumbers) {
   EXPECT_EQ(text.find("visibility"), std::string::npos) << text;  // passing classes stay out
   EXPECT_EQ(describe(compareFrames(ref, ref, ref, tolerancesForFrames(ref, ref))),
             "PASS synthetic/rects ref vs ref");
+}
+
+// The heat legend's colour map is kept in the user cache (fixtures/shared_cache.h), so that
+// report.html of a run that wrote no image loads no image library: the stops are
+// OpenImageIO's, an entry changed on disk is what a later call gets, and without the cache
+// the map is OpenImageIO's again.
+TEST(ColorStops, TheUserCacheKeepsOpenImageIOsMap) {
+  const std::filesystem::path user =
+      std::filesystem::temp_directory_path() / ("rc_color_stops_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(user);
+  ::setenv("RASTERCHECK_CACHE_DISABLE", "1", 1);
+  const std::vector<Rgb8> plain = colorStops(9, kHeatColorMap);
+  ::unsetenv("RASTERCHECK_CACHE_DISABLE");
+  ::setenv("RASTERCHECK_CACHE_DIR", user.c_str(), 1);
+  EXPECT_EQ(colorStops(9, kHeatColorMap), plain);
+  std::vector<std::filesystem::path> entries;
+  for (const auto& e : std::filesystem::directory_iterator(user)) entries.push_back(e.path());
+  ASSERT_EQ(entries.size(), 1u);
+  EXPECT_EQ(entries[0].extension(), ".rcmap");
+  {
+    std::fstream f(entries[0], std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(-4, std::ios::end);  // the last stop's blue, a float
+    const float zero = 0.0f;
+    f.write(reinterpret_cast<const char*>(&zero), sizeof zero);
+  }
+  const std::vector<Rgb8> cached = colorStops(9, kHeatColorMap);
+  ASSERT_EQ(cached.size(), plain.size());
+  EXPECT_EQ(cached.back()[2], 0);
+  EXPECT_NE(plain.back()[2], 0);
+  EXPECT_EQ(colorStops(5, kHeatColorMap).size(), 5u);  // another count: another entry
+  ::setenv("RASTERCHECK_CACHE_DISABLE", "1", 1);
+  EXPECT_EQ(colorStops(9, kHeatColorMap), plain);
+  ::unsetenv("RASTERCHECK_CACHE_DISABLE");
+  ::unsetenv("RASTERCHECK_CACHE_DIR");
+  std::filesystem::remove_all(user);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <Imath/half.h>
 #include <OpenImageIO/imageio.h>
@@ -198,6 +199,56 @@ TEST(FrameIo, FilesAreByteIdenticalAndCarryNoTimeStamp) {
   EXPECT_EQ(in->spec().get_string_attribute("DateTime"), "");
   fs::remove_all(a);
   fs::remove_all(b);
+}
+
+// Encoded frames are kept in the user cache (fixtures/shared_cache.h) under their planes:
+// a later write of the same frame copies frame.exr and color.png from there (an entry
+// changed on disk shows), the files are the encoder's own bytes, and a frame that differs
+// in one uncertainty value is another key, encoded again.
+TEST(FrameIo, TheUserCacheServesAFrameEncodedBefore) {
+  const fs::path dir = tempDir("user_cache");
+  const fs::path user = dir / "user";
+  ::setenv("RASTERCHECK_CACHE_DIR", user.c_str(), 1);
+  const rc::Frame f = makeFrame(true);
+  rc::writeFrameDir(f, dir / "a");
+  auto entries = [&](const std::string& ext) {
+    std::vector<fs::path> out;
+    for (const auto& e : fs::directory_iterator(user))
+      if (e.path().extension() == ext) out.push_back(e.path());
+    return out;
+  };
+  const std::vector<fs::path> exr = entries(".rcexr");
+  ASSERT_EQ(exr.size(), 1u);
+  ASSERT_EQ(entries(".rcpng").size(), 1u);
+  ::setenv("RASTERCHECK_CACHE_DISABLE", "1", 1);
+  rc::writeFrameDir(f, dir / "plain");
+  ::unsetenv("RASTERCHECK_CACHE_DISABLE");
+  for (const char* name : {"frame.exr", "color.png"})
+    EXPECT_EQ(fileBytes(dir / "a" / name), fileBytes(dir / "plain" / name)) << name;
+
+  // Served from the entry: its last byte changed there is the file's last byte.
+  std::string entry = fileBytes(exr[0]);
+  const std::string original = entry;
+  entry.back() = static_cast<char>(entry.back() ^ 0x5a);
+  std::ofstream(exr[0], std::ios::binary | std::ios::trunc) << entry;
+  rc::writeFrameDir(f, dir / "b");
+  EXPECT_EQ(fileBytes(dir / "b" / "frame.exr").back(), entry.back());
+  EXPECT_EQ(fileBytes(dir / "b" / "color.png"), fileBytes(dir / "a" / "color.png"));
+  std::ofstream(exr[0], std::ios::binary | std::ios::trunc) << original;
+
+  // One uncertainty value more: another key, the encoder's bytes.
+  rc::Frame g = makeFrame(true);
+  g.normal_reach[3] += 1.0f;
+  rc::writeFrameDir(g, dir / "c");
+  EXPECT_EQ(entries(".rcexr").size(), 2u);
+  ::setenv("RASTERCHECK_CACHE_DISABLE", "1", 1);
+  rc::writeFrameDir(g, dir / "c_plain");
+  ::unsetenv("RASTERCHECK_CACHE_DISABLE");
+  EXPECT_EQ(fileBytes(dir / "c" / "frame.exr"), fileBytes(dir / "c_plain" / "frame.exr"));
+  EXPECT_NE(fileBytes(dir / "c" / "frame.exr"), fileBytes(dir / "a" / "frame.exr"));
+  EXPECT_EQ(rc::readFrameDir(dir / "c").normal_reach, g.normal_reach);
+  ::unsetenv("RASTERCHECK_CACHE_DIR");
+  fs::remove_all(dir);
 }
 
 TEST(FrameIo, EveryLosslessCompressionRoundTrips) {
