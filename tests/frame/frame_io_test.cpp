@@ -234,6 +234,11 @@ TEST(FrameIo, TheUserCacheServesAFrameEncodedBefore) {
   rc::writeFrameDir(f, dir / "b");
   EXPECT_EQ(fileBytes(dir / "b" / "frame.exr").back(), entry.back());
   EXPECT_EQ(fileBytes(dir / "b" / "color.png"), fileBytes(dir / "a" / "color.png"));
+  // An entry cut short is not served: the encoder's bytes again.
+  std::ofstream(exr[0], std::ios::binary | std::ios::trunc)
+      << original.substr(0, original.size() - 1);
+  rc::writeFrameDir(f, dir / "cut");
+  EXPECT_EQ(fileBytes(dir / "cut" / "frame.exr"), fileBytes(dir / "plain" / "frame.exr"));
   std::ofstream(exr[0], std::ios::binary | std::ios::trunc) << original;
 
   // One uncertainty value more: another key, the encoder's bytes.
