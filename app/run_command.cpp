@@ -305,7 +305,8 @@ int runCommand(const RunArgs& args) {
   };
   std::vector<Checked> checked;
   auto check = [&] {
-    files = findFixtures(inputs);
+    // Not the report folder (an earlier run's variant probes are scenes too).
+    files = findFixtures(inputs, {args.out});
     // The mesh files the fixtures name, imported in one importer process before the check
     // below asks for them one by one (prefetchMeshImports: an optimisation only).
     {

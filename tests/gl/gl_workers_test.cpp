@@ -192,6 +192,27 @@ TEST(GlWorkers, ABadFixtureEndsTheRunWhileTheWorkersDrawTheProbes) {
   fs::remove_all(dir);
 }
 
+// A report folder inside the input folder is output, not input: neither this run's staged
+// variant probes (written before the fixtures are found) nor an earlier run's are fixtures.
+TEST(GlWorkers, AReportFolderInsideTheInputsHoldsNoFixture) {
+  const fs::path dir = scratch("out_inside");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  const fs::path inputs = dir / "inputs";
+  fs::create_directories(inputs);
+  fs::copy_file(catalog("coverage/triangle_fan.json"), inputs / "a.json");
+  for (int k = 0; k < 2; ++k) {
+    const Result r = run("run " + inputs.string() + " --backends gl:egl:llvmpipe --out " +
+                         (inputs / "out").string());
+    EXPECT_EQ(r.code, 0) << r.out;
+    ASSERT_TRUE(fs::exists(inputs / "out" / "variants" / "probes"));
+    const json report = json::parse(std::ifstream(inputs / "out" / "report.json"));
+    std::vector<std::string> fixtures;
+    for (const json& row : report["results"]) fixtures.push_back(row["fixture"]);
+    EXPECT_EQ(fixtures, std::vector<std::string>{"coverage/triangle_fan"}) << "run " << k;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(GlWorkers, TheFaultsHangAndCrashARenderOnTheirOwn) {
   const fs::path dir = scratch("faults");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
