@@ -4,8 +4,9 @@
 // costs one row), compares every backend with --against as each fixture's frames arrive,
 // classifying with the reference's uncertainty channels, and writes one report. Frames
 // and pair images are written for pairs that do not pass (all with --keep-frames).
-// Everything the user gave is checked before the first render (exit 2, nothing written);
-// the outputs replace an earlier run's only once all of them are written. With
+// Everything the user gave is checked before the first fixture renders (exit 2, nothing
+// written; the GL workers draw the variant probes meanwhile); the outputs replace an
+// earlier run's only once all of them are written. With
 // --shard K/N it runs one deterministic part of the whole run (compare/shards.h).
 #include <sys/resource.h>
 #include <unistd.h>
@@ -215,7 +216,7 @@ std::vector<FixtureEntry> selectCaselist(const fs::path& caselist,
 }
 
 // The niceness of work done beside the renders that only the report needs.
-constexpr int kBackgroundNice = 19;
+constexpr int kBackgroundNice = 10;
 
 // A render's time as its frame.json says (time_ms), in seconds; 0 when it does not.
 double renderSeconds(const RenderOutcome& o) {
@@ -281,11 +282,13 @@ int runCommand(const RunArgs& args) {
   std::optional<WorkerPool> pool;
   pool.emplace(WorkerPool::Options{parallel, args.timeout_seconds, folder.staging() / "workers"});
   // Which legal variant each GL backend follows, probed once per backend for the run: every
-  // backend the run names (those left without pairs, by --skips or --shard, are rendered but
-  // not analysed).
+  // backend the run names. With --skips or --shard a backend may be left without pairs (its
+  // driver perhaps broken or hanging): the probes then wait for the fixture check, and go to
+  // the backends that render, as the fixtures do.
   VariantProbes probes;
   std::vector<std::size_t> probe_tickets;
-  if (args.variants) {
+  const bool early_probes = args.variants && args.skips.empty() && !sharded;
+  if (early_probes) {
     std::vector<std::string> named = {against.text};
     if (needs_ref && against.text != "ref") named.emplace_back("ref");
     for (const BackendSpec& b : backends)
@@ -293,7 +296,7 @@ int runCommand(const RunArgs& args) {
     probes = prepareVariantProbes(named, folder.staging() / "variants");
     for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool->submit(r));
   }
-  const auto probes_start = std::chrono::steady_clock::now();
+  auto probes_start = std::chrono::steady_clock::now();
 
   // Loaded `parallel` at a time (a mesh file's import is a child process of its own, and a
   // catalog's images and meshes are read one after another otherwise); the first fixture in
@@ -339,12 +342,16 @@ int runCommand(const RunArgs& args) {
     validate();
     for (std::thread& t : helpers) t.join();
   };
-  // The probes' outcomes that come in meanwhile, taken up with the renders' below.
-  std::vector<std::pair<std::size_t, RenderOutcome>> early;
+  // The probes' outcomes that come in meanwhile (with when), taken up with the renders'.
+  struct Early {
+    std::size_t ticket;
+    RenderOutcome outcome;
+    std::chrono::steady_clock::time_point at;
+  };
+  std::vector<Early> early;
   if (probe_tickets.empty()) {
     check();
   } else {
-    pool->poll(0);  // starts the workers on the probes
     std::atomic<bool> checked_all{false};
     std::exception_ptr check_error;
     std::thread checker([&] {
@@ -355,8 +362,15 @@ int runCommand(const RunArgs& args) {
       }
       checked_all = true;
     });
-    while (!checked_all)
-      for (auto& outcome : pool->poll(5)) early.push_back(std::move(outcome));
+    try {
+      // The first poll starts the workers on the probes.
+      for (bool first = true; first || !checked_all; first = false)
+        for (auto& [ticket, outcome] : pool->poll(first ? 0 : 5))
+          early.push_back({ticket, std::move(outcome), std::chrono::steady_clock::now()});
+    } catch (...) {
+      checker.join();  // a worker that cannot start: ends the run once the check is done
+      throw;
+    }
     checker.join();
     if (check_error) std::rethrow_exception(check_error);
   }
@@ -464,6 +478,11 @@ int runCommand(const RunArgs& args) {
     std::erase_if(probes.gl_specs, [&](const std::string& s) {
       return std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end();
     });
+    if (args.variants && !early_probes) {  // first in the queue, so the workers start on them
+      probes = prepareVariantProbes(render_specs, folder.staging() / "variants");
+      for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool->submit(r));
+      probes_start = std::chrono::steady_clock::now();
+    }
     std::vector<RenderOutcome> probe_outcomes(probe_tickets.size());
     std::size_t probes_left = probe_tickets.size();
     double probe_seconds = 0.0;
@@ -603,21 +622,23 @@ int runCommand(const RunArgs& args) {
     std::string input_failure;
     const auto to_render = static_cast<std::size_t>(
         std::count_if(left.begin(), left.end(), [](std::size_t n) { return n > 0; }));
-    auto take = [&](std::size_t ticket, RenderOutcome& outcome) {
+    // `at`: when it arrived (a probe that came in during the check is timed then).
+    auto take = [&](std::size_t ticket, RenderOutcome& outcome,
+                    std::chrono::steady_clock::time_point at) {
       if (const auto it = std::find(probe_tickets.begin(), probe_tickets.end(), ticket);
           it != probe_tickets.end()) {
         probe_outcomes[static_cast<std::size_t>(it - probe_tickets.begin())] = std::move(outcome);
         if (--probes_left == 0) {
-          probe_seconds =
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - probes_start)
-                  .count();
+          probe_seconds = std::chrono::duration<double>(at - probes_start).count();
           // Analysed (and their frames written) on a thread of its own, in the time the
           // workers leave, rather than after the renders: the reference's subpixel renders
           // and the image library's loading (~0.2 s, for frame.exr and color.png) would
           // otherwise end every run.
           variants_done = std::async(std::launch::async, [&, probe_seconds] {
-            // At the lowest priority: it is needed only for the report, and at normal
-            // priority it took time from the workers (gen200 x llvmpipe 1.25 -> 1.18 s).
+            // At a low priority: it is needed only for the report, and at normal priority
+            // it took time from the workers (at nice 19: gen200 x llvmpipe 1.25 -> 1.18 s).
+            // Not the lowest: on a busy machine the run waits for it at the end, and an
+            // image library it loads first starts its threads at its priority.
             ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), kBackgroundNice);
             return analyseVariants(probes, probe_outcomes, probe_seconds);
           });
@@ -634,13 +655,13 @@ int runCommand(const RunArgs& args) {
         ++done;
       }
     };
-    for (auto& [ticket, outcome] : early) take(ticket, outcome);
+    for (Early& e : early) take(e.ticket, e.outcome, e.at);
     early.clear();
     while (pool->outstanding() > 0) {
       // Frames wait in memory until compared: do not render far ahead of the comparator.
       const bool start_more = comparer.backlog() < 2 * static_cast<std::size_t>(parallel) + 2;
       for (auto& [ticket, outcome] : pool->poll(start_more ? 200 : 20, start_more))
-        take(ticket, outcome);
+        take(ticket, outcome, std::chrono::steady_clock::now());
       if (comparer.failed() || !input_failure.empty()) break;
       while (first_open < fixtures.size() && left[first_open] == 0) ++first_open;
       if (first_open < fixtures.size())
