@@ -287,16 +287,20 @@ int runCommand(const RunArgs& args) {
   // the backends that render, as the fixtures do.
   VariantProbes probes;
   std::vector<std::size_t> probe_tickets;
+  auto probes_start = std::chrono::steady_clock::now();
+  auto queueProbes = [&](const std::vector<std::string>& specs) {
+    probes = prepareVariantProbes(specs, folder.staging() / "variants");
+    for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool->submit(r));
+    probes_start = std::chrono::steady_clock::now();
+  };
   const bool early_probes = args.variants && args.skips.empty() && !sharded;
   if (early_probes) {
     std::vector<std::string> named = {against.text};
     if (needs_ref && against.text != "ref") named.emplace_back("ref");
     for (const BackendSpec& b : backends)
       if (std::find(named.begin(), named.end(), b.text) == named.end()) named.push_back(b.text);
-    probes = prepareVariantProbes(named, folder.staging() / "variants");
-    for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool->submit(r));
+    queueProbes(named);
   }
-  auto probes_start = std::chrono::steady_clock::now();
 
   // Loaded `parallel` at a time (a mesh file's import is a child process of its own, and a
   // catalog's images and meshes are read one after another otherwise); the first fixture in
@@ -475,13 +479,12 @@ int runCommand(const RunArgs& args) {
       for (const std::string& s : n)
         if (std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end())
           render_specs.push_back(s);
-    std::erase_if(probes.gl_specs, [&](const std::string& s) {
-      return std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end();
-    });
-    if (args.variants && !early_probes) {  // first in the queue, so the workers start on them
-      probes = prepareVariantProbes(render_specs, folder.staging() / "variants");
-      for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool->submit(r));
-      probes_start = std::chrono::steady_clock::now();
+    if (early_probes) {
+      std::erase_if(probes.gl_specs, [&](const std::string& s) {
+        return std::find(render_specs.begin(), render_specs.end(), s) == render_specs.end();
+      });
+    } else if (args.variants) {
+      queueProbes(render_specs);  // first in the queue, so the workers start on them
     }
     std::vector<RenderOutcome> probe_outcomes(probe_tickets.size());
     std::size_t probes_left = probe_tickets.size();

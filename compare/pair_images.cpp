@@ -209,15 +209,8 @@ class FrameHash {
   // The buffer's bytes, eight at a time, the rest one by one.
   template <class T>
   void bytes(const std::vector<T>& v) {
-    const std::size_t n = v.size() * sizeof(T);
-    const auto* p = reinterpret_cast<const unsigned char*>(v.data());
-    std::size_t k = 0;
-    for (; k + 8 <= n; k += 8) {
-      std::uint64_t w;
-      std::memcpy(&w, p + k, 8);
-      word(w);
-    }
-    for (; k < n; ++k) word(p[k]);
+    h_ = fnv1aWords(std::string_view(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T)),
+                    h_);
   }
   // A plane: its length, then its bytes (an empty plane still counts).
   template <class T>
@@ -228,7 +221,7 @@ class FrameHash {
   std::string hex() const { return fmt::format("{:016x}", h_); }
 
  private:
-  std::uint64_t h_ = 0xcbf29ce484222325ull;
+  std::uint64_t h_ = kFnv1aOffset;
 };
 
 }  // namespace
@@ -290,6 +283,9 @@ float heatPosition(float value, double scale) {
   return static_cast<float>(std::clamp(t, 0.0, 1.0));
 }
 
+// The colour maps kept in the user cache: a few hundred bytes each.
+constexpr std::uintmax_t kUserColorMapCacheBytes = std::uintmax_t{1} << 20;
+
 std::vector<Rgb8> colorStops(int count, const char* map) {
   count = std::max(count, 2);
   std::vector<float> ramp(static_cast<std::size_t>(count));
@@ -309,9 +305,10 @@ std::vector<Rgb8> colorStops(int count, const char* map) {
   } else {
     rgb = image_io::functions().color_map(ramp, map);
     if (!user.empty() && rgb.size() == ramp.size() * 3)
-      writeSharedEntry(
+      writeUserEntry(
           user, key, "rcmap",
-          std::string_view(reinterpret_cast<const char*>(rgb.data()), rgb.size() * sizeof(float)));
+          std::string_view(reinterpret_cast<const char*>(rgb.data()), rgb.size() * sizeof(float)),
+          kUserColorMapCacheBytes);
   }
   std::vector<Rgb8> stops(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i)

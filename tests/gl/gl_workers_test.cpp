@@ -133,6 +133,14 @@ TEST(GlWorkers, ACrashingDriverCostsOneRowAndTheRunGoesOn) {
   fs::remove_all(dir);
 }
 
+// DIR/inputs holding one fixture llvmpipe renders within tolerance, as a.json.
+fs::path inputsWithTheFan(const fs::path& dir) {
+  fs::path inputs = dir / "inputs";
+  fs::create_directories(inputs);
+  fs::copy_file(catalog("coverage/triangle_fan.json"), inputs / "a.json");
+  return inputs;
+}
+
 // `run` starts its GL workers on the variant probes while it checks the fixtures; a bad
 // fixture still ends the run with exit 2, one line, no report folder, and no worker left
 // behind, even one stuck in a render (hang_once: the first render of each fixture hangs,
@@ -142,9 +150,7 @@ TEST(GlWorkers, ACrashingDriverCostsOneRowAndTheRunGoesOn) {
 TEST(GlWorkers, ABadFixtureEndsTheRunWhileTheWorkersDrawTheProbes) {
   const fs::path dir = scratch("bad_beside_probes");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
-  const fs::path inputs = dir / "inputs";
-  fs::create_directories(inputs);
-  fs::copy_file(catalog("coverage/triangle_fan.json"), inputs / "a.json");
+  const fs::path inputs = inputsWithTheFan(dir);
   std::ofstream(inputs / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
   std::ofstream(inputs / "b.json") << R"({"format": "rastercheck-scene/1",
     "image": {"width": 8, "height": 8}, "camera": {"eye": [0, 0, 5]},
@@ -197,9 +203,7 @@ TEST(GlWorkers, ABadFixtureEndsTheRunWhileTheWorkersDrawTheProbes) {
 TEST(GlWorkers, AReportFolderInsideTheInputsHoldsNoFixture) {
   const fs::path dir = scratch("out_inside");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
-  const fs::path inputs = dir / "inputs";
-  fs::create_directories(inputs);
-  fs::copy_file(catalog("coverage/triangle_fan.json"), inputs / "a.json");
+  const fs::path inputs = inputsWithTheFan(dir);
   for (int k = 0; k < 2; ++k) {
     const Result r = run("run " + inputs.string() + " --backends gl:egl:llvmpipe --out " +
                          (inputs / "out").string());
