@@ -88,28 +88,33 @@ class Progress {
   std::size_t width_ = 0;
 };
 
-// Comparison threads: a fixture is compared as soon as all its frames are in, beside the
-// rendering, so that the workers never wait for the comparator.
-class CompareQueue {
+// Threads that take tasks in order: the comparison threads (a fixture is compared as soon as
+// all its frames are in, beside the rendering, so that the workers never wait for the
+// comparator) and the thread that writes what a comparison keeps (frames and pair images:
+// the image library's first load, ~0.2 s, and the encoding no longer hold up the
+// comparisons behind it, and through them the workers).
+class TaskQueue {
  public:
-  CompareQueue(int threads, std::function<void(std::size_t)> work) : work_(std::move(work)) {
+  explicit TaskQueue(int threads) {
     for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { loop(); });
   }
+  TaskQueue(const TaskQueue&) = delete;
+  TaskQueue& operator=(const TaskQueue&) = delete;
   // Only reached without finish() when the run is already failing: that failure wins.
-  ~CompareQueue() {
+  ~TaskQueue() {
     try {
       finish();
     } catch (...) {  // NOLINT(bugprone-empty-catch)
     }
   }
-  void push(std::size_t fixture) {
+  void push(std::function<void()> task) {
     {
       const std::lock_guard lock(mutex_);
-      queue_.push_back(fixture);
+      queue_.push_back(std::move(task));
     }
     ready_.notify_one();
   }
-  // Fixtures queued or being compared.
+  // Tasks queued or running.
   std::size_t backlog() {
     const std::lock_guard lock(mutex_);
     return queue_.size() + active_;
@@ -133,17 +138,17 @@ class CompareQueue {
  private:
   void loop() {
     for (;;) {
-      std::size_t fixture = 0;
+      std::function<void()> task;
       {
         std::unique_lock lock(mutex_);
         ready_.wait(lock, [&] { return closing_ || !queue_.empty(); });
         if (queue_.empty() || failure_) return;
-        fixture = queue_.front();
+        task = std::move(queue_.front());
         queue_.pop_front();
         ++active_;
       }
       try {
-        work_(fixture);
+        task();
       } catch (...) {
         const std::lock_guard lock(mutex_);
         if (!failure_) failure_ = std::current_exception();
@@ -153,10 +158,9 @@ class CompareQueue {
     }
   }
 
-  std::function<void(std::size_t)> work_;
   std::mutex mutex_;
   std::condition_variable ready_;
-  std::deque<std::size_t> queue_;
+  std::deque<std::function<void()>> queue_;
   std::size_t active_ = 0;
   bool closing_ = false;
   std::exception_ptr failure_;
@@ -507,33 +511,49 @@ int runCommand(const RunArgs& args) {
       return runnerSuccess(
           withBaseline(now, it == runner.baseline.expected.end() ? std::string() : it->second));
     };
-    // Compares one pair and writes its images when it does not pass (always with
-    // --keep-frames); `pictures` keeps the frames the images show and names their color.png.
-    // The tolerances were checked up front; an InputError from here on (a fixture changed
-    // under us) ends the run with exit 2 and no report.
-    auto compareAndWrite = [&](const FixtureEntry& fx, const Frame& expected, const Frame& actual,
-                               const Frame& uncertainty,
-                               const std::function<PairPictures()>& pictures) {
-      const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
+    // Compares one pair. One that does not pass (any, with --keep-frames) gets its images:
+    // their folder is taken here, in comparison order, and result.images names them; the
+    // caller writes them (writePairImages with `maps`). The tolerances were checked up front;
+    // an InputError from here on (a fixture changed under us) ends the run with exit 2 and no
+    // report.
+    struct Compared {
+      PairResult result;
       ClassMaps maps;
-      maps.want_flip = args.flip;  // --flip-threshold asks through tol as well
-      PairResult r = compareNamed(expected, actual, uncertainty, tol, &maps);
-      if (args.keep_frames || r.status != Status::Pass)
-        writePairImages(expected, actual, maps, folder.pairDirectory(r), r, pictures());
-      return r;
+      fs::path images;  // the pair's folder, when it gets images
     };
+    auto comparePairOf = [&](const FixtureEntry& fx, const Frame& expected, const Frame& actual,
+                             const Frame& uncertainty) {
+      const Tolerances tol = pairTolerances(expected, actual, fx.tolerance, cli);
+      Compared c;
+      c.maps.want_flip = args.flip;  // --flip-threshold asks through tol as well
+      c.result = compareNamed(expected, actual, uncertainty, tol, &c.maps);
+      if (args.keep_frames || c.result.status != Status::Pass) {
+        c.images = folder.pairDirectory(c.result);
+        c.result.images = pairImageNames(c.images, true, c.maps);
+      }
+      return c;
+    };
+    // What a comparison keeps is written on the writer thread, after it, in order.
+    TaskQueue writer(1);
     auto compareFixture = [&](std::size_t f) {
       const FixtureEntry& fx = fixtures[f];
-      std::map<std::string, RenderOutcome>& outs = got[f];
+      // The fixture's frames, shared with the writes that need them.
+      const auto held =
+          std::make_shared<const std::map<std::string, RenderOutcome>>(std::move(got[f]));
+      got[f].clear();
+      const std::map<std::string, RenderOutcome>& outs = *held;
       const fs::path dir = frames_dir / fx.slug;
       std::set<std::string> kept;
+      std::vector<std::function<void()>> writes;
       // Frames (and what the worker printed) of the renders a non-passing pair shows.
       auto keepFrame = [&](const std::string& spec) -> fs::path {
         fs::path frame_dir = dir / fixtureSlug(spec);
         if (kept.insert(spec).second) {
-          const RenderOutcome& o = outs.at(spec);
-          if (o.ok) writeFrameDir(o.frame, frame_dir);
-          if (!o.log.empty()) writeText(fs::path(frame_dir) += ".log", o.log);
+          writes.emplace_back([held, spec, frame_dir] {
+            const RenderOutcome& o = held->at(spec);
+            if (o.ok) writeFrameDir(o.frame, frame_dir);
+            if (!o.log.empty()) writeText(fs::path(frame_dir) += ".log", o.log);
+          });
         }
         return frame_dir;
       };
@@ -586,12 +606,26 @@ int runCommand(const RunArgs& args) {
                                                expected.height));
               uncertainty = &ref;
             }
-            r = compareAndWrite(fx, expected, actual, *uncertainty, [&]() -> PairPictures {
-              const fs::path da = keepFrame(against.text);
-              const fs::path db = keepFrame(spec);
+            Compared c = comparePairOf(fx, expected, actual, *uncertainty);
+            if (!c.images.empty()) {
+              // The images show the frames compared, kept beside them (their color.png is
+              // the pictures' when the colours are the same).
+              fs::path da = keepFrame(against.text);
+              fs::path db = keepFrame(spec);
               if (use_ref) keepFrame("ref");
-              return {readyPicture(da, expected), readyPicture(db, actual)};
-            });
+              std::shared_ptr<const Frame> own_expected;
+              if (expected_frame == &resampled)
+                own_expected = std::make_shared<const Frame>(std::move(resampled));
+              writes.emplace_back([held, own_expected, against = against.text, spec,
+                                   maps = std::move(c.maps), pair_dir = c.images, r = c.result,
+                                   da = std::move(da), db = std::move(db)]() mutable {
+                const Frame& e = own_expected ? *own_expected : held->at(against).frame;
+                const Frame& drawn = held->at(spec).frame;
+                writePairImages(e, drawn, maps, pair_dir, r,
+                                {readyPicture(da, e), readyPicture(db, drawn)});
+              });
+            }
+            r = std::move(c.result);
           } catch (const BackendError& e) {
             r = errorResult(fx.name, against.text, spec, e.what());
           }
@@ -615,10 +649,14 @@ int runCommand(const RunArgs& args) {
         }
         results[static_cast<std::size_t>(p - pairs.data())] = std::move(r);
       }
-      outs.clear();  // the frames are done with
+      if (!writes.empty()) {
+        writer.push([writes = std::move(writes)] {
+          for (const std::function<void()>& w : writes) w();
+        });
+      }
     };
 
-    CompareQueue comparer(std::max(1, parallel / 2), compareFixture);
+    TaskQueue comparer(std::max(1, parallel / 2));
     Progress progress;
     std::size_t done = 0;
     std::size_t first_open = 0;
@@ -654,7 +692,7 @@ int runCommand(const RunArgs& args) {
       const auto [f, spec] = ticket_of.at(ticket);
       got[f][spec] = std::move(outcome);
       if (--left[f] == 0) {
-        comparer.push(f);
+        comparer.push([&compareFixture, f] { compareFixture(f); });
         ++done;
       }
     };
@@ -662,10 +700,11 @@ int runCommand(const RunArgs& args) {
     early.clear();
     while (pool->outstanding() > 0) {
       // Frames wait in memory until compared: do not render far ahead of the comparator.
-      const bool start_more = comparer.backlog() < 2 * static_cast<std::size_t>(parallel) + 2;
+      const bool start_more =
+          comparer.backlog() + writer.backlog() < 2 * static_cast<std::size_t>(parallel) + 2;
       for (auto& [ticket, outcome] : pool->poll(start_more ? 200 : 20, start_more))
         take(ticket, outcome, std::chrono::steady_clock::now());
-      if (comparer.failed() || !input_failure.empty()) break;
+      if (comparer.failed() || writer.failed() || !input_failure.empty()) break;
       while (first_open < fixtures.size() && left[first_open] == 0) ++first_open;
       if (first_open < fixtures.size())
         progress.show(
@@ -673,6 +712,7 @@ int runCommand(const RunArgs& args) {
     }
     progress.clear();
     comparer.finish();  // rethrows a comparison's InputError: exit 2, no report
+    writer.finish();    // the kept frames are on disk before any retry is judged
     if (!input_failure.empty()) throw InputError(input_failure);
 
     // --retries: each failing or erroring GL pair rendered again, every render in a worker
@@ -714,8 +754,9 @@ int runCommand(const RunArgs& args) {
         if (!expected.hasUncertainty() && fs::exists(dir / "ref"))
           ref_frame = readFrameDir(dir / "ref");
         const Frame& uncertainty = ref_frame.width > 0 ? ref_frame : expected;
-        PairResult compared =
-            compareAndWrite(fx, expected, o.frame, uncertainty, [] { return PairPictures{}; });
+        Compared c = comparePairOf(fx, expected, o.frame, uncertainty);
+        if (!c.images.empty()) writePairImages(expected, o.frame, c.maps, c.images, c.result);
+        PairResult compared = std::move(c.result);
         compared.attempts = std::move(r.attempts);
         compared.render_seconds = r.render_seconds;
         r = std::move(compared);

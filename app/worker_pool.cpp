@@ -182,7 +182,6 @@ bool WorkerPool::send(Worker& w, const Task& task) {
   w.busy = true;
   w.ticket = task.ticket;
   w.started = Clock::now();
-  w.reply.clear();
   w.filled = 0;
   ++busy_;
   return true;
@@ -199,11 +198,13 @@ std::size_t WorkerPool::workersFor(const std::string& spec) const {
     return 1;
   // The reference and softpipe draw on one thread: one more worker when other backends'
   // queued renders cannot fill the other busy slots, and what is queued for this one (its
-  // renders so far, on average) outweighs a worker's start (~0.2 s of loading). Measured on
-  // 200 small scenes: the reference's 1.8 ms renders are not worth a second worker,
-  // softpipe's 26 ms ones are when it renders alone; beside three other drivers a second
-  // softpipe worker made the run slower (6.6 s against 5.9 s).
-  constexpr double kQueuedWorkForAWorker = 0.5;  // seconds
+  // renders so far, on average) outweighs a worker's start: ~0.2 s of loading a GL driver,
+  // ~0.03 s for the reference (no driver). Measured on 200 small scenes: softpipe's 26 ms
+  // renders are worth a second worker when it renders alone; beside three other drivers a
+  // second softpipe worker made the run slower (6.6 s against 5.9 s). The reference, whose
+  // worker runs at a lower priority (worker.cpp), is often the last one drawing: with
+  // llvmpipe done, a second worker halves the tail it draws alone.
+  const double kQueuedWorkForAWorker = b.kind == BackendSpec::Kind::Reference ? 0.1 : 0.5;
   std::set<std::string> others;
   for (const auto& [key, q] : queues_)
     if (!q.empty() && key.first != spec) others.insert(key.first);
@@ -290,6 +291,10 @@ void WorkerPool::retire(Worker& w, const std::string& why,
   std::erase_if(workers_, [&](const std::unique_ptr<Worker>& p) { return p.get() == &w; });
 }
 
+// A reply buffer up to this size is kept for the worker's next reply (no allocation and
+// page faults per frame); a larger one is given back.
+constexpr std::size_t kKeptReplyBytes = std::size_t{16} << 20;
+
 void WorkerPool::readReply(Worker& w, std::vector<std::pair<std::size_t, RenderOutcome>>& done) {
   constexpr std::size_t kHeader = sizeof(worker::ReplyHeader);
   constexpr std::uint64_t kMaxPayload = std::uint64_t{1} << 36;
@@ -298,7 +303,7 @@ void WorkerPool::readReply(Worker& w, std::vector<std::pair<std::size_t, RenderO
     std::size_t want = kHeader;
     if (w.filled >= kHeader) {
       worker::ReplyHeader h{};
-      std::memcpy(&h, w.reply.data(), kHeader);
+      std::memcpy(&h, w.reply.get(), kHeader);
       if (std::memcmp(h.tag, worker::kReplyTag, sizeof h.tag) != 0 || !w.busy || h.id != w.ticket ||
           h.length > kMaxPayload) {
         retire(w, "sent a malformed reply", done, true);
@@ -307,7 +312,7 @@ void WorkerPool::readReply(Worker& w, std::vector<std::pair<std::size_t, RenderO
       want = kHeader + h.length;
       if (w.filled == want) {
         RenderOutcome out;
-        const std::string_view payload(w.reply.data() + kHeader, h.length);
+        const std::string_view payload(w.reply.get() + kHeader, h.length);
         out.log = logSince(w);
         if (h.kind == worker::ReplyKind::Frame) {
           try {
@@ -326,14 +331,22 @@ void WorkerPool::readReply(Worker& w, std::vector<std::pair<std::size_t, RenderO
         seconds += std::chrono::duration<double>(Clock::now() - w.started).count();
         w.busy = false;
         --busy_;
-        std::string().swap(w.reply);
+        if (w.reply_size > kKeptReplyBytes) {
+          w.reply.reset();
+          w.reply_size = 0;
+        }
         w.filled = 0;
         if (w.single_use) retire(w, "", done, true);  // its one render is done
         return;
       }
     }
-    if (w.reply.size() < want) w.reply.resize(want);
-    const ssize_t n = ::read(w.reply_fd, w.reply.data() + w.filled, want - w.filled);
+    if (w.reply_size < want) {
+      auto bigger = std::make_unique_for_overwrite<char[]>(want);
+      if (w.filled > 0) std::memcpy(bigger.get(), w.reply.get(), w.filled);
+      w.reply = std::move(bigger);
+      w.reply_size = want;
+    }
+    const ssize_t n = ::read(w.reply_fd, w.reply.get() + w.filled, want - w.filled);
     if (n > 0) {
       w.filled += static_cast<std::size_t>(n);
       continue;

@@ -91,7 +91,10 @@ class WorkerPool {
     std::size_t ticket = 0;
     Clock::time_point started;
     std::uintmax_t log_start = 0;
-    std::string reply;  // bytes read so far of the current reply
+    // The current reply's bytes read so far (`filled` of `reply_size`): not zeroed first,
+    // and kept for the next reply unless large.
+    std::unique_ptr<char[]> reply;
+    std::size_t reply_size = 0;
     std::size_t filled = 0;
   };
   struct Task {

@@ -47,6 +47,25 @@ bool storePng(int w, int h) {
   return static_cast<std::size_t>(w) * static_cast<std::size_t>(h) > kPngStoreAbove;
 }
 
+// Pair images in the user cache (shared_cache.h), as frames are (frame_io.cpp): a pair that
+// fails in the same way run after run (a known failure) writes its images without loading
+// the image library. Keyed by every input of the file and the image module; images of more
+// than kCachedPixels pixels are encoded every time (their hashing would cost more than the
+// cache saves for files that rarely repeat).
+constexpr std::size_t kCachedPixels = std::size_t{1} << 20;
+constexpr std::uintmax_t kUserPairImageCacheBytes = std::uintmax_t{64} << 20;
+
+// The user cache for an image of w x h pixels: empty for none.
+fs::path pairImageCache(int w, int h) {
+  if (static_cast<std::size_t>(w) * static_cast<std::size_t>(h) > kCachedPixels) return {};
+  return userCacheDir();
+}
+
+const std::string& imageModule() {
+  static const std::string module = image_io::moduleIdentity();
+  return module;
+}
+
 void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_t>& rgb,
                const fs::path& target) {
   ImageFormat format{.width = w, .height = h, .channels = 3, .type = PixelType::UInt8};
@@ -55,7 +74,14 @@ void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_
     format.numbers = {{"png:compressionLevel", store ? 0 : kPngCompressionLevel},
                       {"png:filter", store ? kPngFilterNone : kPngFilterSub}};
   }
-  image_io::writeImage(file, format, rgb.data(), target);
+  const fs::path user = pairImageCache(w, h);
+  const std::string key = user.empty()
+                              ? std::string()
+                              : fmt::format("rastercheck rgb8 1|{}|{}|{}x{}|{}|{}", imageModule(),
+                                            file.extension().string(), w, h, store, bytesKey(rgb));
+  writeThroughUserCache(
+      user, key, "rcpair", file, [&] { image_io::writeImage(file, format, rgb.data(), target); },
+      kUserPairImageCacheBytes);
 }
 
 // v >= 0 rounded to nearest, halves up, as std::lround: v - trunc(v) is exact in float
@@ -124,21 +150,11 @@ std::vector<std::uint8_t> heatImage(const ClassMaps& maps, const std::vector<flo
 
 // diff.exr: every float a tool might want, one channel each, written in bands of rows so
 // that the interleaved pixels never exist for the whole image.
-void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& maps,
-                  const PairResult& result, const fs::path& file, const fs::path& target) {
-  const int w = maps.width;
-  const int h = maps.height;
-  const std::vector<std::string> names = {
-      "id_class", "depth_steps", "depth_tolerance", "shading_abs", "shading_tolerance", "dR", "dG",
-      "dB",       "dA"};
-  const int nch = static_cast<int>(names.size());
-  ImageFormat format{
-      .width = w, .height = h, .channel_names = names, .channels = nch, .type = PixelType::Float};
-  format.text = {
-      {"compression",
-       static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo ? kDiffExrCompression : "none"},
-      {"rastercheck:fixture", result.fixture},
-      {"rastercheck:pair", result.expected + " vs " + result.actual}};
+void writeDiffExrRows(const Frame& expected, const Frame& actual, const ClassMaps& maps,
+                      const ImageFormat& format, const fs::path& file, const fs::path& target) {
+  const int w = format.width;
+  const int h = format.height;
+  const int nch = format.channels;
   const std::unique_ptr<image_io::RowWriter> out =
       image_io::functions().open_rows(file, format, target);
   constexpr int kBandRows = 32;  // a multiple of every EXR compression's block height
@@ -159,6 +175,45 @@ void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& m
     out->rows(y0, y1, band.data());
   }
   out->close();
+}
+
+// diff.exr, from the user cache when it was written before.
+void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& maps,
+                  const PairResult& result, const fs::path& file, const fs::path& target) {
+  const int w = maps.width;
+  const int h = maps.height;
+  const std::vector<std::string> names = {
+      "id_class", "depth_steps", "depth_tolerance", "shading_abs", "shading_tolerance", "dR", "dG",
+      "dB",       "dA"};
+  const int nch = static_cast<int>(names.size());
+  ImageFormat format{
+      .width = w, .height = h, .channel_names = names, .channels = nch, .type = PixelType::Float};
+  format.text = {
+      {"compression",
+       static_cast<std::size_t>(w) * h <= kDiffExrCompressUpTo ? kDiffExrCompression : "none"},
+      {"rastercheck:fixture", result.fixture},
+      {"rastercheck:pair", result.expected + " vs " + result.actual},
+      // No write time (OIIO stamps capDate otherwise): the same pair gives the same bytes,
+      // which the user cache relies on.
+      {"DateTime", ""}};
+  const fs::path user = pairImageCache(w, h);
+  std::string key;
+  if (!user.empty()) {
+    // The names with their lengths: no two pairs' texts run together into one key.
+    const std::string pair = result.expected + " vs " + result.actual;
+    key = fmt::format("rastercheck diff.exr 1|{}|{}x{}|{}|{}:{}|{}:{}|", imageModule(), w, h,
+                      format.text.at(0).second, result.fixture.size(), result.fixture, pair.size(),
+                      pair);
+    for (const std::string& part :
+         {bytesKey(maps.pixel_class), bytesKey(maps.depth_steps), bytesKey(maps.depth_tolerance),
+          bytesKey(maps.shading_abs), bytesKey(maps.shading_tolerance), bytesKey(expected.color),
+          bytesKey(actual.color)})
+      key += part + ',';
+  }
+  writeThroughUserCache(
+      user, key, "rcpair", file,
+      [&] { writeDiffExrRows(expected, actual, maps, format, file, target); },
+      kUserPairImageCacheBytes);
 }
 
 // Runs the writers concurrently (each file is independent and most time is deflate), and
@@ -391,13 +446,20 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
     writeRgb8(files.stage(flip_png), w, h, flipHeatRgb(maps.flip), flip_png);
 
   files.commit();
-  result.images = {{"expected", expected_png},
-                   {"actual", actual_png},
-                   {"visibility", visibility_png},
-                   {"depth_heat", depth_png},
-                   {"shading_heat", shading_png}};
-  if (with_diff_exr) result.images["diff_exr"] = diff_exr;
-  if (maps.flip.size() == n) result.images["flip_heat"] = flip_png;
+  result.images = pairImageNames(dir, with_diff_exr, maps);
+}
+
+std::map<std::string, fs::path> pairImageNames(const fs::path& dir, bool with_diff_exr,
+                                               const ClassMaps& maps) {
+  std::map<std::string, fs::path> names = {{"expected", dir / "expected.png"},
+                                           {"actual", dir / "actual.png"},
+                                           {"visibility", dir / "visibility.png"},
+                                           {"depth_heat", dir / "depth_heat.png"},
+                                           {"shading_heat", dir / "shading_heat.png"}};
+  if (with_diff_exr) names["diff_exr"] = dir / "diff.exr";
+  if (!maps.flip.empty() && maps.flip.size() == maps.pixel_class.size())
+    names["flip_heat"] = dir / "flip_heat.png";
+  return names;
 }
 
 fs::path pairDirectory(const fs::path& out_dir, const PairResult& result) {

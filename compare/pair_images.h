@@ -67,6 +67,11 @@ void writePairImages(const Frame& expected, const Frame& actual, const ClassMaps
                      const std::filesystem::path& dir, PairResult& result,
                      const PairPictures& pictures = {}, bool with_diff_exr = true);
 
+// The files writePairImages writes into `dir` for these maps, by role (PairResult::images).
+std::map<std::string, std::filesystem::path> pairImageNames(const std::filesystem::path& dir,
+                                                            bool with_diff_exr,
+                                                            const ClassMaps& maps);
+
 // The values at the top of the two heat maps' colour scales (what writePairImages sets):
 // max(largest error, fail threshold, 1) for depth steps and shading units.
 void setHeatScales(PairResult& result);

@@ -88,12 +88,38 @@ TEST(FrameStream, RoundTripsMultisampledFrames) {
   }
 }
 
+// A plane whose elements are all the same is sent as one element: it comes back whole, bit
+// for bit (a NaN, a negative zero, +inf), and a plane that differs in its last element only
+// is not taken for one.
+TEST(FrameStream, ConstantPlanesTravelAsOneElementAndComeBackWhole) {
+  Frame in = sample(true);
+  const std::size_t n = in.pixelCount();
+  const auto channels = in.uncertainty();
+  channels[0]->assign(n, 0.0f);
+  channels[1]->assign(n, -0.0f);
+  channels[2]->assign(n, std::numeric_limits<float>::quiet_NaN());
+  channels[3]->assign(n, std::numeric_limits<float>::infinity());
+  channels[4]->assign(n, 2.5f);
+  channels[4]->back() = 2.25f;
+  in.id.assign(n, 42u);
+  const std::string constant = encodeFrame(in);
+  const Frame out = decodeFrame(constant);
+  for (int c = 0; c < kUncertaintyChannels; ++c)
+    EXPECT_TRUE(sameBits(*out.uncertainty()[c], *in.uncertainty()[c]))
+        << kUncertaintyChannelInfo[c].name;
+  EXPECT_EQ(out.id, in.id);
+  EXPECT_TRUE(std::signbit((*out.uncertainty()[1])[n - 1]));
+  // Four channels and the ids sent as one element each: that many elements fewer.
+  EXPECT_EQ(constant.size() + 5 * (n - 1) * sizeof(float), encodeFrame(sample(true)).size());
+}
+
 TEST(FrameStream, DamagedBytesAreRefused) {
   const std::string good = encodeFrame(sample(true));
   EXPECT_THROW(decodeFrame(good.substr(0, good.size() - 1)), InputError);
   EXPECT_THROW(decodeFrame(good + "x"), InputError);
   EXPECT_THROW(decodeFrame("RCF1" + good.substr(4)), InputError);  // older layouts
   EXPECT_THROW(decodeFrame("RCF2" + good.substr(4)), InputError);
+  EXPECT_THROW(decodeFrame("RCF3" + good.substr(4)), InputError);
   EXPECT_THROW(decodeFrame(""), InputError);
   std::string huge = good;
   const std::uint32_t big = 1u << 20;
