@@ -297,14 +297,21 @@ int runCommand(const RunArgs& args) {
     for (const RenderRequest& r : probes.requests) probe_tickets.push_back(pool->submit(r));
     probes_start = std::chrono::steady_clock::now();
   };
+  // Every backend the run names, in the order a fixture's renders are queued.
+  std::vector<std::string> run_specs = {against.text};
+  if (needs_ref && against.text != "ref") run_specs.emplace_back("ref");
+  for (const BackendSpec& b : backends)
+    if (std::find(run_specs.begin(), run_specs.end(), b.text) == run_specs.end())
+      run_specs.push_back(b.text);
   const bool early_probes = args.variants && args.skips.empty() && !sharded;
-  if (early_probes) {
-    std::vector<std::string> named = {against.text};
-    if (needs_ref && against.text != "ref") named.emplace_back("ref");
-    for (const BackendSpec& b : backends)
-      if (std::find(named.begin(), named.end(), b.text) == named.end()) named.push_back(b.text);
-    queueProbes(named);
-  }
+  if (early_probes) queueProbes(run_specs);
+  // The fixtures that have passed the check are rendered while the others are checked (the
+  // workers waited ~0.2 s for the check of 200 small scenes) when the run renders every
+  // fixture it finds on every backend it names (no --skips, --shard, --caselist or
+  // --fraction); at most kEarlyFixtures, whose frames wait in memory for the check's end.
+  const bool early_renders = args.skips.empty() && !sharded && args.caselist.empty() &&
+                             args.fraction == 1 && args.fraction_start == 1;
+  const std::size_t early_limit = 4 * static_cast<std::size_t>(parallel) + 4;
 
   // Loaded `parallel` at a time (a mesh file's import is a child process of its own, and a
   // catalog's images and meshes are read one after another otherwise); the first fixture in
@@ -315,6 +322,11 @@ int runCommand(const RunArgs& args) {
     std::exception_ptr error;
   };
   std::vector<Checked> checked;
+  // How far the check has come: files[0, checked_prefix) are checked and fine (guarded by
+  // check_mutex, as check_state, a file's 0 unchecked, 1 fine, 2 bad).
+  std::mutex check_mutex;
+  std::size_t checked_prefix = 0;
+  std::vector<char> check_state;
   auto check = [&] {
     // Not the report folder (an earlier run's variant probes are scenes too).
     files = findFixtures(inputs, {args.out});
@@ -329,6 +341,10 @@ int runCommand(const RunArgs& args) {
       prefetchMeshImports(meshes);
     }
     checked.resize(files.size());
+    {
+      const std::lock_guard lock(check_mutex);
+      check_state.assign(files.size(), 0);
+    }
     std::atomic<std::size_t> next{0};
     auto validate = [&] {
       for (std::size_t i = next++; i < files.size(); i = next++) {
@@ -342,6 +358,10 @@ int runCommand(const RunArgs& args) {
         } catch (...) {
           checked[i].error = std::current_exception();
         }
+        const std::lock_guard lock(check_mutex);
+        check_state[i] = checked[i].error ? 2 : 1;
+        while (checked_prefix < check_state.size() && check_state[checked_prefix] == 1)
+          ++checked_prefix;
       }
     };
     const std::size_t threads = std::min<std::size_t>(files.size(), parallel);
@@ -357,7 +377,24 @@ int runCommand(const RunArgs& args) {
     std::chrono::steady_clock::time_point at;
   };
   std::vector<Early> early;
-  if (probe_tickets.empty()) {
+  // (file index, backend) -> ticket of a render queued during the check.
+  std::map<std::pair<std::size_t, std::string>, std::size_t> early_tickets;
+  std::size_t early_fixtures = 0;
+  auto queueChecked = [&] {
+    if (!early_renders) return;
+    std::vector<fs::path> ready;
+    {
+      const std::lock_guard lock(check_mutex);
+      for (std::size_t i = early_fixtures; i < std::min(checked_prefix, early_limit); ++i)
+        ready.push_back(checked[i].entry.file);
+    }
+    for (const fs::path& file : ready) {
+      for (const std::string& spec : run_specs)
+        early_tickets[{early_fixtures, spec}] = pool->submit({file, spec});
+      ++early_fixtures;
+    }
+  };
+  if (probe_tickets.empty() && !early_renders) {
     check();
   } else {
     std::atomic<bool> checked_all{false};
@@ -372,9 +409,11 @@ int runCommand(const RunArgs& args) {
     });
     try {
       // The first poll starts the workers on the probes.
-      for (bool first = true; first || !checked_all; first = false)
+      for (bool first = true; first || !checked_all; first = false) {
+        queueChecked();
         for (auto& [ticket, outcome] : pool->poll(first ? 0 : 5))
           early.push_back({ticket, std::move(outcome), std::chrono::steady_clock::now()});
+      }
     } catch (...) {
       checker.join();  // a worker that cannot start: ends the run once the check is done
       throw;
@@ -500,8 +539,14 @@ int runCommand(const RunArgs& args) {
     std::vector<std::size_t> left(fixtures.size(), 0);
     for (std::size_t f = 0; f < fixtures.size(); ++f) {
       left[f] = needed[f].size();
-      for (const std::string& spec : needed[f])
-        ticket_of[pool->submit({fixtures[f].file, spec})] = {f, spec};
+      for (const std::string& spec : needed[f]) {
+        // Queued during the check (the fixture is file f then), else now.
+        const auto it = early_tickets.find({f, spec});
+        const std::size_t ticket =
+            it != early_tickets.end() ? it->second : pool->submit({fixtures[f].file, spec});
+        if (it != early_tickets.end()) early_tickets.erase(it);
+        ticket_of[ticket] = {f, spec};
+      }
     }
 
     auto expectedFailure = [&](const PairResult& r) {
@@ -686,10 +731,13 @@ int runCommand(const RunArgs& args) {
         }
         return;
       }
+      // A render queued during the check that no pair wants (a run with no pairs).
+      const auto mine = ticket_of.find(ticket);
+      if (mine == ticket_of.end()) return;
       // A worker that judged the fixture bad input (a file changed since it was checked)
       // ends the run as bad input does before rendering: exit 2, nothing written.
       if (outcome.input_error && input_failure.empty()) input_failure = outcome.error;
-      const auto [f, spec] = ticket_of.at(ticket);
+      const auto [f, spec] = mine->second;
       got[f][spec] = std::move(outcome);
       if (--left[f] == 0) {
         comparer.push([&compareFixture, f] { compareFixture(f); });
