@@ -308,10 +308,12 @@ int runCommand(const RunArgs& args) {
   // The fixtures that have passed the check are rendered while the others are checked (the
   // workers waited ~0.2 s for the check of 200 small scenes) when the run renders every
   // fixture it finds on every backend it names (no --skips, --shard, --caselist or
-  // --fraction); at most kEarlyFixtures, whose frames wait in memory for the check's end.
+  // --fraction); their frames wait in memory for the check's end, so at most
+  // kEarlyFixtures of kEarlyPixels pixels in all.
   const bool early_renders = args.skips.empty() && !sharded && args.caselist.empty() &&
                              args.fraction == 1 && args.fraction_start == 1;
-  const std::size_t early_limit = 4 * static_cast<std::size_t>(parallel) + 4;
+  constexpr std::size_t kEarlyFixtures = 64;
+  constexpr std::size_t kEarlyPixels = std::size_t{4} << 20;
 
   // Loaded `parallel` at a time (a mesh file's import is a child process of its own, and a
   // catalog's images and meshes are read one after another otherwise); the first fixture in
@@ -319,27 +321,32 @@ int runCommand(const RunArgs& args) {
   std::vector<fs::path> files;
   struct Checked {
     FixtureEntry entry;
+    std::size_t pixels = 0;
     std::exception_ptr error;
   };
   std::vector<Checked> checked;
-  // How far the check has come: files[0, checked_prefix) are checked and fine (guarded by
-  // check_mutex, as check_state, a file's 0 unchecked, 1 fine, 2 bad).
+  // Where the check has come (guarded by check_mutex): per file 0 unchecked, 1 fine, 2 bad.
   std::mutex check_mutex;
-  std::size_t checked_prefix = 0;
   std::vector<char> check_state;
   auto check = [&] {
     // Not the report folder (an earlier run's variant probes are scenes too).
     files = findFixtures(inputs, {args.out});
-    // The mesh files the fixtures name, imported in one importer process before the check
-    // below asks for them one by one (prefetchMeshImports: an optimisation only).
-    {
-      std::vector<std::pair<fs::path, bool>> meshes;
-      for (const fs::path& f : files) {
-        auto named = meshFilesNamed(f);
-        meshes.insert(meshes.end(), named.begin(), named.end());
-      }
-      prefetchMeshImports(meshes);
+    // The mesh files the fixtures name, imported in one importer process (prefetchMeshImports:
+    // an optimisation only) while the fixtures that name none are checked; those that do
+    // are checked after it, so that they find their imports made.
+    std::vector<std::pair<fs::path, bool>> meshes;
+    std::vector<std::size_t> order;
+    std::vector<std::size_t> with_meshes;
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      auto named = meshFilesNamed(files[i]);
+      (named.empty() ? order : with_meshes).push_back(i);
+      meshes.insert(meshes.end(), named.begin(), named.end());
     }
+    const std::size_t first_with_meshes = order.size();
+    order.insert(order.end(), with_meshes.begin(), with_meshes.end());
+    std::shared_future<void> prefetched;
+    if (!meshes.empty())
+      prefetched = std::async(std::launch::async, [&meshes] { prefetchMeshImports(meshes); });
     checked.resize(files.size());
     {
       const std::lock_guard lock(check_mutex);
@@ -347,7 +354,9 @@ int runCommand(const RunArgs& args) {
     }
     std::atomic<std::size_t> next{0};
     auto validate = [&] {
-      for (std::size_t i = next++; i < files.size(); i = next++) {
+      for (std::size_t k = next++; k < order.size(); k = next++) {
+        const std::size_t i = order[k];
+        if (k >= first_with_meshes) prefetched.wait();
         try {
           const Scene scene = loadScene(files[i]);
           checkResources(scene, RendererKind::Reference, limits);
@@ -355,13 +364,12 @@ int runCommand(const RunArgs& args) {
           checkComparison(files[i].string(), scene.width, scene.height, limits);
           checked[i].entry = {fs::absolute(files[i]), scene.name, "", scene.tolerance,
                               rasterCost(scene)};
+          checked[i].pixels = static_cast<std::size_t>(scene.width) * scene.height;
         } catch (...) {
           checked[i].error = std::current_exception();
         }
         const std::lock_guard lock(check_mutex);
         check_state[i] = checked[i].error ? 2 : 1;
-        while (checked_prefix < check_state.size() && check_state[checked_prefix] == 1)
-          ++checked_prefix;
       }
     };
     const std::size_t threads = std::min<std::size_t>(files.size(), parallel);
@@ -380,19 +388,26 @@ int runCommand(const RunArgs& args) {
   // (file index, backend) -> ticket of a render queued during the check.
   std::map<std::pair<std::size_t, std::string>, std::size_t> early_tickets;
   std::size_t early_fixtures = 0;
+  std::size_t early_pixels = 0;
+  std::vector<bool> early_queued;
   auto queueChecked = [&] {
     if (!early_renders) return;
-    std::vector<fs::path> ready;
+    std::vector<std::pair<std::size_t, fs::path>> ready;
     {
       const std::lock_guard lock(check_mutex);
-      for (std::size_t i = early_fixtures; i < std::min(checked_prefix, early_limit); ++i)
-        ready.push_back(checked[i].entry.file);
+      early_queued.resize(check_state.size());
+      for (std::size_t i = 0; i < check_state.size() && early_fixtures < kEarlyFixtures; ++i) {
+        if (check_state[i] != 1 || early_queued[i]) continue;
+        if (early_pixels + checked[i].pixels > kEarlyPixels) break;
+        early_queued[i] = true;
+        early_pixels += checked[i].pixels;
+        ++early_fixtures;
+        ready.emplace_back(i, checked[i].entry.file);
+      }
     }
-    for (const fs::path& file : ready) {
+    for (const auto& [i, file] : ready)
       for (const std::string& spec : run_specs)
-        early_tickets[{early_fixtures, spec}] = pool->submit({file, spec});
-      ++early_fixtures;
-    }
+        early_tickets[{i, spec}] = pool->submit({file, spec});
   };
   if (probe_tickets.empty() && !early_renders) {
     check();

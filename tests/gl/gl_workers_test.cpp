@@ -198,6 +198,49 @@ TEST(GlWorkers, ABadFixtureEndsTheRunWhileTheWorkersDrawTheProbes) {
   fs::remove_all(dir);
 }
 
+// A fixture that has passed the check is rendered while the others are still checked: b's
+// mesh import (a script that waits for a's render to begin, then runs the real importer)
+// cannot end before a worker draws a (hang_once leaves its marker, then that render hangs
+// until --timeout). Rendering only after the check, the script would wait its minute out
+// and fail, and the run would exit 2.
+TEST(GlWorkers, FixturesThatPassedTheCheckAreRenderedWhileTheRestIsChecked) {
+  const fs::path dir = scratch("early_renders");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  const fs::path inputs = inputsWithTheFan(dir);
+  std::ofstream(inputs / "tri.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(inputs / "b.json") << R"({"format": "rastercheck-scene/1", "name": "early/b",
+    "image": {"width": 8, "height": 8}, "camera": {"eye": [0, 0, 5]},
+    "objects": [{"mesh": {"file": "tri.obj"}}]})";
+  const fs::path tmp = dir / "tmp";
+  fs::create_directories(tmp);
+  const fs::path importer = dir / "importer.sh";
+  const fs::path real = fs::path(RC_EXE).parent_path() / "rastercheck-mesh-import";
+  std::ofstream(importer) << "#!/bin/sh\n"
+                             "for i in $(seq 600); do\n"
+                             "  if ls \"$TMPDIR\" | grep -q rastercheck-hang-once; then\n"
+                             "    exec "
+                          << real.string()
+                          << " \"$@\"\n"
+                             "  fi\n"
+                             "  sleep 0.1\n"
+                             "done\n"
+                             "exit 1\n";
+  fs::permissions(importer, fs::perms::owner_all);
+  const Result r =
+      run("run " + inputs.string() + " --backends gl:egl:llvmpipe --timeout 3 --out " +
+              (dir / "out").string(),
+          "TMPDIR=" + tmp.string() + " RASTERCHECK_GL_FAULT=hang_once=coverage/triangle_fan " +
+              "RASTERCHECK_MESH_IMPORTER=" + importer.string());
+  ASSERT_TRUE(fs::exists(dir / "out" / "report.json")) << r.out;
+  const json report = json::parse(std::ifstream(dir / "out" / "report.json"));
+  std::map<std::string, std::string> status;
+  for (const json& row : report["results"]) status[row["fixture"]] = row["status"];
+  // The render that hung, then its retry (run's --retries) that drew.
+  EXPECT_EQ(status["coverage/triangle_fan"], "flake") << r.out;
+  EXPECT_EQ(status["early/b"], "pass") << r.out;
+  fs::remove_all(dir);
+}
+
 // A report folder inside the input folder is output, not input: neither this run's staged
 // variant probes (written before the fixtures are found) nor an earlier run's are fixtures.
 TEST(GlWorkers, AReportFolderInsideTheInputsHoldsNoFixture) {
