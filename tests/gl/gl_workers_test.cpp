@@ -314,6 +314,32 @@ TEST(GlWorkers, ARequestsFaultAppliesToThatRenderAlone) {
   fs::remove_all(dir);
 }
 
+// A worker sends a multi-pass scene's frame pass alone: its callers compare that one, and the
+// pass frames (a 128x128 target here, the reference's with its uncertainty channels) are
+// `render --all-passes`'s. In-process, both renderers keep them.
+TEST(GlWorkers, AWorkerSendsTheFramePassWithoutThePassFrames) {
+  const fs::path dir = scratch("frame_pass_only");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  rc::WorkerPool::Options options;
+  options.log_dir = dir / "workers";
+  options.program = RC_EXE;
+  rc::WorkerPool pool(options);
+  const fs::path fixture = catalog("multipass/mirror_quad.json");
+  for (const char* spec : {"ref", "gl:egl:llvmpipe"}) {
+    SCOPED_TRACE(spec);
+    const rc::RenderOutcome o = pool.renderAll({{fixture, spec, ""}}).front();
+    ASSERT_TRUE(o.ok) << o.error;
+    EXPECT_EQ(o.frame.width, 200);
+    EXPECT_EQ(o.frame.height, 150);
+    EXPECT_TRUE(o.frame.passes.empty());
+  }
+  const Result r = run("render " + fixture.string() + " --backend ref --all-passes --out " +
+                       (dir / "all").string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "all" / "passes" / "0-mirror" / "frame.exr")) << r.out;
+  fs::remove_all(dir);
+}
+
 // Isolation through `run`'s own workers: one worker per driver renders random scenes of
 // every profile and the whole catalog in file order, then the same list shuffled, then A, B,
 // A for a blended and a textured scene, and every frame must be the bits a worker with a new
