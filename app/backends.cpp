@@ -68,11 +68,13 @@ BackendSpec parseBackendSpec(std::string_view spec) {
   throw InputError(fmt::format("unknown backend '{}' (valid: {})", spec, kValidSpecs));
 }
 
-Frame renderWith(const BackendSpec& backend, const Scene& scene) {
+Frame renderWith(const BackendSpec& backend, const Scene& scene, bool pass_frames) {
   const auto start = std::chrono::steady_clock::now();
   Frame frame = backend.kind == BackendSpec::Kind::Reference
                     ? renderReference(scene, backend.reference)
-                    : renderGl(scene, backend.gl);
+                    : renderGl(scene, backend.gl, pass_frames);
+  // The reference draws its passes' frames whatever is asked (it samples them itself).
+  if (!pass_frames) frame.passes.clear();
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   nlohmann::json& m = frame.meta;

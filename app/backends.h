@@ -33,6 +33,7 @@ inline RendererKind rendererKind(const BackendSpec& backend) {
 
 // Renders and fills the frame.json keys every backend shares (backend, fixture, sizes,
 // formats, tool version, total time). Throws BackendError (exit 3) when the backend fails.
-Frame renderWith(const BackendSpec& backend, const Scene& scene);
+// Without `pass_frames`, frame.passes (render --all-passes) stays empty.
+Frame renderWith(const BackendSpec& backend, const Scene& scene, bool pass_frames = true);
 
 }  // namespace rc

@@ -53,7 +53,8 @@ std::vector<std::pair<std::string, std::string>> startupEnvironment(const GlSpec
 // read once per process); later calls reuse that context. Throws BackendError with one
 // line "<fixture name>: <backend spec>: <why>" when GL cannot start or reports an error,
 // and InputError for a scene no renderer could draw (non-positive size, bad indices).
-// The frame's `drawn` facts come from the scene, as the reference's do.
-Frame renderGl(const Scene& scene, const GlSpec& spec);
+// The frame's `drawn` facts come from the scene, as the reference's do. A multi-pass
+// scene's pass frames (frame.passes) are read back only with `pass_frames`.
+Frame renderGl(const Scene& scene, const GlSpec& spec, bool pass_frames = true);
 
 }  // namespace rc

@@ -1651,7 +1651,7 @@ std::vector<MaterialShadow> materialShadows(const Scene& scene, const Scene& pas
 // Draws pass k (before the frame pass) of `scene` into its target and reads it back. The
 // test-only faults are the frame pass's: these passes draw without them.
 Frame drawTargetPass(Session& s, const Program& program, const Scene& scene, std::size_t k,
-                     PassTargets& targets, int max_texture_size) {
+                     PassTargets& targets, int max_texture_size, bool read_back) {
   const gl::Functions& gl = s.gl;
   const Scene ps = passScene(scene, k);
   const RenderTarget& target = *findTarget(scene, scene.passes[k].target);
@@ -1709,6 +1709,7 @@ Frame drawTargetPass(Session& s, const Program& program, const Scene& scene, std
   resetPassState(gl);
   checkGl(s, fmt::format("pass {} (target {})", k, target.name).c_str());
   Frame frame;
+  if (!read_back) return frame;
   readBack(s, ps, frame);
   checkGl(s, "target readback");
   frame.meta["pass"] = {{"index", k}, {"target", target.name}, {"format", toString(target.format)}};
@@ -1716,7 +1717,7 @@ Frame drawTargetPass(Session& s, const Program& program, const Scene& scene, std
   return frame;
 }
 
-Frame renderLocked(const Scene& multi, const GlSpec& spec) {
+Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames) {
   // A multi-pass scene draws its targets first, then its frame pass (`scene` below).
   validateForRendering(multi);
   const bool multipass = !multi.passes.empty();
@@ -1777,9 +1778,11 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec) {
   double passes_ms = 0.0;
   if (multipass) {
     const auto passes_start = Clock::now();
-    for (std::size_t k = 0; k + 1 < multi.passes.size(); ++k)
-      pass_frames.push_back(
-          drawTargetPass(s, program, multi, k, targets, glInteger(gl, GL_MAX_TEXTURE_SIZE)));
+    for (std::size_t k = 0; k + 1 < multi.passes.size(); ++k) {
+      Frame pass = drawTargetPass(s, program, multi, k, targets, glInteger(gl, GL_MAX_TEXTURE_SIZE),
+                                  want_pass_frames);
+      if (want_pass_frames) pass_frames.push_back(std::move(pass));
+    }
     passes_ms = msSince(passes_start);
   }
   bindFramebuffer(s, scene);
@@ -1902,11 +1905,11 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec) {
 
 }  // namespace
 
-Frame renderGl(const Scene& scene, const GlSpec& spec) {
+Frame renderGl(const Scene& scene, const GlSpec& spec, bool pass_frames) {
   const std::string name = scene.name.empty() ? "(unnamed scene)" : scene.name;
   try {
     const std::lock_guard lock(g_mutex);
-    return renderLocked(scene, spec);
+    return renderLocked(scene, spec, pass_frames);
   } catch (const NotSupportedError& e) {
     throw NotSupportedError(
         fmt::format("not supported: {}: {}: {}", name, toString(spec), e.what()));
