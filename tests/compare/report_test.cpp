@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -494,6 +495,80 @@ TEST(ColorStops, TheUserCacheKeepsOpenImageIOsMap) {
   ::unsetenv("RASTERCHECK_CACHE_DISABLE");
   ::unsetenv("RASTERCHECK_CACHE_DIR");
   std::filesystem::remove_all(user);
+}
+
+// Pair images go through the user cache too (compare/pair_images.cpp): a pair that fails in
+// the same way as before has its visibility map, heat maps and diff.exr copied from there
+// (an entry changed on disk is what the next write gives), they are the encoder's bytes, and
+// a pair with other errors is other keys, encoded again.
+TEST(PairImages, TheUserCacheServesPairImagesWrittenBefore) {
+  const fs::path dir = freshDir("pair_image_cache");
+  const fs::path user = dir / "user";
+  Frame ref = testing::renderRects(kW, kH, testing::defaultRects(kW, kH));
+  ref.meta["fixture"] = "synthetic/cached";
+  auto failing = [&](std::uint32_t id) {
+    Frame f = ref;
+    f.clearUncertainty();
+    f.meta["backend"] = "gl:egl:llvmpipe";
+    for (int y = kBy0; y < kBy1; ++y)
+      for (int x = kBx0; x < kBx1; ++x) f.id[f.index(x, y)] = id;
+    return f;
+  };
+  auto write = [&](const Frame& actual, const fs::path& out) {
+    ClassMaps maps;
+    PairResult r = compareFrames(ref, actual, ref, tolerancesForFrames(ref, actual), &maps);
+    EXPECT_EQ(r.status, Status::Fail);
+    writePairImages(ref, actual, maps, out, r);
+  };
+  const std::vector<std::string> names = {"visibility.png", "depth_heat.png", "shading_heat.png",
+                                          "diff.exr"};
+  auto bytes = [](const fs::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  auto entries = [&] {
+    std::vector<fs::path> out;
+    for (const auto& e : fs::directory_iterator(user))
+      if (e.path().extension() == ".rcpair") out.push_back(e.path());
+    return out;
+  };
+  ::setenv("RASTERCHECK_CACHE_DISABLE", "1", 1);
+  write(failing(0), dir / "plain");
+  write(failing(7), dir / "plain7");
+  ::unsetenv("RASTERCHECK_CACHE_DISABLE");
+  ::setenv("RASTERCHECK_CACHE_DIR", user.c_str(), 1);
+  write(failing(0), dir / "a");
+  for (const std::string& n : names) EXPECT_EQ(bytes(dir / "a" / n), bytes(dir / "plain" / n)) << n;
+  // One entry per distinct file (the two heat maps of a pair whose errors are all visibility
+  // are the same picture).
+  std::set<std::string> distinct;
+  for (const std::string& n : names) distinct.insert(bytes(dir / "a" / n));
+  const std::vector<fs::path> made = entries();
+  ASSERT_EQ(made.size(), distinct.size());
+  std::vector<std::string> originals;
+  for (const fs::path& e : made) {  // every entry's last byte flipped
+    originals.push_back(bytes(e));
+    std::string b = originals.back();
+    b.back() = static_cast<char>(b.back() ^ 0x5a);
+    std::ofstream(e, std::ios::binary | std::ios::trunc) << b;
+  }
+  write(failing(0), dir / "b");
+  for (const std::string& n : names) {
+    const std::string served = bytes(dir / "b" / n);
+    const std::string plain = bytes(dir / "plain" / n);
+    ASSERT_EQ(served.size(), plain.size()) << n;
+    EXPECT_EQ(served.back(), static_cast<char>(plain.back() ^ 0x5a)) << n;
+  }
+  for (std::size_t k = 0; k < made.size(); ++k)
+    std::ofstream(made[k], std::ios::binary | std::ios::trunc) << originals[k];
+  write(failing(7), dir / "c");  // other ids: other images, other keys
+  for (const std::string& n : names) distinct.insert(bytes(dir / "c" / n));
+  EXPECT_EQ(entries().size(), distinct.size());
+  EXPECT_GT(distinct.size(), made.size());
+  for (const std::string& n : names)
+    EXPECT_EQ(bytes(dir / "c" / n), bytes(dir / "plain7" / n)) << n;
+  ::unsetenv("RASTERCHECK_CACHE_DIR");
+  fs::remove_all(dir);
 }
 
 }  // namespace
