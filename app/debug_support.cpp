@@ -26,8 +26,9 @@ namespace {
 class GlWorkers {
  public:
   Frame render(const fs::path& scene_file, const std::string& spec) {
-    RenderOutcome outcome =
-        std::move(pool_.renderAll({RenderRequest{fs::absolute(scene_file), spec}}).front());
+    RenderRequest request{fs::absolute(scene_file), spec};
+    request.pass_frames = true;  // explain compares the driver's shadow maps
+    RenderOutcome outcome = std::move(pool_.renderAll({request}).front());
     if (!outcome.ok) {
       // The worker's message usually names the spec already.
       throw BackendError(outcome.error.find(spec) != std::string::npos

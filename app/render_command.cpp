@@ -60,7 +60,7 @@ int renderCommand(const RenderArgs& args) {
   restartWithStartupEnvironment(args, backend);
   const Scene scene = loadScene(args.scene);
   checkResources(scene, rendererKind(backend), ResourceLimits::current());
-  const Frame frame = renderWith(backend, scene);
+  const Frame frame = renderWith(backend, scene, args.all_passes);
   writeFrameDir(frame, args.out);
   std::cout << fmt::format("{}: {} -> {}\n", scene.name, backend.text, args.out.string());
   if (args.all_passes) {

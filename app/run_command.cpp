@@ -100,8 +100,13 @@ class TaskQueue {
   }
   TaskQueue(const TaskQueue&) = delete;
   TaskQueue& operator=(const TaskQueue&) = delete;
-  // Only reached without finish() when the run is already failing: that failure wins.
+  // Only reached without finish() when the run is already failing: that failure wins, and
+  // what is still queued is dropped (it would write into a report folder that is discarded).
   ~TaskQueue() {
+    {
+      const std::lock_guard lock(mutex_);
+      queue_.clear();
+    }
     try {
       finish();
     } catch (...) {  // NOLINT(bugprone-empty-catch)
@@ -308,12 +313,16 @@ int runCommand(const RunArgs& args) {
   // The fixtures that have passed the check are rendered while the others are checked (the
   // workers waited ~0.2 s for the check of 200 small scenes) when the run renders every
   // fixture it finds on every backend it names (no --skips, --shard, --caselist or
-  // --fraction); their frames wait in memory for the check's end, so at most
-  // kEarlyFixtures of kEarlyPixels pixels in all.
+  // --fraction); their frames wait in memory for the check's end, so at most kEarlyFixtures
+  // whose frames come to kEarlyBytes (estimated: ~100 bytes a sample for the reference's
+  // planes, ~30 for a GL driver's).
   const bool early_renders = args.skips.empty() && !sharded && args.caselist.empty() &&
                              args.fraction == 1 && args.fraction_start == 1;
   constexpr std::size_t kEarlyFixtures = 64;
-  constexpr std::size_t kEarlyPixels = std::size_t{4} << 20;
+  constexpr std::size_t kEarlyBytes = std::size_t{256} << 20;
+  std::size_t bytes_per_sample = 0;
+  for (const std::string& spec : run_specs)
+    bytes_per_sample += parseBackendSpec(spec).kind == BackendSpec::Kind::Reference ? 100 : 30;
 
   // Loaded `parallel` at a time (a mesh file's import is a child process of its own, and a
   // catalog's images and meshes are read one after another otherwise); the first fixture in
@@ -321,7 +330,7 @@ int runCommand(const RunArgs& args) {
   std::vector<fs::path> files;
   struct Checked {
     FixtureEntry entry;
-    std::size_t pixels = 0;
+    std::size_t samples = 0;  // pixels x samples per pixel
     std::exception_ptr error;
   };
   std::vector<Checked> checked;
@@ -356,7 +365,10 @@ int runCommand(const RunArgs& args) {
     auto validate = [&] {
       for (std::size_t k = next++; k < order.size(); k = next++) {
         const std::size_t i = order[k];
-        if (k >= first_with_meshes) prefetched.wait();
+        if (k >= first_with_meshes) {
+          const std::shared_future<void> mine = prefetched;  // a copy per thread
+          mine.wait();
+        }
         try {
           const Scene scene = loadScene(files[i]);
           checkResources(scene, RendererKind::Reference, limits);
@@ -364,7 +376,8 @@ int runCommand(const RunArgs& args) {
           checkComparison(files[i].string(), scene.width, scene.height, limits);
           checked[i].entry = {fs::absolute(files[i]), scene.name, "", scene.tolerance,
                               rasterCost(scene)};
-          checked[i].pixels = static_cast<std::size_t>(scene.width) * scene.height;
+          checked[i].samples = static_cast<std::size_t>(scene.width) * scene.height *
+                               static_cast<std::size_t>(std::max(1, scene.state.samples));
         } catch (...) {
           checked[i].error = std::current_exception();
         }
@@ -388,7 +401,7 @@ int runCommand(const RunArgs& args) {
   // (file index, backend) -> ticket of a render queued during the check.
   std::map<std::pair<std::size_t, std::string>, std::size_t> early_tickets;
   std::size_t early_fixtures = 0;
-  std::size_t early_pixels = 0;
+  std::size_t early_bytes = 0;
   std::vector<bool> early_queued;
   auto queueChecked = [&] {
     if (!early_renders) return;
@@ -398,9 +411,10 @@ int runCommand(const RunArgs& args) {
       early_queued.resize(check_state.size());
       for (std::size_t i = 0; i < check_state.size() && early_fixtures < kEarlyFixtures; ++i) {
         if (check_state[i] != 1 || early_queued[i]) continue;
-        if (early_pixels + checked[i].pixels > kEarlyPixels) break;
+        const std::size_t bytes = checked[i].samples * bytes_per_sample;
+        if (early_bytes + bytes > kEarlyBytes) continue;  // a smaller one may fit
         early_queued[i] = true;
-        early_pixels += checked[i].pixels;
+        early_bytes += bytes;
         ++early_fixtures;
         ready.emplace_back(i, checked[i].entry.file);
       }
@@ -593,8 +607,9 @@ int runCommand(const RunArgs& args) {
       }
       return c;
     };
-    // What a comparison keeps is written on the writer thread, after it, in order.
-    TaskQueue writer(1);
+    // What a comparison keeps is written on the writer threads, after it (a fixture's files in
+    // order: its frames before the pair images that link their color.png).
+    TaskQueue writer(std::max(1, parallel / 2));
     auto compareFixture = [&](std::size_t f) {
       const FixtureEntry& fx = fixtures[f];
       // The fixture's frames, shared with the writes that need them.

@@ -91,11 +91,13 @@ int workerCommand(const std::string& spec) {
         FaultScope(const FaultScope&) = delete;
         FaultScope& operator=(const FaultScope&) = delete;
       } fault(request);
-      // A multi-pass scene's pass frames are for `render --all-passes`: the pool's callers
-      // compare the frame pass only, and the reference's pass frames (shadow maps and
-      // render targets, with their uncertainty channels) were megabytes a render through
-      // the pipe; GL's read-back of them ~1.7 ms a multi-pass render on llvmpipe.
-      payload = encodeFrame(renderWith(backend, scene, false));
+      // A multi-pass scene's pass frames only when asked (`explain`): `run` compares the
+      // frame pass, and the reference's pass frames (shadow maps and render targets, with
+      // their uncertainty channels) were megabytes a render through the pipe; GL's
+      // read-back of them ~1.7 ms a multi-pass render on llvmpipe.
+      const auto asked = request.find("pass_frames");
+      const bool pass_frames = asked != request.end() && asked->is_boolean() && asked->get<bool>();
+      payload = encodeFrame(renderWith(backend, scene, pass_frames));
     } catch (const InputError& e) {
       kind = ReplyKind::InputError;
       payload = e.what();

@@ -4,7 +4,8 @@
 // fixture:
 //   request, parent -> worker on stdin: one JSON line {"id": N, "fixture": "/abs/f.json"},
 //   with "fault": "SETTING" (test-only) to render this fixture alone with that
-//   RASTERCHECK_GL_FAULT setting (gl_backend/gl_testing.h)
+//   RASTERCHECK_GL_FAULT setting (gl_backend/gl_testing.h), and "pass_frames": true to send
+//   a multi-pass scene's pass frames with its frame
 //   reply, worker -> parent on fd 3: a ReplyHeader, then `length` bytes: the frame as
 //   encodeFrame() gives it (kind Frame), or a one-line message (the other kinds).
 // Its stdout and stderr (driver chatter, warnings) go to a log file the parent reads.

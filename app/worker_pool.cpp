@@ -163,6 +163,7 @@ WorkerPool::Worker* WorkerPool::startWorker(const std::string& spec) {
 bool WorkerPool::send(Worker& w, const Task& task) {
   nlohmann::json request{{"id", task.ticket}, {"fixture", task.request.fixture.string()}};
   if (!task.request.fault.empty()) request["fault"] = task.request.fault;
+  if (task.request.pass_frames) request["pass_frames"] = true;
   const std::string line =
       request.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   std::error_code ec;

@@ -31,6 +31,9 @@ struct RenderRequest {
   // Rendered by a worker started for this render alone and ended after it (`run --retries`:
   // nothing the driver kept from earlier fixtures can reach it).
   bool fresh = false;
+  // A multi-pass scene's pass frames sent too (frame.passes: `explain` reads the driver's
+  // shadow maps there); without, the frame pass alone.
+  bool pass_frames = false;
 };
 
 struct RenderOutcome {

@@ -504,6 +504,16 @@ TEST(ColorStops, TheUserCacheKeepsOpenImageIOsMap) {
 TEST(PairImages, TheUserCacheServesPairImagesWrittenBefore) {
   const fs::path dir = freshDir("pair_image_cache");
   const fs::path user = dir / "user";
+  // The variables back as they were whichever way the test ends (the binary's other tests).
+  struct Unset {
+    Unset() = default;
+    Unset(const Unset&) = delete;
+    Unset& operator=(const Unset&) = delete;
+    ~Unset() {
+      ::unsetenv("RASTERCHECK_CACHE_DIR");
+      ::unsetenv("RASTERCHECK_CACHE_DISABLE");
+    }
+  } unset;
   Frame ref = testing::renderRects(kW, kH, testing::defaultRects(kW, kH));
   ref.meta["fixture"] = "synthetic/cached";
   auto failing = [&](std::uint32_t id) {

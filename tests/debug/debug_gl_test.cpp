@@ -93,6 +93,9 @@ TEST(DebugGl, ExplainJsonKeysBothWaysIncludingABackendThatCannotRun) {
   ASSERT_EQ(shadow.code, 0) << shadow.err;
   const json shadow_doc = json::parse(shadow.out);
   EXPECT_FALSE(shadow_doc["backends"][kLlvmpipe]["shadow_texels"].empty()) << shadow.out;
+  // The driver's own map (its pass frame, which the worker sends for explain) at each texel.
+  for (const json& t : shadow_doc["backends"][kLlvmpipe]["shadow_texels"])
+    EXPECT_TRUE(t["driver"].is_number()) << t.dump();
   collectKeys(shadow_doc, "", seen);
   for (const std::string& k : seen) EXPECT_TRUE(documented.count(k)) << "undocumented key " << k;
   for (const std::string& k : documented) EXPECT_TRUE(seen.count(k)) << "never seen " << k;

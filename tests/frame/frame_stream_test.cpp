@@ -109,8 +109,18 @@ TEST(FrameStream, ConstantPlanesTravelAsOneElementAndComeBackWhole) {
         << kUncertaintyChannelInfo[c].name;
   EXPECT_EQ(out.id, in.id);
   EXPECT_TRUE(std::signbit((*out.uncertainty()[1])[n - 1]));
-  // Four channels and the ids sent as one element each: that many elements fewer.
-  EXPECT_EQ(constant.size() + 5 * (n - 1) * sizeof(float), encodeFrame(sample(true)).size());
+  // Four channels and the ids sent as one element each (and its count): that many fewer bytes.
+  EXPECT_EQ(constant.size() + 5 * (n - 1) * sizeof(float) - 5 * sizeof(std::uint64_t),
+            encodeFrame(sample(true)).size());
+  // A constant plane that claims another size is refused.
+  std::string marker = "c";
+  const std::uint64_t count = n;
+  marker.append(reinterpret_cast<const char*>(&count), sizeof count);
+  const std::size_t at = constant.find(marker);
+  ASSERT_NE(at, std::string::npos);
+  std::string damaged = constant;
+  damaged[at + 1] = static_cast<char>(damaged[at + 1] + 1);
+  EXPECT_THROW(decodeFrame(damaged), InputError);
 }
 
 TEST(FrameStream, DamagedBytesAreRefused) {
