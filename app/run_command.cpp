@@ -365,10 +365,8 @@ int runCommand(const RunArgs& args) {
     auto validate = [&] {
       for (std::size_t k = next++; k < order.size(); k = next++) {
         const std::size_t i = order[k];
-        if (k >= first_with_meshes) {
-          const std::shared_future<void> mine = prefetched;  // a copy per thread
-          mine.wait();
-        }
+        // (wait() is const: threads may call it on one object, [res.on.data.races].)
+        if (k >= first_with_meshes) prefetched.wait();
         try {
           const Scene scene = loadScene(files[i]);
           checkResources(scene, RendererKind::Reference, limits);
