@@ -160,6 +160,7 @@ Frame Renderer::run() {
   const std::uint32_t clear_key = depthKey(clampDepth(scene_.clear_depth), depth_format_);
   // The depth plane is written once, from the keys, when the frame is drawn.
   frame_.allocate(fb_width_, fb_height_, clear_rgba, std::nullopt, uncertainty_);
+  if (options_.optional_cover != nullptr) options_.optional_cover->assign(frame_.pixelCount(), 0);
   depth_.assign(frame_.pixelCount(), clear_key);
   if (uncertainty_) gaps_.reset(frame_, depth_format_, clampDepth(scene_.clear_depth));
   edges_.clear();

@@ -428,6 +428,7 @@ void Renderer::markAmbiguous(const WindowVertex& a, const WindowVertex& b, doubl
       const glm::dvec2 off = glm::abs(c - (pa + t * d));
       if (std::max(off.x, off.y) > radius) continue;  // squares: a point's shape
       frame_.edge_dist[frameIndex(px, py)] = 0.0f;
+      if (options_.optional_cover != nullptr) (*options_.optional_cover)[frameIndex(px, py)] = 1;
     }
   }
 }

@@ -91,7 +91,8 @@ std::shared_ptr<Texture> targetTexture(const Frame& frame, const std::string& na
 // none); where a depth test is within twice its tolerances of a tie, or a blend may go
 // either way, any colour (the other fragment shows nowhere in the target).
 std::vector<float> targetUncertainty(const Frame& frame, DepthFormat format,
-                                     const glm::dvec4& clear) {
+                                     const glm::dvec4& clear,
+                                     const std::vector<std::uint8_t>& optional_cover) {
   std::vector<float> out(frame.pixelCount(), 0.0f);
   if (!frame.hasUncertainty()) return out;
   for (int y = 0; y < frame.height; ++y) {
@@ -109,7 +110,8 @@ std::vector<float> targetUncertainty(const Frame& frame, DepthFormat format,
            (frame.edge_dist[i] <= kMapBandPx ||
             frame.blend_gap[i] <=
                 2.0 * depthAllowanceSteps(frame, format, i, finiteOr0(frame.blend_slope[i]))));
-      if (tie) u = 255.0;
+      // A primitive drawn in one implementation and not the other: any colour.
+      if (tie || (!optional_cover.empty() && optional_cover[i] != 0)) u = 255.0;
       if (!tie && coverageOpen(frame, format, i)) {
         for (int c = 0; c < 4; ++c)  // the background
           u = std::max(u, 1.0 + 255.0 * std::fabs(clear[c] - frame.color[i * 4 + c]));
@@ -145,7 +147,8 @@ void bindInputs(Scene& pass_scene, const Bound& bound) {
 
 }  // namespace
 
-void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map) {
+void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map,
+                    const std::vector<std::uint8_t>* optional_cover) {
   const std::size_t n = frame.pixelCount();
   map.lo.assign(n, 0.0);
   map.hi.assign(n, 0.0);
@@ -183,6 +186,11 @@ void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map) 
           lo = std::min(lo, clear_depth);
           hi = std::max(hi, clear_depth);
         }
+        // A primitive only another implementation draws (or only this one): any depth.
+        if (optional_cover != nullptr && i < optional_cover->size() && (*optional_cover)[i] != 0) {
+          lo = 0.0;
+          hi = 1.0;
+        }
       }
       map.lo[k] = lo;
       map.hi[k] = hi;
@@ -198,6 +206,8 @@ PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options) {
     bindInputs(ps, bound);
     ReferenceOptions o = options;
     o.uncertainty = true;  // the map's range comes from its channels
+    std::vector<std::uint8_t> cover;
+    o.optional_cover = &cover;
     Frame f = renderReference(ps, o);
     const std::string& name = scene.passes[k].target;
     const RenderTarget* target = findTarget(scene, name);
@@ -213,12 +223,12 @@ PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options) {
       map->depth.resize(f.pixelCount());
       for (int y = 0; y < f.height; ++y)
         for (int x = 0; x < f.width; ++x) map->depth[texelIndex(f, x, y)] = f.depth[f.index(x, y)];
-      if (options.uncertainty) shadowMapRange(f, ps.clear_depth, *map);
+      if (options.uncertainty) shadowMapRange(f, ps.clear_depth, *map, &cover);
       bound.maps[name] = std::move(map);
     } else if (target != nullptr) {
       auto texture = targetTexture(f, name);
       if (options.uncertainty)
-        texture->uncertainty = targetUncertainty(f, ps.state.depth_format, ps.clear_color);
+        texture->uncertainty = targetUncertainty(f, ps.state.depth_format, ps.clear_color, cover);
       bound.textures[name] = std::move(texture);
     }
     out.frames.push_back(std::move(f));

@@ -4,6 +4,7 @@
 // conforming implementation's contents may take, and bound into the passes that sample it.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "fixtures/frame.h"
@@ -21,7 +22,9 @@ PassOutputs renderPasses(const Scene& scene, const ReferenceOptions& options);
 
 // The range a conforming implementation's stored depth may take at each texel of a depth
 // target the reference drew as `frame` (its channels; docs/tolerances.md "Shadow maps"),
-// written into map.lo and map.hi (texel rows bottom-up, as map.depth).
-void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map);
+// written into map.lo and map.hi (texel rows bottom-up, as map.depth). `optional_cover`
+// (ReferenceOptions::optional_cover of the pass, or null): pixels where any depth may be.
+void shadowMapRange(const Frame& frame, double clear_depth, ShadowMapData& map,
+                    const std::vector<std::uint8_t>* optional_cover = nullptr);
 
 }  // namespace rc::ref

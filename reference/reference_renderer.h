@@ -48,6 +48,13 @@ struct ReferenceOptions {
   // colour per flat triangle, Gouraud written out, Phong eight fragments at a time in vector
   // lanes). The same bits, slower: tests render both ways and compare (FragmentLoop.*).
   bool fragment_definition_only = false;
+  // When set (the target passes of a multi-pass scene), filled with one byte per pixel (the
+  // frame's pixel order): 1 where a primitive may be drawn in another implementation and
+  // not here, or here and not there (markAmbiguous: a point whose centre is outside the view
+  // volume, drawn as its square's part inside; vertices and edges made by clipping at the
+  // viewport; a polygon whose facing float32 may flip). A target may hold anything there,
+  // which the frame's channels (edge_dist 0) say for the frame but not what it stored.
+  std::vector<std::uint8_t>* optional_cover = nullptr;
 };
 
 // Renders the scene. Throws InputError for options out of range (subpixel_bits outside

@@ -13,6 +13,7 @@
 
 #include "fixtures/loader.h"
 #include "fixtures/scene_logic.h"
+#include "reference/multipass.h"
 #include "reference/reference_renderer.h"
 #include "reference/shadow.h"
 
@@ -163,6 +164,38 @@ TEST(Shadow, UncertaintyIsZeroInsideTheRegionsAndTheWholeLightAtTheBorder) {
     }
   }
   EXPECT_GT(border, 20);
+}
+
+// A point whose centre lies just outside the map (the blocker in polygon mode point, one
+// corner a third of a texel past the map's right border, 4 px points): GL discards it, a
+// driver that clips points as squares draws its part inside (llvmpipe: campaign s20261339
+// scene 00030, 258 units of shadow on the floor). The map's range is open there, any depth,
+// and nowhere else: the columns it may reach, the texels around its corner.
+TEST(Shadow, APointOnlyAnotherDriverDrawsOpensTheMapsRangeWhereItMayReach) {
+  json doc = blockerScene();
+  doc["objects"][1]["state"] = {{"polygon_mode", "point"}};
+  doc["state"]["point_size"] = 4;
+  // x in [1.52, 2.02]: the corners at x = 2.02 map to texel x 64.32 of 64, the others inside.
+  for (auto& p : doc["objects"][1]["mesh"]["positions"])
+    p[0] = p[0].get<double>() < 0.0 ? 1.52 : 2.02;
+  const ref::PassOutputs out = ref::renderPasses(load(doc), ReferenceOptions{});
+  const std::shared_ptr<const ShadowMapData>& map = out.frame_scene.materials[0].shadow->data;
+  ASSERT_TRUE(map);
+  ASSERT_EQ(map->lo.size(), static_cast<std::size_t>(64 * 64));
+  int open = 0;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const std::size_t k = static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x);
+      const bool any = map->lo[k] == 0.0 && map->hi[k] == 1.0;
+      if (x < 60) {
+        EXPECT_FALSE(any) << x << "," << y;  // the points inside are drawn, their range tight
+      }
+      open += any ? 1 : 0;
+    }
+  }
+  // Two corners, each a square of 4 px (+1 of reach) around a centre 0.32 px outside.
+  EXPECT_GE(open, 2 * 2 * 4);
+  EXPECT_LE(open, 2 * 4 * 11);
 }
 
 // Linear lookups give values between lit and shadowed at the border (the reference's
