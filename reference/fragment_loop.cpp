@@ -779,6 +779,15 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
         constexpr int kSteps = 48;
         const int steps = slack_t > 0.0 ? kSteps : 0;
         const int levels = std::isnan(lo) || lo == hi ? 1 : 3;
+        // What another implementation's inputs may change at each sampled parameter (a shadow
+        // lookup that may go the other way, a rendered texture's texels): the driver's colour
+        // at its parameter q may differ from the reference's there by that much, on top of
+        // the slack, so the largest over q is added (the note at s alone missed a fragment lit
+        // at another parameter where the reference's was in shadow: campaign s20261341 scene
+        // 00039, 47 units on llvmpipe and zink).
+        const bool cross_terms = (t.shading != nullptr && t.shading->shadowed) ||
+                                 (t.texture != nullptr && !t.texture->uncertainty.empty());
+        double inputs = 0.0;
         double worst = 0.0;
         double step = 0.0;
         glm::dvec4 last(0.0);
@@ -791,7 +800,10 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
             double ignore_hi = 0.0;
             t.line_lambda = std::isnan(lo) ? lambda_at(q, ignore_lo, ignore_hi)
                                            : (l == 0 ? lo : (l == 1 ? hi : 0.5 * (lo + hi)));
-            const glm::dvec4 c = fragmentColor<kShading>(t, w, nullptr);
+            TexelNote q_note;
+            const glm::dvec4 c =
+                fragmentColor<kShading>(t, w, nullptr, cross_terms ? &q_note : nullptr);
+            inputs = std::max(inputs, static_cast<double>(q_note.normal));
             c_lo = glm::min(c_lo, glm::dvec3(c));
             c_hi = glm::max(c_hi, glm::dvec3(c));
             for (int ch = 0; ch < 3; ++ch) {
@@ -806,7 +818,12 @@ void Renderer::shadeLineFragments(const std::vector<LinePixel>& pixels, const Wi
           c_lo -= step;
           c_hi += step;
         }
-        colour_reach = static_cast<float>(255.0 * worst);
+        colour_reach = static_cast<float>(255.0 * worst + inputs);
+        // The range another edge's fragment here may take (outline_spread_) includes it too.
+        if (inputs > 0.0) {
+          c_lo -= inputs / 255.0;
+          c_hi += inputs / 255.0;
+        }
         if (shared && !outline_dry_) {
           if (const OutlineSpread* it = spread_at(index)) {
             const glm::dvec3 d_lo = glm::dvec3(own) - it->c_lo;
