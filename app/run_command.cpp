@@ -334,9 +334,10 @@ int runCommand(const RunArgs& args) {
     std::exception_ptr error;
   };
   std::vector<Checked> checked;
-  // Where the check has come (guarded by check_mutex): per file 0 unchecked, 1 fine, 2 bad.
+  // Where the check has come (guarded by check_mutex): per file, one of these.
+  enum class CheckState : char { Unchecked, Fine, Bad, Queued /* fine, its renders queued */ };
   std::mutex check_mutex;
-  std::vector<char> check_state;
+  std::vector<CheckState> check_state;
   auto check = [&] {
     // Not the report folder (an earlier run's variant probes are scenes too).
     files = findFixtures(inputs, {args.out});
@@ -359,7 +360,7 @@ int runCommand(const RunArgs& args) {
     checked.resize(files.size());
     {
       const std::lock_guard lock(check_mutex);
-      check_state.assign(files.size(), 0);
+      check_state.assign(files.size(), CheckState::Unchecked);
     }
     std::atomic<std::size_t> next{0};
     auto validate = [&] {
@@ -380,7 +381,7 @@ int runCommand(const RunArgs& args) {
           checked[i].error = std::current_exception();
         }
         const std::lock_guard lock(check_mutex);
-        check_state[i] = checked[i].error ? 2 : 1;
+        check_state[i] = checked[i].error ? CheckState::Bad : CheckState::Fine;
       }
     };
     const std::size_t threads = std::min<std::size_t>(files.size(), parallel);
@@ -400,18 +401,16 @@ int runCommand(const RunArgs& args) {
   std::map<std::pair<std::size_t, std::string>, std::size_t> early_tickets;
   std::size_t early_fixtures = 0;
   std::size_t early_bytes = 0;
-  std::vector<bool> early_queued;
   auto queueChecked = [&] {
     if (!early_renders) return;
     std::vector<std::pair<std::size_t, fs::path>> ready;
     {
       const std::lock_guard lock(check_mutex);
-      early_queued.resize(check_state.size());
       for (std::size_t i = 0; i < check_state.size() && early_fixtures < kEarlyFixtures; ++i) {
-        if (check_state[i] != 1 || early_queued[i]) continue;
+        if (check_state[i] != CheckState::Fine) continue;
         const std::size_t bytes = checked[i].samples * bytes_per_sample;
         if (early_bytes + bytes > kEarlyBytes) continue;  // a smaller one may fit
-        early_queued[i] = true;
+        check_state[i] = CheckState::Queued;
         early_bytes += bytes;
         ++early_fixtures;
         ready.emplace_back(i, checked[i].entry.file);

@@ -61,11 +61,6 @@ fs::path pairImageCache(int w, int h) {
   return userCacheDir();
 }
 
-const std::string& imageModule() {
-  static const std::string module = image_io::moduleIdentity();
-  return module;
-}
-
 void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_t>& rgb,
                const fs::path& target) {
   ImageFormat format{.width = w, .height = h, .channels = 3, .type = PixelType::UInt8};
@@ -75,10 +70,10 @@ void writeRgb8(const fs::path& file, int w, int h, const std::vector<std::uint8_
                       {"png:filter", store ? kPngFilterNone : kPngFilterSub}};
   }
   const fs::path user = pairImageCache(w, h);
-  const std::string key = user.empty()
-                              ? std::string()
-                              : fmt::format("rastercheck rgb8 1|{}|{}|{}x{}|{}|{}", imageModule(),
-                                            file.extension().string(), w, h, store, bytesKey(rgb));
+  const std::string key =
+      user.empty() ? std::string()
+                   : fmt::format("rastercheck rgb8 1|{}|{}|{}x{}|{}|{}", image_io::moduleIdentity(),
+                                 file.extension().string(), w, h, store, bytesKey(rgb));
   writeThroughUserCache(
       user, key, "rcpair", file, [&] { image_io::writeImage(file, format, rgb.data(), target); },
       kUserPairImageCacheBytes);
@@ -201,9 +196,9 @@ void writeDiffExr(const Frame& expected, const Frame& actual, const ClassMaps& m
   if (!user.empty()) {
     // The names with their lengths: no two pairs' texts run together into one key.
     const std::string pair = result.expected + " vs " + result.actual;
-    key = fmt::format("rastercheck diff.exr 1|{}|{}x{}|{}|{}:{}|{}:{}|", imageModule(), w, h,
-                      format.text.at(0).second, result.fixture.size(), result.fixture, pair.size(),
-                      pair);
+    key = fmt::format("rastercheck diff.exr 1|{}|{}x{}|{}|{}:{}|{}:{}|", image_io::moduleIdentity(),
+                      w, h, format.text.at(0).second, result.fixture.size(), result.fixture,
+                      pair.size(), pair);
     for (const std::string& part :
          {bytesKey(maps.pixel_class), bytesKey(maps.depth_steps), bytesKey(maps.depth_tolerance),
           bytesKey(maps.shading_abs), bytesKey(maps.shading_tolerance), bytesKey(expected.color),

@@ -48,6 +48,14 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
+// A pool of this build's workers, their logs in DIR/workers.
+rc::WorkerPool::Options poolOptions(const fs::path& dir) {
+  rc::WorkerPool::Options options;
+  options.log_dir = dir / "workers";
+  options.program = RC_EXE;
+  return options;
+}
+
 // Three fixtures llvmpipe renders within tolerance; the middle one gets the fault.
 const std::string kFixtures = catalog("coverage/triangle_fan.json") + " " +
                               catalog("zbuffer/interpenetrating_ab.json") + " " +
@@ -285,10 +293,7 @@ TEST(GlWorkers, TheFaultsHangAndCrashARenderOnTheirOwn) {
 TEST(GlWorkers, ARequestsFaultAppliesToThatRenderAlone) {
   const fs::path dir = scratch("request_fault");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
-  rc::WorkerPool::Options options;
-  options.log_dir = dir / "workers";
-  options.program = RC_EXE;
-  rc::WorkerPool pool(options);
+  rc::WorkerPool pool(poolOptions(dir));
   const fs::path fixture = catalog("shading/sphere_gouraud_low.json");
   auto render = [&](const std::string& fault) {
     rc::RenderOutcome o = pool.renderAll({{fixture, "gl:egl:llvmpipe", fault}}).front();
@@ -347,10 +352,7 @@ TEST(GlWorkers, CampaignScenesThatShowedReferenceGapsPass) {
 TEST(GlWorkers, AWorkerSendsTheFramePassWithoutThePassFrames) {
   const fs::path dir = scratch("frame_pass_only");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
-  rc::WorkerPool::Options options;
-  options.log_dir = dir / "workers";
-  options.program = RC_EXE;
-  rc::WorkerPool pool(options);
+  rc::WorkerPool pool(poolOptions(dir));
   const fs::path fixture = catalog("multipass/mirror_quad.json");
   for (const char* spec : {"ref", "gl:egl:llvmpipe"}) {
     SCOPED_TRACE(spec);
@@ -399,9 +401,7 @@ TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
     };
     std::vector<std::size_t> order(files.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    rc::WorkerPool::Options options;
-    options.log_dir = dir / "workers";
-    options.program = RC_EXE;
+    const rc::WorkerPool::Options options = poolOptions(dir);
     // What each scene gives in a new context of its own.
     std::vector<std::string> fresh;
     {
