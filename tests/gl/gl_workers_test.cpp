@@ -15,6 +15,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -433,6 +434,59 @@ TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
     EXPECT_TRUE(bytes(aba[0]) == fresh[a] && bytes(aba[1]) == fresh[b] &&
                 bytes(aba[2]) == fresh[a]);
     EXPECT_EQ(pool.workersStarted(), 1);
+  }
+  fs::remove_all(dir);
+}
+
+// `run`'s workers choose llvmpipe's rasterizer threads (none where every core already runs a
+// render: app/worker_pool.cpp), which is only allowed because the thread count does not
+// change a frame: random scenes of every profile and the whole catalog, rendered by workers
+// without rasterizer threads and by workers with three, must give the same bits on llvmpipe
+// and zink (lavapipe rasterizes like llvmpipe), and frame.json says what the worker had.
+TEST(GlWorkers, RasterizerThreadsDoNotChangeTheBits) {
+  const fs::path dir = scratch("rasterizer_threads");
+  if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
+  std::vector<fs::path> files = rc::test::writeRandomProfiles(dir / "random", 20261206, 2, 96, 72);
+  for (const auto& e : fs::recursive_directory_iterator(catalog("")))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 50u);
+  for (const char* spec : {"gl:egl:llvmpipe", "gl:egl:zink"}) {
+    SCOPED_TRACE(spec);
+    std::vector<rc::RenderRequest> requests;
+    requests.reserve(files.size());
+    for (const fs::path& f : files) requests.push_back({f, spec, ""});
+    auto renderWith = [&](const std::string& threads) {
+      rc::WorkerPool::Options o = poolOptions(dir);
+      o.environment.push_back("LP_NUM_THREADS=" + threads);
+      rc::WorkerPool pool(o);
+      return pool.renderAll(requests);
+    };
+    const std::vector<rc::RenderOutcome> none = renderWith("0");
+    const std::vector<rc::RenderOutcome> three = renderWith("3");
+    ASSERT_EQ(none.size(), files.size());
+    ASSERT_EQ(three.size(), files.size());
+    int rendered = 0;
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      SCOPED_TRACE(files[i].string());
+      ASSERT_EQ(none[i].ok, three[i].ok) << none[i].error << " / " << three[i].error;
+      if (!none[i].ok) continue;  // not supported (zink's multisampling on Mesa 22)
+      ++rendered;
+      EXPECT_EQ(none[i].frame.meta["mesa"]["lp_num_threads"], "0");
+      EXPECT_EQ(three[i].frame.meta["mesa"]["lp_num_threads"], "3");
+      EXPECT_TRUE(rc::test::framePlanes(none[i].frame) == rc::test::framePlanes(three[i].frame));
+    }
+    EXPECT_GE(rendered, 40);
+  }
+  // Without a setting of the user's, a pool that runs a render per core gives its workers none.
+  if (std::getenv("LP_NUM_THREADS") == nullptr) {
+    rc::WorkerPool::Options o = poolOptions(dir);
+    o.max_busy = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    rc::WorkerPool pool(o);
+    const rc::RenderOutcome got =
+        pool.renderAll({{catalog("coverage/triangle_fan.json"), "gl:egl:llvmpipe", ""}}).front();
+    ASSERT_TRUE(got.ok) << got.error;
+    EXPECT_EQ(got.frame.meta["mesa"]["lp_num_threads"], "0");
   }
   fs::remove_all(dir);
 }
