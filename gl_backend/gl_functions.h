@@ -55,6 +55,7 @@ namespace rc::gl {
   X(PFNGLREADPIXELSPROC, ReadPixels)                                                   \
   X(PFNGLPIXELSTOREIPROC, PixelStorei)                                                 \
   X(PFNGLFINISHPROC, Finish)                                                           \
+  X(PFNGLFLUSHPROC, Flush)                                                             \
   X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                                         \
   X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                                         \
   X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                                   \

@@ -187,11 +187,56 @@ struct Session {
   // A render that did not finish (its context state unknown): the next gets a new context
   // even where contexts are reused (reusesContext).
   bool render_unfinished = false;
-  // The last render drew lines or points (softpipe: the next render gets a new context).
-  bool drew_lines = false;
+  // Mesa's fallback textures (FallbackFlush) this context has created, and those a new
+  // context would have created by now in the current render.
+  unsigned fallbacks_created = 0;
+  unsigned fallbacks_this_render = 0;
   const char* context_use = "new";       // frame.json "context": new, reused or replaced
   const char* program_use = "compiled";  // frame.json "program": compiled or reused
   bool program_binary = false;           // frame.json "program_binary"
+};
+
+// Mesa's fallback textures, what a sampler reads where its unit holds no complete texture:
+// Mesa creates one per target and kind (colour, depth) the first time a draw in a share group
+// needs it, and flushes the context when it does (_mesa_get_fallback_texture,
+// src/mesa/main/texobj.c). softpipe's flush writes its colour tile cache back to an rgba8
+// buffer, and blending after it reads the stored 8-bit values instead of the cache's floats
+// (docs/results/findings.md, "softpipe: a reused context changes later frames"). A new
+// context therefore flushes at the render's first draw whose material has no texture (or no
+// shadow map), and a reused one, whose fallbacks exist, would not: before each draw in a
+// softpipe context, beforeDraw() flushes where a new context's Mesa would have.
+struct FallbackFlush {
+  static constexpr unsigned kColor2D = 1;  // sampler2D on unit 0 (the material's texture)
+  static constexpr unsigned kDepth2D = 2;  // sampler2DShadow on unit 1 (the shadow map)
+  Session* s = nullptr;                    // null: the driver's frames do not depend on it
+  bool shadow_unit = false;                // the program has the shadow sampler
+
+  FallbackFlush(Session& session, const Program& program)
+      : s(session.driver == "softpipe" && !gl::testing::hooks().no_fallback_flush ? &session
+                                                                                  : nullptr),
+        shadow_unit(program.shadow_map >= 0) {}
+
+  void beforeDraw() const {
+    if (s == nullptr) return;
+    const gl::Functions& gl = s->gl;
+    GLint active = GL_TEXTURE0;
+    gl.GetIntegerv(GL_ACTIVE_TEXTURE, &active);
+    const auto empty = [&](GLenum unit) {
+      GLint texture = 0;
+      gl.ActiveTexture(unit);
+      gl.GetIntegerv(GL_TEXTURE_BINDING_2D, &texture);
+      return texture == 0;
+    };
+    unsigned needed = empty(GL_TEXTURE0) ? kColor2D : 0;
+    if (shadow_unit && empty(GL_TEXTURE1)) needed |= kDepth2D;
+    gl.ActiveTexture(static_cast<GLenum>(active));
+    const unsigned first = needed & ~s->fallbacks_this_render;
+    if (first == 0) return;
+    // Where the context lacks one of them, Mesa flushes by itself.
+    if ((first & ~s->fallbacks_created) == 0) gl.Flush();
+    s->fallbacks_this_render |= first;
+    s->fallbacks_created |= first;
+  }
 };
 
 std::mutex g_mutex;
@@ -281,44 +326,21 @@ bool keepsOneContext(const Session& s) {
   return s.zink && s.mesa_version.rfind("Mesa 22.", 0) == 0;
 }
 
-// softpipe's one dependence on what its context drew before (docs/gl_backend.md, "softpipe
-// and its context"): its colour tile cache holds a tile as floats (a cleared tile as the
-// clear colour's floats, unclamped: sp_tile_cache.c clear_tile_rgba; a blended one clamped
-// but not rounded to 8 bits) until the tile is written back to the rgba8 buffer, and blending
-// reads the destination from the cache. Whether a write-back comes between two draws (or the
-// clear and a draw) depends on what the context holds from earlier renders (texture cache
-// slots that still reference old textures make a later resource map flush every cache), so
-// blending onto an 8-bit buffer may read the floats or the stored 8-bit values. Those renders
-// get a new context; without blending, or into rgba32f, the tile's values are what is stored.
-bool blendsOntoRgba8(const Scene& scene, const std::vector<DrawPass>& passes) {
-  if (scene.state.color_format != ColorFormat::RGBA8) return false;
-  return std::any_of(passes.begin(), passes.end(), [](const DrawPass& p) { return p.blend; });
-}
-
-// Lines, points or polygon modes: in a reused context softpipe draws them differently from a
-// new one, and a render after them too (docs/results/findings.md "softpipe: lines after lines
-// in a reused context"): they get a new context, and so does the render after them.
-bool drawsLines(const std::vector<DrawPass>& passes) {
-  return std::any_of(passes.begin(), passes.end(),
-                     [](const DrawPass& p) { return p.rasterizesLinesOrPoints(); });
-}
-
 // Whether the next render reuses this process's context, and with it the programs it
 // compiled, instead of starting from a new one (resetReusedContext() restores what a render
 // does not set itself): where the isolation test shows that a frame is the one a new context
 // gives, whatever the context drew before (GlBackend.FramesDoNotDependOnWhatWasDrawnBefore),
-// that is llvmpipe and zink; zink on Mesa 22 in any case (keepsOneContext); and softpipe but
-// for the renders blendsOntoRgba8() names. A driver the test has not run on (a GPU)
-// gets a new context per render. RASTERCHECK_GL_CONTEXT=new gives every driver but zink on
+// that is llvmpipe, zink and softpipe (softpipe with FallbackFlush); zink on Mesa 22 in any
+// case (keepsOneContext). A driver the test has not run on (a GPU) gets a new context per
+// render. RASTERCHECK_GL_CONTEXT=new gives every driver but zink on
 // Mesa 22 a new context per render, =reuse reuses it on every driver and render (to test
 // one); it is read at every render.
-bool reusesContext(const Session& s, bool blends_onto_rgba8, bool lines) {
+bool reusesContext(const Session& s) {
   if (keepsOneContext(s)) return true;
   const char* forced = std::getenv("RASTERCHECK_GL_CONTEXT");
   if (forced != nullptr && std::string_view(forced) == "new") return false;
   if (forced != nullptr && std::string_view(forced) == "reuse") return true;
-  if (s.driver == "softpipe") return !blends_onto_rgba8 && !lines && !s.drew_lines;
-  return s.driver == "llvmpipe" || s.driver == "zink";
+  return s.driver == "llvmpipe" || s.driver == "zink" || s.driver == "softpipe";
 }
 
 std::unique_ptr<Session> createSession(const GlSpec& spec) {
@@ -383,6 +405,7 @@ void renewContext(Session& s, bool abandon_old = false) {
   s.sample_program = 0;
   s.empty_vertex_array = 0;
   s.framebuffer = Framebuffer{};
+  s.fallbacks_created = 0;
   s.debug_errors.clear();
   if (abandon_old) {
     s.context->abandon();
@@ -419,9 +442,7 @@ void resetReusedContext(Session& s) {
 }
 
 // Returns the session for spec, made current on this thread.
-// `blends_onto_rgba8`, `lines`: blendsOntoRgba8() and drawsLines() of the scene about to be
-// drawn.
-Session& acquireSession(const GlSpec& spec, bool blends_onto_rgba8, bool lines) {
+Session& acquireSession(const GlSpec& spec) {
   // A missing GPU is the answer for an egl-device spec, whatever else this process runs.
   if (spec.platform == GlSpec::Platform::EglDevice) gl::findEglDevice(spec.device);
   if (g_session == nullptr) {
@@ -444,7 +465,7 @@ Session& acquireSession(const GlSpec& spec, bool blends_onto_rgba8, bool lines) 
         spec.driver, have.driver, toString(spec)));
   }
   Session& s = *g_session;
-  const bool reuse = reusesContext(s, blends_onto_rgba8, lines);
+  const bool reuse = reusesContext(s);
   s.context_use = !reuse ? "new" : s.render_unfinished ? "replaced" : "reused";
   if (!reuse) {
     renewContext(s);
@@ -1138,13 +1159,14 @@ void appendOffsetProbe(gl::VertexData& data) {
 }
 
 double measureOffsetR(const gl::Functions& gl, const Program& p, const Scene& scene,
-                      GLint first_vertex) {
+                      GLint first_vertex, const FallbackFlush& fallback) {
   const glm::mat4 identity(1.0f);
   gl.UniformMatrix4fv(p.view_projection, 1, GL_FALSE, glm::value_ptr(identity));
   DrawPass probe;
   probe.depth_func = DepthFunc::Always;
   probe.ops.polygon_offset = PolygonOffset{0.0, kOffsetProbeUnits};
   setPassState(gl, probe, gl::testing::Faults{});
+  fallback.beforeDraw();
   gl.DrawArrays(GL_TRIANGLES, first_vertex, static_cast<GLsizei>(kOffsetProbeVertices));
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
   double offset_steps = 0.0;  // the offset in steps of r_min
@@ -1176,7 +1198,8 @@ double measureOffsetR(const gl::Functions& gl, const Program& p, const Scene& sc
 
 void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
                   const gl::VertexData& data, const std::vector<GLuint>& textures,
-                  const std::vector<MaterialShadow>& shadows, const gl::testing::Faults& faults) {
+                  const std::vector<MaterialShadow>& shadows, const gl::testing::Faults& faults,
+                  const FallbackFlush& fallback) {
   std::uint32_t bound_material = UINT32_MAX;
   for (const gl::PassRuns& pass : data.passes) {
     setPassState(gl, pass.state, faults);
@@ -1187,6 +1210,7 @@ void drawPassesGl(const gl::Functions& gl, const Program& p, const Scene& scene,
         bound_material = run.material;
       }
       constexpr std::array<GLenum, 3> kPrimitives{GL_TRIANGLES, GL_LINES, GL_POINTS};
+      fallback.beforeDraw();
       gl.DrawArrays(kPrimitives.at(static_cast<std::size_t>(pass.state.primitive)),
                     static_cast<GLint>(run.first_vertex), static_cast<GLsizei>(run.vertex_count));
     }
@@ -1705,7 +1729,8 @@ Frame drawTargetPass(Session& s, const Program& program, const Scene& scene, std
   setSceneUniforms(gl, program, ps, none);
   setFixedState(gl, ps);
   clearFramebuffer(gl, ps);
-  drawPassesGl(gl, program, ps, data, textures, materialShadows(scene, ps, targets, none), none);
+  drawPassesGl(gl, program, ps, data, textures, materialShadows(scene, ps, targets, none), none,
+               FallbackFlush(s, program));
   resetPassState(gl);
   checkGl(s, fmt::format("pass {} (target {})", k, target.name).c_str());
   Frame frame;
@@ -1727,9 +1752,8 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames
   const gl::testing::Faults faults = activeFaults();  // bad RASTERCHECK_GL_FAULT: exit 2
   const std::vector<DrawPass> passes = drawPasses(scene);
   auto start = Clock::now();
-  const bool lines = drawsLines(passes);
-  Session& s = acquireSession(spec, blendsOntoRgba8(scene, passes), lines);
-  s.drew_lines = lines;
+  Session& s = acquireSession(spec);
+  s.fallbacks_this_render = 0;
   struct Release {
     Session& s;
     ~Release() { s.context->release(); }
@@ -1842,10 +1866,10 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames
   std::optional<double> offset_r;
   if (probe_offset) {
     clearFramebuffer(gl, scene);
-    offset_r = measureOffsetR(gl, program, scene, probe_first);
+    offset_r = measureOffsetR(gl, program, scene, probe_first, FallbackFlush(s, program));
   }
   clearFramebuffer(gl, scene);
-  drawPassesGl(gl, program, scene, data, textures, shadows, faults);
+  drawPassesGl(gl, program, scene, data, textures, shadows, faults, FallbackFlush(s, program));
   resetPassState(gl);
   gl.Finish();
   injectStall(faults, scene.name);

@@ -101,6 +101,7 @@ struct Hooks {
   Faults faults;                       // any(): used instead of RASTERCHECK_GL_FAULT
   bool ignore_pack_invert = false;     // read back as if GL_MESA_pack_invert were missing
   bool program_from_source = false;    // draw with the program as linked, not its binary
+  bool no_fallback_flush = false;      // a reused softpipe context skips FallbackFlush's flushes
 };
 
 // The process-wide hooks (all off by default).

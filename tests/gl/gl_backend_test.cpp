@@ -287,9 +287,9 @@ struct HookGuard {
 // Both readback paths (rows inverted by GL_MESA_pack_invert, or swapped afterwards) give
 // the same frame for every colour and depth format, at an odd height (middle row).
 // llvmpipe, zink and softpipe reuse the process's context and its programs from one render to
-// the next (softpipe not for renders that blend onto rgba8; a driver the isolation test has
-// not run on gets a new context per render); a render that failed halfway is followed by a
-// new context ("replaced"), and the next reuses that one.
+// the next, whatever they draw (a driver the isolation test has not run on gets a new context
+// per render); a render that failed halfway is followed by a new context ("replaced"), and the
+// next reuses that one.
 TEST_F(GlBackend, ContextIsReusedWhereIsolationIsShown) {
   Scene s = orthoScene(8, 8);
   s.objects.push_back(quad(-1, -1, 1, 1, 0, addMaterial(s, Material{})));
@@ -314,19 +314,51 @@ TEST_F(GlBackend, ContextIsReusedWhereIsolationIsShown) {
   EXPECT_EQ(c.meta.at("context"), keeps ? "reused" : "new");
   EXPECT_EQ(c.color, a.color);
   EXPECT_EQ(c.id, a.id);
-  if (driver != "softpipe" || forced != nullptr) return;
-  // softpipe: blending onto rgba8 gets a new context (its tile cache: docs/gl_backend.md);
-  // the same blending into rgba32f, or rgba8 without it, reuses the context.
+  if (forced != nullptr) return;
+  // Blending onto rgba8 and lines too (softpipe took new contexts for them before
+  // FallbackFlush).
   Scene blended = s;
   blended.materials[0].opacity = 0.5;
   blended.state.blend = Blend::Alpha;
   blended.state.color_format = ColorFormat::RGBA8;
-  EXPECT_EQ(render(blended).meta.at("context"), "new");
-  blended.state.color_format = ColorFormat::RGBA32F;
-  EXPECT_EQ(render(blended).meta.at("context"), "reused");
-  Scene opaque = s;
-  opaque.state.color_format = ColorFormat::RGBA8;
-  EXPECT_EQ(render(opaque).meta.at("context"), "reused");
+  EXPECT_EQ(render(blended).meta.at("context"), keeps ? "reused" : "new");
+  Scene wire = s;
+  wire.objects[0].state.polygon_mode = PolygonMode::Line;
+  EXPECT_EQ(render(wire).meta.at("context"), keeps ? "reused" : "new");
+}
+
+// Mesa creates its fallback texture (what a sampler reads where its unit has no texture) the
+// first time a context draws with such a unit, and flushes the context when it does; softpipe
+// blends after that flush over the stored 8-bit colour instead of its tile cache's floats. In
+// transparency/softpipe_unclamped_clear_blend the textured quad comes first, so a new context
+// flushes between the two quads; a context reused after a render of an untextured material
+// has the fallback already, and FallbackFlush flushes there in its place. Every driver must
+// give the new context's bits in the reused one; on softpipe, without the harness's flush
+// (the no_fallback_flush hook) the frame differs, which shows the flush is what it takes.
+TEST_F(GlBackend, AReusedContextFlushesWhereANewOneCreatesItsFallbackTexture) {
+  const Scene scene = loadScene(fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes" / "transparency" /
+                                "softpipe_unclamped_clear_blend.json");
+  Scene untextured = orthoScene(8, 8);
+  untextured.objects.push_back(quad(-1, -1, 1, 1, 0, addMaterial(untextured, Material{})));
+  const char* outer = std::getenv("RASTERCHECK_GL_CONTEXT");
+  if (outer != nullptr) GTEST_SKIP() << "RASTERCHECK_GL_CONTEXT=" << outer << " decides contexts";
+  ::setenv("RASTERCHECK_GL_CONTEXT", "new", 1);
+  const Frame fresh = render(scene);
+  ::unsetenv("RASTERCHECK_GL_CONTEXT");
+  const std::string driver = fresh.meta.at("driver");
+  if (driver != "llvmpipe" && driver != "zink" && driver != "softpipe")
+    GTEST_SKIP() << driver << " gets a new context per render";
+  render(untextured);
+  const Frame reused = render(scene);
+  EXPECT_EQ(reused.meta.at("context"), "reused");
+  EXPECT_TRUE(test::framePlanes(reused) == test::framePlanes(fresh));
+  if (driver != "softpipe") return;
+  HookGuard guard;
+  gl::testing::hooks().no_fallback_flush = true;
+  render(untextured);
+  const Frame unflushed = render(scene);
+  EXPECT_EQ(unflushed.meta.at("context"), "reused");
+  EXPECT_FALSE(test::framePlanes(unflushed) == test::framePlanes(fresh));
 }
 
 // `count` small random fixtures of every profile (written to `dir`) and the whole catalog,
@@ -347,7 +379,7 @@ std::vector<fs::path> randomAndCatalog(const fs::path& dir, std::uint64_t seed, 
 // names), and every plane of every frame must be the new context's bits. This is what lets a
 // driver reuse its context (ContextIsReusedWhereIsolationIsShown). Tried: with the front face
 // set only for clockwise scenes it fails on llvmpipe at the first counter-clockwise scene
-// drawn after a clockwise one; with RASTERCHECK_GL_CONTEXT=reuse it fails on softpipe at
+// drawn after a clockwise one; before FallbackFlush, in a reused softpipe context it failed at
 // transparency/softpipe_unclamped_clear_blend and random rgba8 scenes with blending (why
 // softpipe takes a new context for those).
 TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
