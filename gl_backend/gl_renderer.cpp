@@ -184,6 +184,10 @@ struct Session {
   Scratch scratch;
   GLuint sample_program = 0;  // reads one sample of the ids / depth (multisampled renders)
   GLuint empty_vertex_array = 0;
+  // resetSetupFacing's triangle: its program and a 1x1 framebuffer (0: not made yet).
+  GLuint facing_program = 0;
+  GLuint facing_framebuffer = 0;
+  GLuint facing_renderbuffer = 0;
   // A render that did not finish (its context state unknown): the next gets a new context
   // even where contexts are reused (reusesContext).
   bool render_unfinished = false;
@@ -404,6 +408,9 @@ void renewContext(Session& s, bool abandon_old = false) {
   s.programs.clear();  // their objects go with the old context
   s.sample_program = 0;
   s.empty_vertex_array = 0;
+  s.facing_program = 0;
+  s.facing_framebuffer = 0;
+  s.facing_renderbuffer = 0;
   s.framebuffer = Framebuffer{};
   s.fallbacks_created = 0;
   s.debug_errors.clear();
@@ -1424,6 +1431,71 @@ void main() {
   return id;
 }
 
+// softpipe's triangle set-up keeps the facing of the last triangle it set up (even one culled
+// after it) and hands it to the lines and points drawn after it: their two-sided stencil
+// state and gl_FrontFacing (sp_setup.c sets setup->facing in triangle set-up only). A new
+// context starts at 0, front; a reused one at whatever the last render's last triangle was
+// (docs/results/findings.md, "softpipe: lines and points take the facing of the last
+// triangle"). Before a render in a reused softpipe context one front-facing triangle with
+// colour writes off, into a 1x1 framebuffer of its own, puts it back to front (a triangle in
+// an empty scissor box never reaches the set-up).
+void resetSetupFacing(Session& s) {
+  if (gl::testing::hooks().no_facing_reset) return;
+  const gl::Functions& gl = s.gl;
+  if (s.facing_program == 0) {
+    const std::string vertex = R"(#version 330 core
+void main() {
+  vec2 p = vec2(gl_VertexID == 1 ? 0.5 : -0.5, gl_VertexID == 2 ? 0.5 : -0.5);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+    const std::string fragment = R"(#version 330 core
+out vec4 o_color;
+void main() { o_color = vec4(0.0); }
+)";
+    const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, vertex);
+    const GLuint fs = compileShader(gl, GL_FRAGMENT_SHADER, fragment);
+    const GLuint id = gl.CreateProgram();
+    gl.AttachShader(id, vs);
+    gl.AttachShader(id, fs);
+    gl.LinkProgram(id);
+    gl.DeleteShader(vs);
+    gl.DeleteShader(fs);
+    GLint ok = GL_FALSE;
+    gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
+    if (ok != GL_TRUE) {
+      gl.DeleteProgram(id);
+      throw BackendError("the set-up facing program does not link");
+    }
+    s.facing_program = id;
+    gl.GenRenderbuffers(1, &s.facing_renderbuffer);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, s.facing_renderbuffer);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, 1, 1);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
+    gl.GenFramebuffers(1, &s.facing_framebuffer);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, s.facing_framebuffer);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                               s.facing_renderbuffer);
+  }
+  if (s.empty_vertex_array == 0) gl.GenVertexArrays(1, &s.empty_vertex_array);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, s.facing_framebuffer);
+  gl.Viewport(0, 0, 1, 1);
+  gl.Disable(GL_SCISSOR_TEST);
+  gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  gl.Disable(GL_CULL_FACE);
+  gl.Disable(GL_RASTERIZER_DISCARD);
+  gl.PolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  gl.FrontFace(GL_CCW);  // the triangle is counter-clockwise: front
+  gl.UseProgram(s.facing_program);
+  gl.BindVertexArray(s.empty_vertex_array);
+  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl.BindVertexArray(0);
+  gl.UseProgram(0);
+  gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  checkGl(s, "set-up facing reset");
+}
+
 // After the draw into `t`: resolves the colour into the bound single-sample FBO, reads it,
 // then every sample's id and depth, and fills frame's multisample planes and resolve.
 void readBackMultisample(Session& s, const Scene& scene, MultisampleTargets& t, Frame& frame) {
@@ -1754,6 +1826,7 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames
   auto start = Clock::now();
   Session& s = acquireSession(spec);
   s.fallbacks_this_render = 0;
+  if (s.driver == "softpipe" && std::string_view(s.context_use) == "reused") resetSetupFacing(s);
   struct Release {
     Session& s;
     ~Release() { s.context->release(); }
@@ -1907,6 +1980,10 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames
   m["driver"] = s.driver;
   m["stack"] = s.stack;
   m["mesa"] = gl::toJson(s.mesa, s.spec, s.mesa_version);
+  // llvmpipe's (and lavapipe's) rasterizer threads as this process was started with them:
+  // `run`'s workers choose it (app/worker_pool.cpp); null: the driver's default, one a core.
+  const char* lp_threads = std::getenv("LP_NUM_THREADS");
+  m["lp_num_threads"] = lp_threads != nullptr ? nlohmann::json(lp_threads) : nlohmann::json();
   if (s.zink) {
     m["vulkan"] = s.vulkan ? gl::toJson(*s.vulkan) : nlohmann::json{{"error", s.vulkan_error}};
     m["vulkan"]["query_ms"] = s.vulkan_query_ms;

@@ -102,6 +102,7 @@ struct Hooks {
   bool ignore_pack_invert = false;     // read back as if GL_MESA_pack_invert were missing
   bool program_from_source = false;    // draw with the program as linked, not its binary
   bool no_fallback_flush = false;      // a reused softpipe context skips FallbackFlush's flushes
+  bool no_facing_reset = false;        // ... and resetSetupFacing's triangle
 };
 
 // The process-wide hooks (all off by default).

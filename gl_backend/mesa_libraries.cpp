@@ -243,13 +243,6 @@ std::string mesaVersion(const std::string& gl_version) {
   return at == std::string::npos ? std::string() : gl_version.substr(at);
 }
 
-namespace {
-nlohmann::json lpNumThreads() {
-  const char* v = std::getenv("LP_NUM_THREADS");
-  return v != nullptr ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-}  // namespace
-
 nlohmann::json toJson(const LoadedMesa& mesa, const GlSpec& spec, const std::string& version) {
   return {
       {"version", version.empty() ? nlohmann::json(nullptr) : nlohmann::json(version)},
@@ -257,10 +250,7 @@ nlohmann::json toJson(const LoadedMesa& mesa, const GlSpec& spec, const std::str
       {"dir", mesa.dir.empty() ? nlohmann::json(nullptr) : nlohmann::json(mesa.dir)},
       {"driver_library",
        mesa.driver_library.empty() ? nlohmann::json(nullptr) : nlohmann::json(mesa.driver_library)},
-      {"libraries", mesa.libraries},
-      // llvmpipe's (and lavapipe's) rasterizer threads as this process set them: `run`'s
-      // workers choose it (app/worker_pool.cpp); null: the driver's default, one per core.
-      {"lp_num_threads", lpNumThreads()}};
+      {"libraries", mesa.libraries}};
 }
 
 }  // namespace rc::gl

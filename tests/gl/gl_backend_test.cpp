@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "fixtures/loader.h"
+#include "fixtures/scene_logic.h"
 #include "gl_backend/gl_testing.h"
 #include "tests/gl/gl_test_util.h"
 #include "tests/support/random_fixtures.h"
@@ -327,6 +328,22 @@ TEST_F(GlBackend, ContextIsReusedWhereIsolationIsShown) {
   EXPECT_EQ(render(wire).meta.at("context"), keeps ? "reused" : "new");
 }
 
+// One quad wound clockwise (back-facing) with culling off: the last triangle a driver sets up
+// in it faces away.
+Scene backFacingQuad() {
+  Scene s = orthoScene(8, 8);
+  Object o = quad(-1, -1, 1, 1, 0, addMaterial(s, Material{}));
+  o.mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
+  s.objects.push_back(o);
+  return s;
+}
+
+bool drawsLinesOrPoints(const Scene& scene) {
+  const std::vector<DrawPass> passes = drawPasses(scene);
+  return std::any_of(passes.begin(), passes.end(),
+                     [](const DrawPass& p) { return p.rasterizesLinesOrPoints(); });
+}
+
 // Mesa creates its fallback texture (what a sampler reads where its unit has no texture) the
 // first time a context draws with such a unit, and flushes the context when it does; softpipe
 // blends after that flush over the stored 8-bit colour instead of its tile cache's floats. In
@@ -361,6 +378,36 @@ TEST_F(GlBackend, AReusedContextFlushesWhereANewOneCreatesItsFallbackTexture) {
   EXPECT_FALSE(test::framePlanes(unflushed) == test::framePlanes(fresh));
 }
 
+// softpipe gives lines and points the facing of the last triangle it set up (their two-sided
+// stencil state and gl_FrontFacing); a new context starts at front. In
+// lines/polygon_mode_back_stencil back faces never pass the stencil test: drawn after a
+// back-facing triangle in a reused context its lines vanished. resetSetupFacing sets the
+// facing back before each render in a reused softpipe context; without it (the
+// no_facing_reset hook) the frame differs from the new context's.
+TEST_F(GlBackend, AReusedContextDrawsLinesWithTheFacingOfANewOne) {
+  const Scene scene = loadScene(fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes" / "lines" /
+                                "polygon_mode_back_stencil.json");
+  const char* outer = std::getenv("RASTERCHECK_GL_CONTEXT");
+  if (outer != nullptr) GTEST_SKIP() << "RASTERCHECK_GL_CONTEXT=" << outer << " decides contexts";
+  ::setenv("RASTERCHECK_GL_CONTEXT", "new", 1);
+  const Frame fresh = render(scene);
+  ::unsetenv("RASTERCHECK_GL_CONTEXT");
+  const std::string driver = fresh.meta.at("driver");
+  if (driver != "llvmpipe" && driver != "zink" && driver != "softpipe")
+    GTEST_SKIP() << driver << " gets a new context per render";
+  render(backFacingQuad());
+  const Frame reused = render(scene);
+  EXPECT_EQ(reused.meta.at("context"), "reused");
+  EXPECT_TRUE(test::framePlanes(reused) == test::framePlanes(fresh));
+  if (driver != "softpipe") return;
+  HookGuard guard;
+  gl::testing::hooks().no_facing_reset = true;
+  render(backFacingQuad());
+  const Frame stale = render(scene);
+  EXPECT_EQ(stale.meta.at("context"), "reused");
+  EXPECT_FALSE(test::framePlanes(stale) == test::framePlanes(fresh));
+}
+
 // `count` small random fixtures of every profile (written to `dir`) and the whole catalog,
 // sorted: the scenes the tests below draw twice and compare bit for bit.
 std::vector<fs::path> randomAndCatalog(const fs::path& dir, std::uint64_t seed, int count) {
@@ -379,9 +426,9 @@ std::vector<fs::path> randomAndCatalog(const fs::path& dir, std::uint64_t seed, 
 // names), and every plane of every frame must be the new context's bits. This is what lets a
 // driver reuse its context (ContextIsReusedWhereIsolationIsShown). Tried: with the front face
 // set only for clockwise scenes it fails on llvmpipe at the first counter-clockwise scene
-// drawn after a clockwise one; before FallbackFlush, in a reused softpipe context it failed at
-// transparency/softpipe_unclamped_clear_blend and random rgba8 scenes with blending (why
-// softpipe takes a new context for those).
+// drawn after a clockwise one; without FallbackFlush, in a reused softpipe context it fails at
+// transparency/softpipe_unclamped_clear_blend, blended rgba8 and line scenes (7 of them).
+// Then every scene with lines or points again, right after a back-facing triangle.
 TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
   const fs::path dir =
       fs::path(::testing::TempDir()) / ("rc_isolation_" + std::to_string(getpid()));
@@ -420,6 +467,15 @@ TEST_F(GlBackend, FramesDoNotDependOnWhatWasDrawnBefore) {
         << files[i].string() << " differs from its new-context frame when drawn after "
         << files[previous].string();
     previous = i;
+  }
+  // Lines and points once more, each right after a back-facing triangle (softpipe's set-up
+  // hands its facing on: AReusedContextDrawsLinesWithTheFacingOfANewOne).
+  const Scene back = backFacingQuad();
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    if (!drawsLinesOrPoints(scenes[i])) continue;
+    render(back);
+    EXPECT_TRUE(frameOf(scenes[i]) == fresh[i])
+        << files[i].string() << " differs from its new-context frame after a back-facing quad";
   }
   fs::remove_all(dir);
 }
