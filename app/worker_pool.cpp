@@ -215,9 +215,10 @@ bool WorkerPool::send(Worker& w, const Task& task) {
 std::size_t WorkerPool::workersFor(const std::string& spec) const {
   if (options_.max_workers_per_spec > 0)
     return static_cast<std::size_t>(options_.max_workers_per_spec);
-  // llvmpipe, and lavapipe under zink, rasterize on threads of their own (one per core): a
-  // second worker of the driver would compete for the same cores and JIT-compile every
-  // shader variant again.
+  // llvmpipe, and lavapipe under zink, JIT-compile every state variant in each process: a
+  // second worker of the driver would compile them all again (tried: what it saved, its start
+  // and JIT cost). With cores to spare they rasterize on threads of their own
+  // (rasterizerThreads).
   const BackendSpec b = parseBackendSpec(spec);
   if (b.kind == BackendSpec::Kind::Gl && (b.gl.driver == "llvmpipe" || b.gl.driver == "zink"))
     return 1;

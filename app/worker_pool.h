@@ -57,8 +57,8 @@ class WorkerPool {
     // TMPDIR under its campaign folder).
     std::vector<std::string> environment;
     // Workers of one backend at a time; 0: workersFor()'s choice (one for llvmpipe and zink,
-    // which draw on threads of their own; else a second and further ones only while the
-    // backend's queued renders are worth more than starting one).
+    // which JIT-compile their variants in each process; else a second and further ones only
+    // while the backend's queued renders are worth more than starting one).
     int max_workers_per_spec = 0;
   };
   explicit WorkerPool(Options options);
