@@ -205,7 +205,7 @@ struct Session {
 // needs it, and flushes the context when it does (_mesa_get_fallback_texture,
 // src/mesa/main/texobj.c). softpipe's flush writes its colour tile cache back to an rgba8
 // buffer, and blending after it reads the stored 8-bit values instead of the cache's floats
-// (docs/results/findings.md, "softpipe: a reused context changes later frames"). A new
+// (docs/results/findings.md, "softpipe: a reused context changed later frames"). A new
 // context therefore flushes at the render's first draw whose material has no texture (or no
 // shadow map), and a reused one, whose fallbacks exist, would not: before each draw in a
 // softpipe context, beforeDraw() flushes where a new context's Mesa would have.
