@@ -1826,7 +1826,6 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames
   auto start = Clock::now();
   Session& s = acquireSession(spec);
   s.fallbacks_this_render = 0;
-  if (s.driver == "softpipe" && std::string_view(s.context_use) == "reused") resetSetupFacing(s);
   struct Release {
     Session& s;
     ~Release() { s.context->release(); }
@@ -1870,6 +1869,7 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames
           samples, usable, max_samples));
   }
   s.render_unfinished = true;  // until the frame is read back
+  if (s.driver == "softpipe" && std::string_view(s.context_use) == "reused") resetSetupFacing(s);
   PassTargets targets(gl);
   std::vector<Frame> pass_frames;
   double passes_ms = 0.0;
