@@ -10,7 +10,10 @@
 #include <chrono>
 #include <csignal>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -19,6 +22,8 @@
 
 namespace rc {
 namespace {
+
+namespace fs = std::filesystem;
 
 pid_t spawn(const Job& job, bool own_process_group) {
   posix_spawn_file_actions_t actions;
@@ -53,6 +58,51 @@ pid_t spawn(const Job& job, bool own_process_group) {
     throw BackendError(fmt::format("cannot start {}: {}", job.argv[0], std::strerror(err)));
   }
   return pid;
+}
+
+// Whether a process of `group` still runs: kill(2) also counts zombies, and an orphan's
+// zombie lasts until the init process reaps it (seconds in some containers), long after it
+// released its files. /proc/PID/stat gives each process's state and group.
+bool groupHasLiveProcess(pid_t group) {
+  if (::kill(-group, 0) != 0 && errno == ESRCH) return false;
+  std::error_code ec;
+  for (fs::directory_iterator it("/proc", ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream in(it->path() / "stat");
+    std::string stat;
+    std::getline(in, stat);
+    // "PID (COMM) STATE PPID PGRP ...": COMM may hold spaces and parentheses.
+    const std::size_t close = stat.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream fields(stat.substr(close + 1));
+    char state = 0;
+    long ppid = 0;
+    long pgrp = 0;
+    if ((fields >> state >> ppid >> pgrp) && pgrp == group && state != 'Z' && state != 'X')
+      return true;
+  }
+  return false;
+}
+
+// A cancelled job's children outlive it by moments: its workers get the same SIGTERM but
+// die on their own time, and a child caught between posix_spawn's clone and its exec
+// still shares the job's open files (a report folder's staging lock) and may still create
+// its log file. The caller cleans up after the job (a campaign removes the run's staging
+// folder), so wait until nothing of the job's process group runs: SIGKILL after 2 s, give
+// up after 5 s.
+void waitForGroup(pid_t group) {
+  const auto start = std::chrono::steady_clock::now();
+  bool killed = false;
+  while (groupHasLiveProcess(group)) {
+    const auto waited = std::chrono::steady_clock::now() - start;
+    if (waited > std::chrono::seconds(5)) return;
+    if (!killed && waited > std::chrono::seconds(2)) {
+      ::kill(-group, SIGKILL);
+      killed = true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
 }
 
 void record(Job& job, int status) {
@@ -125,6 +175,7 @@ void runJobs(std::vector<Job>& jobs, int parallel, const std::function<void(std:
     record(jobs[it->second], status);
     const std::size_t index = it->second;
     running.erase(it);
+    if (jobs[index].cancelled && control.own_process_group) waitForGroup(pid);
     if (on_done) on_done(index);
   }
 }

@@ -30,7 +30,8 @@ struct JobControl {
   std::function<void()> on_tick;
   double tick_seconds = 0.5;
   // When it becomes true: no further job starts, and every running child's process group
-  // gets SIGTERM; its job is marked cancelled. runJobs returns once they have exited.
+  // gets SIGTERM; its job is marked cancelled. runJobs returns once they have exited
+  // (with own_process_group: once their groups are empty, what they started gone too).
   const std::atomic<bool>* cancel = nullptr;
   // Each child leads its own process group, so that a terminal's Ctrl-C reaches only
   // this process (which then stops the children through `cancel`) and SIGTERM to the

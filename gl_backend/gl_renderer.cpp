@@ -202,13 +202,14 @@ struct Session {
 
 // Mesa's fallback textures, what a sampler reads where its unit holds no complete texture:
 // Mesa creates one per target and kind (colour, depth) the first time a draw in a share group
-// needs it, and flushes the context when it does (_mesa_get_fallback_texture,
-// src/mesa/main/texobj.c). softpipe's flush writes its colour tile cache back to an rgba8
-// buffer, and blending after it reads the stored 8-bit values instead of the cache's floats
-// (docs/results/findings.md, "softpipe: a reused context changed later frames"). A new
-// context therefore flushes at the render's first draw whose material has no texture (or no
-// shadow map), and a reused one, whose fallbacks exist, would not: before each draw in a
-// softpipe context, beforeDraw() flushes where a new context's Mesa would have.
+// needs it, and finishes the context when it does (_mesa_get_fallback_texture,
+// src/mesa/main/texobj.c; on softpipe glFinish and glFlush both flush). softpipe's flush
+// writes its colour tile cache back to an rgba8 buffer, and blending after it reads the
+// stored 8-bit values instead of the cache's floats (docs/results/findings.md, "softpipe: a
+// reused context changed later frames"). A new context therefore flushes at the render's
+// first draw with an empty unit its program samples, and a reused one, whose fallbacks exist,
+// would not: before each draw in a softpipe context, beforeDraw() flushes where a new
+// context's Mesa would have.
 struct FallbackFlush {
   static constexpr unsigned kColor2D = 1;  // sampler2D on unit 0 (the material's texture)
   static constexpr unsigned kDepth2D = 2;  // sampler2DShadow on unit 1 (the shadow map)
@@ -334,11 +335,11 @@ bool keepsOneContext(const Session& s) {
 // compiled, instead of starting from a new one (resetReusedContext() restores what a render
 // does not set itself): where the isolation test shows that a frame is the one a new context
 // gives, whatever the context drew before (GlBackend.FramesDoNotDependOnWhatWasDrawnBefore),
-// that is llvmpipe, zink and softpipe (softpipe with FallbackFlush); zink on Mesa 22 in any
-// case (keepsOneContext). A driver the test has not run on (a GPU) gets a new context per
-// render. RASTERCHECK_GL_CONTEXT=new gives every driver but zink on
-// Mesa 22 a new context per render, =reuse reuses it on every driver and render (to test
-// one); it is read at every render.
+// that is llvmpipe, zink and softpipe (softpipe with FallbackFlush and resetSetupFacing); zink
+// on Mesa 22 in any case (keepsOneContext). A driver the test has not run on (a GPU) gets a
+// new context per render. RASTERCHECK_GL_CONTEXT=new gives every driver but zink on Mesa 22 a
+// new context per render, =reuse reuses it on every driver and render (to test one); it is
+// read at every render.
 bool reusesContext(const Session& s) {
   if (keepsOneContext(s)) return true;
   const char* forced = std::getenv("RASTERCHECK_GL_CONTEXT");
@@ -398,10 +399,10 @@ std::unique_ptr<Session> createSession(const GlSpec& spec) {
   return s;
 }
 
-// A new context for the next render, on the driver this process already loaded: every
-// render starts from a fresh context's state, as it did when each render was a process
-// of its own. Reusing one context showed softpipe's results depend on the fixture drawn
-// before (rgba8 with blending: 5 of 120 random scenes; docs/gl_backend.md).
+// A new context for the next render, on the driver this process already loaded: where a
+// driver's frames could depend on what the context drew before (reusesContext), every
+// render starts from a fresh context's state, as it did when each render was a process of
+// its own (docs/gl_backend.md).
 // `abandon_old`: leave the old context allocated instead of destroying it (zink on Mesa 22
 // cannot take the destruction; see acquireSession).
 void renewContext(Session& s, bool abandon_old = false) {
@@ -1427,7 +1428,7 @@ void main() {
     throw BackendError("the sample readback program does not link");
   }
   s.sample_program = id;
-  gl.GenVertexArrays(1, &s.empty_vertex_array);
+  if (s.empty_vertex_array == 0) gl.GenVertexArrays(1, &s.empty_vertex_array);
   return id;
 }
 
@@ -1942,7 +1943,12 @@ Frame renderLocked(const Scene& multi, const GlSpec& spec, bool want_pass_frames
     offset_r = measureOffsetR(gl, program, scene, probe_first, FallbackFlush(s, program));
   }
   clearFramebuffer(gl, scene);
-  drawPassesGl(gl, program, scene, data, textures, shadows, faults, FallbackFlush(s, program));
+  const FallbackFlush fallback(s, program);
+  drawPassesGl(gl, program, scene, data, textures, shadows, faults, fallback);
+  // A render that drew nothing still validates its program's samplers at the read-back (a
+  // new context's Mesa creates the fallbacks there): count them as created. A flush here,
+  // after the last draw, changes no pixel.
+  fallback.beforeDraw();
   resetPassState(gl);
   gl.Finish();
   injectStall(faults, scene.name);

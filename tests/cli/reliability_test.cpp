@@ -8,6 +8,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -19,6 +22,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "app/subprocess.h"
 #include "tests/support/command.h"
 
 namespace fs = std::filesystem;
@@ -283,6 +287,49 @@ TEST(Reliability, ADeadRunsStagingIsRemovedByTheNextRun) {
                 .code,
             0);
   EXPECT_EQ(stagingIn(dir), std::vector<std::string>{});
+  fs::remove_all(dir);
+}
+
+// A cancelled job (a campaign's run on Ctrl-C) is over only when everything it started is:
+// its children share its open files (the staging folder's lock) and write into its folder
+// after it has died, so the campaign's clean-up waits for them. One child of the job
+// outlives it by 0.5 s and then writes; another ignores SIGTERM and must be killed.
+TEST(Reliability, ACancelledJobEndsWithEverythingItStarted) {
+  const fs::path dir = scratch("cancel_group");
+  const fs::path ready = dir / "ready";
+  const fs::path late = dir / "late";
+  const fs::path stubborn = dir / "stubborn.pid";
+  rc::Job job;
+  job.argv = {"/bin/sh", "-c",
+              "(trap '' TERM; sleep 0.5; echo late > " + late.string() + ") & " +
+                  "(trap '' TERM; echo $(exec sh -c 'echo $PPID') > " + stubborn.string() +
+                  "; while :; do sleep 0.05; done) & " + "sleep 0.2; touch " + ready.string() +
+                  "; exec sleep 60"};
+  job.log = dir / "job.log";
+  std::vector<rc::Job> jobs{job};
+  std::atomic<bool> cancel{false};
+  rc::JobControl control;
+  control.cancel = &cancel;
+  control.own_process_group = true;
+  control.tick_seconds = 0.02;
+  control.on_tick = [&] {
+    if (fs::exists(ready)) cancel = true;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  rc::runJobs(jobs, 1, {}, {}, control);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_TRUE(jobs[0].cancelled);
+  EXPECT_EQ(jobs[0].exit_code, 128 + SIGTERM);
+  EXPECT_TRUE(fs::exists(late)) << "runJobs returned before the job's child had finished";
+  const long pid = std::stol(readBytes(stubborn));
+  ASSERT_GT(pid, 1);
+  // Gone, or a zombie until the init process reaps it.
+  const std::string stat = readBytes("/proc/" + std::to_string(pid) + "/stat");
+  const std::size_t close = stat.rfind(')');
+  EXPECT_TRUE(close == std::string::npos || stat.substr(close + 2, 1) == "Z")
+      << "the child that ignores SIGTERM is still running: " << stat;
+  EXPECT_LT(seconds, 10.0);
   fs::remove_all(dir);
 }
 

@@ -374,7 +374,7 @@ TEST(GlWorkers, AWorkerSendsTheFramePassWithoutThePassFrames) {
 // every profile and the whole catalog in file order, then the same list shuffled, then A, B,
 // A for a blended and a textured scene, and every frame must be the bits a worker with a new
 // context per render (RASTERCHECK_GL_CONTEXT=new) gives. Where the driver keeps its context
-// (llvmpipe, zink; softpipe but for renders that blend onto rgba8, docs/gl_backend.md) this
+// (llvmpipe, zink, softpipe with the harness's flush and facing reset, docs/gl_backend.md) this
 // is what allows it. Tried: with the front face set only for
 // clockwise scenes it fails on llvmpipe.
 TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
