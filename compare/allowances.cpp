@@ -91,6 +91,23 @@ bool Comparator::blendUncertainAt(std::size_t i) const {
              2.0 * (tol_.depth.fail + depthAllowance(i, u_.blend_slope[i]));
 }
 
+// Whether the driver may legally hold the clear depth at pixel i where the expected frame
+// holds a fragment's, with the same primitive seen: a visible fragment that writes no depth
+// over a fragment GL leaves to the driver (a line's end, a point's side, a polygon edge
+// within the band: edge_dist). The driver that leaves that fragment out keeps what was
+// there before, and only the clear depth is known to have been there (an earlier fragment's
+// would need a channel of its own). The other way round, a fragment only the driver drew,
+// is not excused: nothing here knows the depth it should have (zink's zero-area triangles in
+// polygon mode store a wrong one: docs/results/findings.md). docs/tolerances.md, "Blended
+// pixels".
+bool Comparator::optionalFragmentLeftOut(std::size_t i, std::size_t k) const {
+  if (!have_uncertainty_ || std::isnan(clear_steps_) || !(u_.edge_dist[k] <= band_) ||
+      i >= a_.depth.size())
+    return false;
+  const double rounding = scale_.quantized ? 1.0 : 0.0;
+  return std::fabs(scale_(a_.depth[i]) - clear_steps_) <= rounding;
+}
+
 // The pixel whose uncertainty channels describe the expected frame's fragment at pixel
 // (x, y), index i: i itself, unless the uncertainty frame is another frame (driver
 // against driver) that shows another primitive there. Then a neighbour (8-connected)
@@ -120,7 +137,7 @@ __attribute__((noinline)) void Comparator::depthOverBase(int x, int y, std::size
   d.max_slope = std::max(d.max_slope, slope);
   const double excess = dz - at.warn;
   if (excess <= 0.0) return;
-  if (blendUncertain(i, k)) {
+  if (blendUncertain(i, k) || optionalFragmentLeftOut(i, k)) {
     ++d.blend_uncertain;
     return;
   }

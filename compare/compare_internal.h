@@ -148,6 +148,9 @@ class Comparator {
     texel_band_ = r.depth.band_px;
     shade_relative_units_ = 255.0 * tol.shading_relative;
     have_sample_uncertainty_ = have_uncertainty_ && u.multisampled() && u.samples == e.samples;
+    const nlohmann::json& meta = e.meta.contains("clear_depth") ? e.meta : u.meta;
+    if (meta.contains("clear_depth") && meta["clear_depth"].is_number())
+      clear_steps_ = scale_(meta["clear_depth"].get<float>());
   }
 
   void run(ClassMaps* maps);
@@ -190,6 +193,7 @@ class Comparator {
   bool ambiguousByDepth(std::size_t i, std::uint32_t a, std::uint32_t b) const;
   bool blendUncertain(std::size_t i, std::size_t k) const;
   bool blendUncertainAt(std::size_t i) const;
+  bool optionalFragmentLeftOut(std::size_t i, std::size_t k) const;
   std::size_t describing(int x, int y, std::size_t i) const;
   __attribute__((noinline)) void depthOverBase(int x, int y, std::size_t i, double dz);
   __attribute__((noinline)) void depthNonFinite(std::size_t i);
@@ -224,6 +228,8 @@ class Comparator {
   double shade_slope_band_ = 0.0;  // shading_slope_factor * slope band
   double texel_band_ = 0.0;        // the slope band: how far a texture sample may move (px)
   double shade_relative_units_ = 0.0;
+  // The clear depth in steps (frame.json clear_depth), NaN where the frames do not say.
+  double clear_steps_ = std::numeric_limits<double>::quiet_NaN();
   // Multisampled frames: per-sample edge distances and sample_alt are available.
   bool have_sample_uncertainty_ = false;
   std::uint64_t sample_mismatches_ = 0;

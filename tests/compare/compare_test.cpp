@@ -868,6 +868,42 @@ TEST_F(CompareTest, BlendedPixelsWithAnUncertainFragmentSetAreExcused) {
   EXPECT_EQ(compare().shading.over_fail, 2 * n);
 }
 
+// A visible fragment that writes no depth over a fragment GL leaves to the driver (edge_dist
+// 0: a line's end) shows the same primitive whether or not that fragment was drawn; a driver
+// that left it out holds the clear depth there. That is excused; the same depth away from
+// the band, another depth than the clear one, or a fragment only the driver drew (the
+// reference's clear depth) is not (campaign s20261355 scene 00027).
+TEST_F(CompareTest, ADriverMayLeaveOutAnOptionalFragmentUnderOneThatWritesNoDepth) {
+  ref_.meta["clear_depth"] = 1.0;
+  const double band = baseline_.visibility.band_px;
+  const Block optional{70, 25, 74, 29};
+  const Block away{80, 25, 84, 29};
+  const Block other{90, 25, 94, 29};
+  forBlock(optional, [&](int x, int y) { ref_.edge_dist[ref_.index(x, y)] = 0.0f; });
+  forBlock(away, [&](int x, int y) {
+    ref_.edge_dist[ref_.index(x, y)] = static_cast<float>(band * 1.01);
+  });
+  forBlock(other, [&](int x, int y) { ref_.edge_dist[ref_.index(x, y)] = 0.0f; });
+  for (const Block& b : {optional, away})
+    forBlock(b, [&](int x, int y) { gl_.depth[gl_.index(x, y)] = 1.0f; });
+  forBlock(other, [&](int x, int y) {
+    gl_.depth[gl_.index(x, y)] = quantized(gl_.depth[gl_.index(x, y)], 5000.0);
+  });
+  const auto n = static_cast<std::uint64_t>(optional.size());
+  PairResult r = compare();
+  EXPECT_EQ(r.depth.over_fail, 2 * n) << "away from the band and a depth other than the clear";
+  EXPECT_EQ(r.depth.blend_uncertain, n);
+  // The other way round: the reference kept the clear depth, the driver drew a fragment.
+  std::swap(ref_.depth, gl_.depth);
+  r = compare();
+  EXPECT_EQ(r.depth.blend_uncertain, 0u);
+  EXPECT_EQ(r.depth.over_fail, 3 * n);
+  // Frames that do not say their clear depth excuse nothing.
+  std::swap(ref_.depth, gl_.depth);
+  ref_.meta.erase("clear_depth");
+  EXPECT_EQ(compare().depth.over_fail, 3 * n);
+}
+
 // The depth slope allowance comes from the reference's depth_slope at the pixel, however
 // few pixels the primitive shows: a one-pixel-wide sliver gets its true steep slope.
 TEST(DepthSlope, TheAllowanceIsTheReferencesSlopeAtThePixel) {
