@@ -489,6 +489,21 @@ Session& acquireSession(const GlSpec& spec) {
   return s;
 }
 
+// A shader's or program's info log (`get_iv` and `get_log`: the glGet*iv and glGet*InfoLog
+// of its kind) on one line: the report shows the first error, the compiler's newlines
+// become ';'.
+template <typename GetIv, typename GetLog>
+std::string oneLineLog(GLuint id, GetIv get_iv, GetLog get_log) {
+  GLint length = 0;
+  get_iv(id, GL_INFO_LOG_LENGTH, &length);
+  std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+  get_log(id, length, nullptr, log.data());
+  log.resize(std::strlen(log.c_str()));
+  while (!log.empty() && (log.back() == '\n' || log.back() == ' ')) log.pop_back();
+  for (char& c : log) c = c == '\n' ? ';' : c;
+  return log;
+}
+
 GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& source) {
   const GLuint shader = gl.CreateShader(stage);
   const char* text = source.c_str();
@@ -497,17 +512,36 @@ GLuint compileShader(const gl::Functions& gl, GLenum stage, const std::string& s
   GLint ok = GL_FALSE;
   gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
   if (ok == GL_TRUE) return shader;
-  GLint length = 0;
-  gl.GetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
-  std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
-  gl.GetShaderInfoLog(shader, length, nullptr, log.data());
+  const std::string log = oneLineLog(shader, gl.GetShaderiv, gl.GetShaderInfoLog);
   gl.DeleteShader(shader);
-  log.resize(std::strlen(log.c_str()));
-  // One line: the report shows the first error; the compiler's newlines become "; ".
-  while (!log.empty() && (log.back() == '\n' || log.back() == ' ')) log.pop_back();
-  for (char& c : log) c = c == '\n' ? ';' : c;
   throw BackendError(fmt::format("{} shader does not compile: {}",
                                  stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log));
+}
+
+// A program linked from the two sources (their shaders deleted), or BackendError naming
+// `what` with the linker's log on one line.
+GLuint linkProgram(const gl::Functions& gl, const std::string& vertex, const std::string& fragment,
+                   std::string_view what) {
+  const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, vertex);
+  GLuint fs = 0;
+  try {
+    fs = compileShader(gl, GL_FRAGMENT_SHADER, fragment);
+  } catch (...) {
+    gl.DeleteShader(vs);
+    throw;
+  }
+  const GLuint id = gl.CreateProgram();
+  gl.AttachShader(id, vs);
+  gl.AttachShader(id, fs);
+  gl.LinkProgram(id);
+  gl.DeleteShader(vs);
+  gl.DeleteShader(fs);
+  GLint ok = GL_FALSE;
+  gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
+  if (ok == GL_TRUE) return id;
+  const std::string log = oneLineLog(id, gl.GetProgramiv, gl.GetProgramInfoLog);
+  gl.DeleteProgram(id);
+  throw BackendError(fmt::format("{} does not link: {}", what, log));
 }
 
 // The program `id` as its binary gives it back: a new program object made from
@@ -564,32 +598,7 @@ const Program& programFor(Session& s, int max_lights, const gl::testing::Faults&
   s.program_use = "compiled";
 
   const gl::Functions& gl = s.gl;
-  const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, source.vertex);
-  GLuint fs = 0;
-  try {
-    fs = compileShader(gl, GL_FRAGMENT_SHADER, source.fragment);
-  } catch (...) {
-    gl.DeleteShader(vs);
-    throw;
-  }
-  const GLuint id = gl.CreateProgram();
-  gl.AttachShader(id, vs);
-  gl.AttachShader(id, fs);
-  gl.LinkProgram(id);
-  gl.DeleteShader(vs);
-  gl.DeleteShader(fs);
-  GLint ok = GL_FALSE;
-  gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
-  if (ok != GL_TRUE) {
-    GLint length = 0;
-    gl.GetProgramiv(id, GL_INFO_LOG_LENGTH, &length);
-    std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
-    gl.GetProgramInfoLog(id, length, nullptr, log.data());
-    gl.DeleteProgram(id);
-    log.resize(std::strlen(log.c_str()));
-    for (char& c : log) c = c == '\n' ? ';' : c;
-    throw BackendError(fmt::format("shader program does not link: {}", log));
-  }
+  const GLuint id = linkProgram(gl, source.vertex, source.fragment, "shader program");
   Program p;
   p.id = hooks.program_from_source ? id : throughBinary(s, id);
   p.from_binary = p.id != id;
@@ -1413,23 +1422,9 @@ void main() {
   }
 }
 )";
-  const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, vertex);
-  const GLuint fs = compileShader(gl, GL_FRAGMENT_SHADER, fragment);
-  const GLuint id = gl.CreateProgram();
-  gl.AttachShader(id, vs);
-  gl.AttachShader(id, fs);
-  gl.LinkProgram(id);
-  gl.DeleteShader(vs);
-  gl.DeleteShader(fs);
-  GLint ok = GL_FALSE;
-  gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
-  if (ok != GL_TRUE) {
-    gl.DeleteProgram(id);
-    throw BackendError("the sample readback program does not link");
-  }
-  s.sample_program = id;
+  s.sample_program = linkProgram(gl, vertex, fragment, "the sample readback program");
   if (s.empty_vertex_array == 0) gl.GenVertexArrays(1, &s.empty_vertex_array);
-  return id;
+  return s.sample_program;
 }
 
 // softpipe's triangle set-up keeps the facing of the last triangle it set up (even one culled
@@ -1454,21 +1449,7 @@ void main() {
 out vec4 o_color;
 void main() { o_color = vec4(0.0); }
 )";
-    const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, vertex);
-    const GLuint fs = compileShader(gl, GL_FRAGMENT_SHADER, fragment);
-    const GLuint id = gl.CreateProgram();
-    gl.AttachShader(id, vs);
-    gl.AttachShader(id, fs);
-    gl.LinkProgram(id);
-    gl.DeleteShader(vs);
-    gl.DeleteShader(fs);
-    GLint ok = GL_FALSE;
-    gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
-    if (ok != GL_TRUE) {
-      gl.DeleteProgram(id);
-      throw BackendError("the set-up facing program does not link");
-    }
-    s.facing_program = id;
+    s.facing_program = linkProgram(gl, vertex, fragment, "the set-up facing program");
     gl.GenRenderbuffers(1, &s.facing_renderbuffer);
     gl.BindRenderbuffer(GL_RENDERBUFFER, s.facing_renderbuffer);
     gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, 1, 1);

@@ -344,6 +344,33 @@ bool drawsLinesOrPoints(const Scene& scene) {
                      [](const DrawPass& p) { return p.rasterizesLinesOrPoints(); });
 }
 
+// `scene` rendered in a reused context right after `before` must give the bits of a new
+// context on every driver that reuses its context; on softpipe, with the emulation that
+// `off` names turned off, the reused context's frame must differ (the emulation is what it
+// takes). Skipped where RASTERCHECK_GL_CONTEXT decides contexts or the driver takes a new
+// one per render.
+void expectReusedLikeNew(const Scene& scene, const Scene& before, bool gl::testing::Hooks::*off) {
+  const char* outer = std::getenv("RASTERCHECK_GL_CONTEXT");
+  if (outer != nullptr) GTEST_SKIP() << "RASTERCHECK_GL_CONTEXT=" << outer << " decides contexts";
+  ::setenv("RASTERCHECK_GL_CONTEXT", "new", 1);
+  const Frame fresh = GlTest::render(scene);
+  ::unsetenv("RASTERCHECK_GL_CONTEXT");
+  const std::string driver = fresh.meta.at("driver");
+  if (driver != "llvmpipe" && driver != "zink" && driver != "softpipe")
+    GTEST_SKIP() << driver << " gets a new context per render";
+  GlTest::render(before);
+  const Frame reused = GlTest::render(scene);
+  EXPECT_EQ(reused.meta.at("context"), "reused");
+  EXPECT_TRUE(test::framePlanes(reused) == test::framePlanes(fresh));
+  if (driver != "softpipe") return;
+  HookGuard guard;
+  gl::testing::hooks().*off = true;
+  GlTest::render(before);
+  const Frame without = GlTest::render(scene);
+  EXPECT_EQ(without.meta.at("context"), "reused");
+  EXPECT_FALSE(test::framePlanes(without) == test::framePlanes(fresh));
+}
+
 // Mesa creates its fallback texture (what a sampler reads where its unit has no texture) the
 // first time a context draws with such a unit, and flushes the context when it does; softpipe
 // blends after that flush over the stored 8-bit colour instead of its tile cache's floats. In
@@ -353,29 +380,11 @@ bool drawsLinesOrPoints(const Scene& scene) {
 // give the new context's bits in the reused one; on softpipe, without the harness's flush
 // (the no_fallback_flush hook) the frame differs, which shows the flush is what it takes.
 TEST_F(GlBackend, AReusedContextFlushesWhereANewOneCreatesItsFallbackTexture) {
-  const Scene scene = loadScene(fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes" / "transparency" /
-                                "softpipe_unclamped_clear_blend.json");
   Scene untextured = orthoScene(8, 8);
   untextured.objects.push_back(quad(-1, -1, 1, 1, 0, addMaterial(untextured, Material{})));
-  const char* outer = std::getenv("RASTERCHECK_GL_CONTEXT");
-  if (outer != nullptr) GTEST_SKIP() << "RASTERCHECK_GL_CONTEXT=" << outer << " decides contexts";
-  ::setenv("RASTERCHECK_GL_CONTEXT", "new", 1);
-  const Frame fresh = render(scene);
-  ::unsetenv("RASTERCHECK_GL_CONTEXT");
-  const std::string driver = fresh.meta.at("driver");
-  if (driver != "llvmpipe" && driver != "zink" && driver != "softpipe")
-    GTEST_SKIP() << driver << " gets a new context per render";
-  render(untextured);
-  const Frame reused = render(scene);
-  EXPECT_EQ(reused.meta.at("context"), "reused");
-  EXPECT_TRUE(test::framePlanes(reused) == test::framePlanes(fresh));
-  if (driver != "softpipe") return;
-  HookGuard guard;
-  gl::testing::hooks().no_fallback_flush = true;
-  render(untextured);
-  const Frame unflushed = render(scene);
-  EXPECT_EQ(unflushed.meta.at("context"), "reused");
-  EXPECT_FALSE(test::framePlanes(unflushed) == test::framePlanes(fresh));
+  expectReusedLikeNew(loadScene(fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes" / "transparency" /
+                                "softpipe_unclamped_clear_blend.json"),
+                      untextured, &gl::testing::Hooks::no_fallback_flush);
 }
 
 // softpipe gives lines and points the facing of the last triangle it set up (their two-sided
@@ -385,38 +394,15 @@ TEST_F(GlBackend, AReusedContextFlushesWhereANewOneCreatesItsFallbackTexture) {
 // facing back before each render in a reused softpipe context; without it (the
 // no_facing_reset hook) the frame differs from the new context's.
 TEST_F(GlBackend, AReusedContextDrawsLinesWithTheFacingOfANewOne) {
-  const Scene scene = loadScene(fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes" / "lines" /
-                                "polygon_mode_back_stencil.json");
-  const char* outer = std::getenv("RASTERCHECK_GL_CONTEXT");
-  if (outer != nullptr) GTEST_SKIP() << "RASTERCHECK_GL_CONTEXT=" << outer << " decides contexts";
-  ::setenv("RASTERCHECK_GL_CONTEXT", "new", 1);
-  const Frame fresh = render(scene);
-  ::unsetenv("RASTERCHECK_GL_CONTEXT");
-  const std::string driver = fresh.meta.at("driver");
-  if (driver != "llvmpipe" && driver != "zink" && driver != "softpipe")
-    GTEST_SKIP() << driver << " gets a new context per render";
-  render(backFacingQuad());
-  const Frame reused = render(scene);
-  EXPECT_EQ(reused.meta.at("context"), "reused");
-  EXPECT_TRUE(test::framePlanes(reused) == test::framePlanes(fresh));
-  if (driver != "softpipe") return;
-  HookGuard guard;
-  gl::testing::hooks().no_facing_reset = true;
-  render(backFacingQuad());
-  const Frame stale = render(scene);
-  EXPECT_EQ(stale.meta.at("context"), "reused");
-  EXPECT_FALSE(test::framePlanes(stale) == test::framePlanes(fresh));
+  expectReusedLikeNew(loadScene(fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes" / "lines" /
+                                "polygon_mode_back_stencil.json"),
+                      backFacingQuad(), &gl::testing::Hooks::no_facing_reset);
 }
 
 // `count` small random fixtures of every profile (written to `dir`) and the whole catalog,
 // sorted: the scenes the tests below draw twice and compare bit for bit.
 std::vector<fs::path> randomAndCatalog(const fs::path& dir, std::uint64_t seed, int count) {
-  std::vector<fs::path> files = test::writeRandomProfiles(dir, seed, count, 96, 72);
-  const fs::path catalog = fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes";
-  for (const auto& e : fs::recursive_directory_iterator(catalog))
-    if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
-  return files;
+  return test::randomAndCatalog(dir, seed, count, fs::path(RC_SOURCE_DIR) / "fixtures" / "scenes");
 }
 
 // Isolation: a fixture's frame does not depend on what this process drew before it. Random

@@ -384,10 +384,8 @@ TEST(GlWorkers, AWorkerSendsTheFramePassWithoutThePassFrames) {
 TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
   const fs::path dir = scratch("isolation");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
-  std::vector<fs::path> files = rc::test::writeRandomProfiles(dir / "random", 20261205, 4, 96, 72);
-  for (const auto& e : fs::recursive_directory_iterator(catalog("")))
-    if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  std::vector<fs::path> files =
+      rc::test::randomAndCatalog(dir / "random", 20261205, 4, catalog(""));
   ASSERT_GE(files.size(), 60u);
   auto bytes = [](const rc::RenderOutcome& o) {
     return o.ok ? rc::test::framePlanes(o.frame) : "error: " + o.error;
@@ -450,10 +448,8 @@ TEST(GlWorkers, FramesDoNotDependOnTheOrderAWorkerDrawsThem) {
 TEST(GlWorkers, RasterizerThreadsDoNotChangeTheBits) {
   const fs::path dir = scratch("rasterizer_threads");
   if (!llvmpipeRuns(dir)) GTEST_SKIP() << "llvmpipe does not start here";
-  std::vector<fs::path> files = rc::test::writeRandomProfiles(dir / "random", 20261206, 2, 96, 72);
-  for (const auto& e : fs::recursive_directory_iterator(catalog("")))
-    if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  std::vector<fs::path> files =
+      rc::test::randomAndCatalog(dir / "random", 20261206, 2, catalog(""));
   ASSERT_GE(files.size(), 50u);
   for (const char* spec : {"gl:egl:llvmpipe", "gl:egl:zink"}) {
     SCOPED_TRACE(spec);

@@ -44,6 +44,18 @@ inline std::vector<std::filesystem::path> writeRandomProfiles(const std::filesys
   return files;
 }
 
+// writeRandomProfiles' fixtures (96x72 at most) and every fixture of the catalog folder
+// `catalog`, sorted: the scenes the isolation tests draw in several orders and compare.
+inline std::vector<std::filesystem::path> randomAndCatalog(const std::filesystem::path& dir,
+                                                           std::uint64_t seed, int count,
+                                                           const std::filesystem::path& catalog) {
+  std::vector<std::filesystem::path> files = writeRandomProfiles(dir, seed, count, 96, 72);
+  for (const auto& e : std::filesystem::recursive_directory_iterator(catalog))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 // Colour, depth and ids, and the per-sample ids and depths of a multisampled frame, as
 // bytes: equal frames give equal strings.
 inline std::string framePlanes(const Frame& f) {
